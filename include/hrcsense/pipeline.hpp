@@ -1,0 +1,184 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — sources, sinks, the per-frame processing path and the threads around it.
+#pragma once
+
+#include "hrcsense/proximity.hpp"
+#include "hrcsense/safety.hpp"
+#include "hrcsense/segmentation.hpp"
+#include "hrcsense/sim.hpp"
+#include "hrcsense/types.hpp"
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+
+namespace hrcsense {
+
+/// What a source says about itself before the first frame.
+struct SourceInfo {
+  std::string type;             ///< "sim", "folder", "bag", ...
+  std::string description;      ///< e.g. the scene or file
+  Intrinsics intrinsics;        ///< of the depth stream
+  float stereo_baseline_mm = 0.0F;  ///< 0 when unknown
+  double nominal_fps = 30.0;    ///< for pacing when frames carry no usable timestamps
+  int64_t frame_count = -1;     ///< -1 when unknown
+};
+
+/// A source of depth frames. One of the two virtual interfaces of hrcsense.
+class Source {
+ public:
+  enum class Status { frame, end, error };
+  virtual ~Source() = default;
+  virtual SourceInfo info() const = 0;
+  /// Reads the next frame into `out`, reusing its buffers. After `error`, error() says why.
+  virtual Status next(Frame& out) = 0;
+  virtual std::string error() const { return {}; }
+};
+
+/// The simulator as a source, ending after params.frames frames.
+class SimSource : public Source {
+ public:
+  explicit SimSource(Simulator simulator) : sim_(std::move(simulator)) {}
+  SourceInfo info() const override;
+  Status next(Frame& out) override;
+
+ private:
+  Simulator sim_;
+  int64_t next_index_ = 0;
+};
+
+/// What the run is about, written once before the first frame.
+struct RunHeader {
+  std::string version;
+  std::string commit;
+  std::string config_hash;
+  SourceInfo source;
+};
+
+/// Totals written once at the end.
+struct RunSummary {
+  int64_t frames_in = 0;          ///< frames read from the source
+  int64_t frames_processed = 0;   ///< frames that went through processing
+  int64_t frames_dropped = 0;     ///< dropped by mailboxes (paced or live runs only)
+  int64_t frames_valid = 0;
+  int64_t verdict_run = 0, verdict_slow = 0, verdict_stop = 0;
+  double wall_s = 0.0;
+  double fps = 0.0;               ///< frames_processed / wall_s
+  double latency_p50_us = 0.0, latency_p99_us = 0.0;
+  float min_distance_m = -1.0F;   ///< smallest distance seen; -1 if never any foreground
+  std::string end_reason;         ///< "end of source", or the source's error
+};
+
+/// A consumer of results. The other virtual interface of hrcsense.
+class Sink {
+ public:
+  virtual ~Sink() = default;
+  virtual void header(const RunHeader& header) = 0;
+  virtual void frame(const FrameResult& result) = 0;
+  virtual void summary(const RunSummary& summary) = 0;
+};
+
+/// Single-slot, latest-value-wins mailbox between two threads. put() never blocks: a value
+/// not yet taken is replaced and counted as dropped. take() waits for a value or close().
+template <typename T>
+class Mailbox {
+ public:
+  /// Stores `value` (swapped in, so buffers circulate without allocation). Never blocks.
+  void put(T& value) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (full_) ++dropped_;
+    std::swap(slot_, value);
+    full_ = true;
+    ready_.notify_one();
+  }
+  /// Waits for a value and swaps it into `out`; false once closed and empty.
+  bool take(T& out) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    ready_.wait(lock, [&] { return full_ || closed_; });
+    if (!full_) return false;
+    std::swap(slot_, out);
+    full_ = false;
+    return true;
+  }
+  /// Like take(), but gives up after `timeout_s`; false on timeout or when closed and empty.
+  bool take_for(T& out, double timeout_s) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    ready_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return full_ || closed_; });
+    if (!full_) return false;
+    std::swap(slot_, out);
+    full_ = false;
+    return true;
+  }
+  bool closed() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return closed_ && !full_;
+  }
+  void close() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    closed_ = true;
+    ready_.notify_all();
+  }
+  int64_t dropped() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return dropped_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::condition_variable ready_;
+  T slot_{};
+  bool full_ = false;
+  bool closed_ = false;
+  int64_t dropped_ = 0;
+};
+
+/// Everything the processing path needs, already parsed (see config.hpp).
+struct PipelineParams {
+  Pose T_base_camera = Pose::Identity();
+  RobotModel robot;
+  BackgroundParams background;
+  ForegroundParams foreground;
+  SafetyParams safety;
+  std::string backend = "brute";
+};
+
+/// The per-frame processing path, single-threaded: background → foreground → proximity →
+/// verdict. Owns the stages' state and scratch buffers.
+class Pipeline {
+ public:
+  explicit Pipeline(PipelineParams params);
+  /// Uses a background learnt earlier instead of learning from the first frames.
+  void set_background(BackgroundModel model);
+  bool background_ready() const { return learner_.ready() || preset_background_; }
+  const BackgroundModel& background() const;
+  /// Processes one frame into `result`, reusing its buffers.
+  void process(const Frame& frame, FrameResult& result);
+  const Foreground& foreground() const { return foreground_; }
+  /// Why the background learning last restarted; empty if it never did.
+  const std::string& background_message() const { return learner_.message(); }
+
+ private:
+  PipelineParams params_;
+  BackgroundLearner learner_;
+  bool preset_background_ = false;
+  BackgroundModel preset_model_;
+  ForegroundExtractor extractor_;
+  Foreground foreground_;
+};
+
+struct RunOptions {
+  bool pace = false;         ///< play at the source's timestamps; frames may then be dropped
+  int64_t max_frames = -1;   ///< stop after this many source frames; -1: until the source ends
+  std::atomic<bool>* stop_requested = nullptr;  ///< set from outside (e.g. SIGINT) to end the run
+};
+
+/// Runs capture, processing and output on three threads joined by mailboxes. Unpaced runs
+/// process every frame (the source waits for processing); paced runs drop and count.
+/// Writes header, every result and the summary to `sink`; returns the summary.
+RunSummary run_pipeline(Source& source, Pipeline& pipeline, Sink& sink, const RunOptions& options,
+                        const RunHeader& header);
+
+}  // namespace hrcsense

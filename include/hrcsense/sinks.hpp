@@ -1,0 +1,26 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — sinks: where results go. JSON Lines as docs/OUTPUT.md describes.
+#pragma once
+
+#include "hrcsense/pipeline.hpp"
+
+#include <ostream>
+
+namespace hrcsense {
+
+/// Writes one JSON object per line: a header, one line per frame, a summary.
+/// Field names are binding (DESIGN.md "Names other tools rely on").
+class JsonLinesSink : public Sink {
+ public:
+  /// `out` must outlive the sink. `T_base_camera` is not needed: results carry both frames.
+  explicit JsonLinesSink(std::ostream& out) : out_(out) {}
+  void header(const RunHeader& header) override;
+  void frame(const FrameResult& result) override;
+  void summary(const RunSummary& summary) override;
+
+ private:
+  std::ostream& out_;
+  std::string line_;  ///< reused per frame
+};
+
+}  // namespace hrcsense

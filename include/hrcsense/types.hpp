@@ -1,0 +1,170 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — the plain value types that flow between the pipeline's stages.
+#pragma once
+
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace hrcsense {
+
+/// Lens distortion models with the RealSense SDK's numeric values (rs2_distortion).
+enum class Distortion : int {
+  none = 0,
+  modified_brown_conrady = 1,
+  inverse_brown_conrady = 2,
+  ftheta = 3,
+  brown_conrady = 4,
+  kannala_brandt4 = 5,
+};
+
+/// Pinhole intrinsics plus distortion, with the same meaning as the SDK's rs2_intrinsics.
+/// Integer pixel (u, v) is the centre of that pixel; the left image edge is at u = -0.5.
+struct Intrinsics {
+  int width = 0;                       ///< pixels
+  int height = 0;                      ///< pixels
+  float fx = 0.0F;                     ///< focal length in pixel widths
+  float fy = 0.0F;                     ///< focal length in pixel heights
+  float ppx = 0.0F;                    ///< principal point, pixels from the left edge
+  float ppy = 0.0F;                    ///< principal point, pixels from the top edge
+  Distortion model = Distortion::none; ///< distortion model
+  std::array<float, 5> coeffs{};       ///< [k1 k2 p1 p2 k3] or [k1 k2 k3 k4 0] or [w ...]
+};
+
+/// A rigid transform. `T_a_b` maps points given in frame b into frame a.
+using Pose = Eigen::Isometry3d;
+
+/// A 16-bit depth image; raw 0 means "no data".
+struct DepthImage {
+  int width = 0;
+  int height = 0;
+  float depth_scale_m = 0.001F;  ///< metres per raw unit
+  std::vector<uint16_t> pixels;  ///< row-major, width * height
+
+  uint16_t at(int u, int v) const { return pixels[static_cast<size_t>(v) * width + u]; }
+  /// Sets the size; keeps the buffer's capacity, so reuse does not allocate.
+  void resize(int w, int h) {
+    width = w;
+    height = h;
+    pixels.resize(static_cast<size_t>(w) * h);
+  }
+};
+
+/// An 8-bit RGB image, row-major, 3 bytes per pixel.
+struct ColorImage {
+  int width = 0;
+  int height = 0;
+  std::vector<uint8_t> rgb;
+};
+
+/// Label 0 in GroundTruth::labels: the static scene (learnt as background).
+inline constexpr uint16_t kStaticLabel = 0;
+
+/// A contact between the foreground and the robot: the closest pair of points.
+struct Contact {
+  bool valid = false;                              ///< false when there was no foreground
+  float distance_m = 0.0F;                         ///< >= 0; 0 when a point is inside a capsule
+  Eigen::Vector3f closest_base = Eigen::Vector3f::Zero();        ///< foreground point, base frame
+  Eigen::Vector3f closest_camera = Eigen::Vector3f::Zero();      ///< same point, camera frame
+  Eigen::Vector3f closest_robot_base = Eigen::Vector3f::Zero();  ///< point on the robot, base frame
+  int robot_link = -1;                             ///< index of the capsule's link
+  int pixel = -1;                                  ///< source pixel index (v * width + u), -1 if none
+};
+
+/// What the simulator knows exactly about a frame it rendered.
+struct GroundTruth {
+  std::vector<float> depth_m;    ///< noise-free Z per pixel, metres; 0 where nothing was hit
+  std::vector<uint16_t> labels;  ///< object id per pixel; kStaticLabel for the static scene
+  /// Closest point over the noise-free rendered pixels of non-static objects (base frame).
+  Contact contact;
+  /// Closest point over the analytic surfaces of non-static objects, visible or not.
+  Contact analytic_contact;
+};
+
+/// One depth frame from a source, with everything needed to interpret it.
+struct Frame {
+  int64_t index = 0;                 ///< 0-based index of the frame in its source
+  int64_t timestamp_ns = 0;          ///< capture time; integer so recordings round-trip exactly
+  DepthImage depth;
+  Intrinsics intrinsics;             ///< of the depth image
+  float stereo_baseline_mm = 0.0F;   ///< 0 when the source does not know it
+  std::optional<ColorImage> color;
+  std::optional<GroundTruth> truth;  ///< simulated sources only
+};
+
+/// Structure-of-arrays point cloud, so that distance loops vectorise.
+struct PointCloud {
+  std::vector<float> x, y, z;      ///< metres
+  std::vector<uint32_t> pixel;     ///< source pixel index (v * width + u)
+
+  size_t size() const { return x.size(); }
+  bool empty() const { return x.empty(); }
+  void clear() {
+    x.clear();
+    y.clear();
+    z.clear();
+    pixel.clear();
+  }
+  void reserve(size_t n) {
+    x.reserve(n);
+    y.reserve(n);
+    z.reserve(n);
+    pixel.reserve(n);
+  }
+  void push_back(float px, float py, float pz, uint32_t pixel_index) {
+    x.push_back(px);
+    y.push_back(py);
+    z.push_back(pz);
+    pixel.push_back(pixel_index);
+  }
+  Eigen::Vector3f point(size_t i) const { return {x[i], y[i], z[i]}; }
+};
+
+/// A segment with a radius, in the robot base frame. A point is a capsule with a == b, radius 0.
+struct Capsule {
+  Eigen::Vector3f a = Eigen::Vector3f::Zero();
+  Eigen::Vector3f b = Eigen::Vector3f::Zero();
+  float radius_m = 0.0F;
+  int link = 0;  ///< which robot link the capsule belongs to
+};
+
+/// The robot as the proximity search sees it: capsules in the base frame.
+struct RobotModel {
+  std::vector<Capsule> capsules;
+};
+
+/// The safety decision for a frame.
+enum class VerdictState { run, slow, stop };
+
+struct Verdict {
+  VerdictState state = VerdictState::stop;  ///< stop unless proven otherwise
+  float speed_scale = 0.0F;                 ///< 1 run, 0 stop, in between slow
+  float protective_distance_m = 0.0F;       ///< the distance the rule compared against
+  std::string reason;                       ///< why; never empty for stop
+};
+
+/// Time spent in one stage of one frame.
+struct StageTiming {
+  const char* stage = "";  ///< static name, e.g. "background", "foreground", "proximity"
+  double us = 0.0;    ///< microseconds
+};
+
+/// Everything a sink needs about one processed frame.
+struct FrameResult {
+  int64_t frame = 0;          ///< source frame index
+  int64_t timestamp_ns = 0;
+  bool valid = false;         ///< usable depth, processed, background ready
+  Verdict verdict;
+  Contact contact;            ///< contact.valid false when there is no foreground
+  size_t foreground_points = 0;
+  size_t invalid_pixels = 0;  ///< raw zeros in the source frame, before any filter
+  std::vector<StageTiming> timings;
+  std::optional<Contact> truth;  ///< simulated sources: ground-truth contact
+  double latency_us = 0.0;       ///< from the frame entering processing to the result
+};
+
+}  // namespace hrcsense
