@@ -7,6 +7,7 @@
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/sim.hpp"
 
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -37,12 +38,22 @@ struct Config {
   std::string background_path;     ///< `background.path`: load if it exists, else save after learning
   PipelineParams pipeline;         ///< camera pose, robot, background, foreground, proximity, safety
   std::string robot_model = "points";
+  std::vector<double> robot_joints_rad;  ///< `robot.joints_rad`: 6 joint angles, stored for later
+  std::string robot_base_frame = "base"; ///< `robot.base_frame`: base or base_link, stored for later
+  int proximity_octree_height = 8;       ///< `proximity.octree.height` (1-10), stored for later
   std::string canonical_yaml;      ///< the effective configuration, for the hash in the header
 };
 
 /// Reads `path` (may be empty: defaults only) and applies `overrides` ("key.sub=value",
 /// value in YAML syntax) in order. Throws ConfigError naming file and key.
 Config load_config(const std::string& path, const std::vector<std::string>& overrides);
+
+/// The simulator described by a configuration (sim.*, scene.*, camera pose, robot).
+Simulator make_simulator(const Config& config);
+
+/// The source the configuration names (source.type); throws ConfigError for a type that is
+/// unknown or not built in.
+std::unique_ptr<Source> make_source(const Config& config);
 
 /// FNV-1a 64-bit hash of the effective configuration, as 16 hex digits.
 std::string config_hash(const Config& config);

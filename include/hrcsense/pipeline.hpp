@@ -9,6 +9,7 @@
 #include "hrcsense/types.hpp"
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <memory>
@@ -94,6 +95,17 @@ class Mailbox {
     full_ = true;
     ready_.notify_one();
   }
+  /// Like put(), but first waits until the slot is empty, so nothing is dropped: for unpaced
+  /// runs, where the producer must wait for the consumer. False (value kept) once closed.
+  bool put_wait(T& value) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    space_.wait(lock, [&] { return !full_ || closed_; });
+    if (closed_) return false;
+    std::swap(slot_, value);
+    full_ = true;
+    ready_.notify_one();
+    return true;
+  }
   /// Waits for a value and swaps it into `out`; false once closed and empty.
   bool take(T& out) {
     std::unique_lock<std::mutex> lock(mutex_);
@@ -101,6 +113,7 @@ class Mailbox {
     if (!full_) return false;
     std::swap(slot_, out);
     full_ = false;
+    space_.notify_one();
     return true;
   }
   /// Like take(), but gives up after `timeout_s`; false on timeout or when closed and empty.
@@ -110,6 +123,7 @@ class Mailbox {
     if (!full_) return false;
     std::swap(slot_, out);
     full_ = false;
+    space_.notify_one();
     return true;
   }
   bool closed() const {
@@ -120,6 +134,7 @@ class Mailbox {
     std::lock_guard<std::mutex> lock(mutex_);
     closed_ = true;
     ready_.notify_all();
+    space_.notify_all();
   }
   int64_t dropped() const {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -129,6 +144,7 @@ class Mailbox {
  private:
   mutable std::mutex mutex_;
   std::condition_variable ready_;
+  std::condition_variable space_;  ///< signalled when the slot empties (put_wait)
   T slot_{};
   bool full_ = false;
   bool closed_ = false;
@@ -150,6 +166,8 @@ struct PipelineParams {
 class Pipeline {
  public:
   explicit Pipeline(PipelineParams params);
+  /// The parameters the pipeline was built with (e.g. safety.max_frame_age_s for the watchdog).
+  const PipelineParams& params() const { return params_; }
   /// Uses a background learnt earlier instead of learning from the first frames.
   void set_background(BackgroundModel model);
   bool background_ready() const { return learner_.ready() || preset_background_; }

@@ -97,10 +97,11 @@ struct ForegroundExtractor {
                Foreground& out);
 
  private:
-  std::vector<int32_t> blob_label_;
+  // Scratch reused across frames (sized once per image size): the flood fill's queue of
+  // packed (v << 16 | u) pixels, and the pinhole rays (u − ppx) / fx and (v − ppy) / fy.
   std::vector<int32_t> stack_;
-  std::vector<float> blob_z_sum_;
-  std::vector<int32_t> blob_size_;
+  std::vector<float> ray_x_;
+  std::vector<float> ray_y_;
 };
 
 }  // namespace hrcsense

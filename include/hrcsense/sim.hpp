@@ -61,14 +61,31 @@ struct Scene {
   std::vector<SceneObject> objects;
 };
 
+/// Buffers a Simulator reuses between frames so that rendering does not allocate after the
+/// first frame. Derived data only: never part of the scene, safe to copy or to leave empty.
+struct SimScratch {
+  int width = 0;                   ///< size the rays were computed for; 0: not yet
+  int height = 0;
+  std::vector<float> ray_x;        ///< per pixel: x/z of the pixel's ray, camera frame
+  std::vector<float> ray_y;        ///< per pixel: y/z of the pixel's ray, camera frame
+  std::vector<Shape> shapes_base;  ///< this frame's existing shapes, moved along their paths
+  std::vector<uint16_t> shape_labels;  ///< label of each entry of shapes_base
+  PointCloud points_base;          ///< noise-free non-static pixels, base frame (truth contact)
+  PointCloud points_camera;        ///< the same points, camera frame
+};
+
 /// Renders frames of a scene. Deterministic: frame i depends only on (params, scene, i).
 struct Simulator {
   SimParams params;
   Scene scene;
   Pose T_base_camera = Pose::Identity();
   RobotModel robot;  ///< for the ground-truth contact
+  /// Reused buffers; because render() writes them, one Simulator must not render from two
+  /// threads at once (copy it instead).
+  mutable SimScratch scratch;
 
   /// The depth intrinsics used (D435i for the configured resolution).
+  /// Throws std::invalid_argument for a resolution the D435 does not offer.
   Intrinsics intrinsics() const;
   /// Renders frame `index` into `out` (depth, intrinsics, timestamp, baseline, ground truth).
   /// Reuses out's buffers, so rendering into the same Frame does not allocate.

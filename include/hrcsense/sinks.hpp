@@ -5,6 +5,8 @@
 #include "hrcsense/pipeline.hpp"
 
 #include <ostream>
+#include <string>
+#include <utility>
 
 namespace hrcsense {
 
@@ -13,13 +15,16 @@ namespace hrcsense {
 class JsonLinesSink : public Sink {
  public:
   /// `out` must outlive the sink. `T_base_camera` is not needed: results carry both frames.
-  explicit JsonLinesSink(std::ostream& out) : out_(out) {}
+  /// `backend` is the proximity backend written in every frame line (proximity.backend).
+  explicit JsonLinesSink(std::ostream& out, std::string backend = "brute")
+      : out_(out), backend_(std::move(backend)) {}
   void header(const RunHeader& header) override;
   void frame(const FrameResult& result) override;
   void summary(const RunSummary& summary) override;
 
  private:
   std::ostream& out_;
+  std::string backend_;
   std::string line_;  ///< reused per frame
 };
 

@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense CLI — progress on stderr: one line per second of wall time, then the summary.
+#include "console_sink.hpp"
+
+#include "hrcsense/safety.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+namespace hrcsense::app {
+namespace {
+
+// Enough for one second at several thousand frames/s; beyond it the window's median is
+// taken over the first samples rather than growing the buffer on the frame path.
+constexpr size_t kWindowCapacity = 8192;
+
+}  // namespace
+
+ConsoleSink::ConsoleSink() : start_(Clock::now()), window_start_(start_) {
+  window_latency_us_.reserve(kWindowCapacity);
+}
+
+void ConsoleSink::header(const RunHeader& header) {
+  start_ = Clock::now();
+  window_start_ = start_;
+  const Intrinsics& in = header.source.intrinsics;
+  spdlog::info("source {} ({}), {}x{}, {} frames, config {}", header.source.type, header.source.description,
+               in.width, in.height, header.source.frame_count, header.config_hash);
+}
+
+void ConsoleSink::frame(const FrameResult& result) {
+  ++window_frames_;
+  if (window_latency_us_.size() < kWindowCapacity) window_latency_us_.push_back(result.latency_us);
+  const Clock::time_point now = Clock::now();
+  const double window_s = std::chrono::duration<double>(now - window_start_).count();
+  if (window_s < 1.0) return;
+
+  double p50_ms = 0.0;
+  if (!window_latency_us_.empty()) {
+    auto middle = window_latency_us_.begin() + static_cast<std::ptrdiff_t>(window_latency_us_.size() / 2);
+    std::nth_element(window_latency_us_.begin(), middle, window_latency_us_.end());
+    p50_ms = *middle / 1000.0;
+  }
+  const double t_s = std::chrono::duration<double>(now - start_).count();
+  const double fps = static_cast<double>(window_frames_) / window_s;
+  if (result.contact.valid) {
+    spdlog::info("t={:.1f}s frames/s={:.1f} latency p50={:.1f}ms closest={:.3f}m verdict={}", t_s, fps, p50_ms,
+                 result.contact.distance_m, verdict_name(result.verdict.state));
+  } else {
+    spdlog::info("t={:.1f}s frames/s={:.1f} latency p50={:.1f}ms closest=none verdict={}", t_s, fps, p50_ms,
+                 verdict_name(result.verdict.state));
+  }
+  window_start_ = now;
+  window_frames_ = 0;
+  window_latency_us_.clear();
+}
+
+void ConsoleSink::summary(const RunSummary& s) {
+  spdlog::info("summary: {} frames in, {} processed, {} dropped, {} valid in {:.2f}s ({:.1f} frames/s)",
+               s.frames_in, s.frames_processed, s.frames_dropped, s.frames_valid, s.wall_s, s.fps);
+  spdlog::info("summary: verdicts run={} slow={} stop={}; latency p50={:.2f}ms p99={:.2f}ms", s.verdict_run,
+               s.verdict_slow, s.verdict_stop, s.latency_p50_us / 1000.0, s.latency_p99_us / 1000.0);
+  if (s.min_distance_m >= 0.0F) {
+    spdlog::info("summary: min distance {:.3f}m; end: {}", s.min_distance_m, s.end_reason);
+  } else {
+    spdlog::info("summary: no foreground seen; end: {}", s.end_reason);
+  }
+}
+
+}  // namespace hrcsense::app

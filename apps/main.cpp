@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense CLI — the `hrcsense` executable: parses the command line and runs a subcommand.
+#include "app_errors.hpp"
+#include "commands.hpp"
+
+#include <CLI/CLI.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <exception>
+#include <string>
+
+namespace {
+
+using hrcsense::app::CommandArgs;
+
+// The flags every subcommand shares (DESIGN.md "Names other tools rely on").
+void add_common_flags(CLI::App& command, CommandArgs& args) {
+  command.add_option("--config", args.config_path, "YAML configuration file (docs/CONFIG.md)");
+  command.add_option("--set", args.sets, "override a key, KEY=VALUE with VALUE in YAML (repeatable)")
+      ->allow_extra_args(false);
+  command.add_option("--frames", args.frames, "stop after N source frames (default: the source's length)")
+      ->check(CLI::PositiveNumber);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Logs go to stderr so that stdout carries only results.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("hrcsense"));
+  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
+
+  CLI::App app{"hrcsense: safety distances in a human-robot collaboration cell from a depth camera"};
+  app.require_subcommand(1);
+  CommandArgs args;
+
+  CLI::App* run = app.add_subcommand("run", "process a source and write JSON Lines (docs/OUTPUT.md)");
+  add_common_flags(*run, args);
+  run->add_option("--out", args.out, "JSON Lines output file (default: stdout)");
+
+  CLI::App* info = app.add_subcommand("info", "describe a configured source or a recording");
+  add_common_flags(*info, args);
+  info->add_option("path", args.input, "a recording (not readable in this build yet)");
+
+  CLI::App* bench = app.add_subcommand("bench", "time the processing path on pre-rendered frames");
+  add_common_flags(*bench, args);
+
+  // CLI11 would only say "a subcommand is required" for a misspelt one; name it instead.
+  const std::string first = argc > 1 ? argv[1] : "";
+  if (!first.empty() && first[0] != '-' && first != "run" && first != "info" && first != "bench") {
+    return hrcsense::app::report_error(std::string("unknown command '") + argv[1] + "'; expected run, info or bench",
+                                       hrcsense::app::kExitUsage);
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    return hrcsense::app::report_error(e.what(), hrcsense::app::kExitUsage);
+  }
+
+  try {
+    if (run->parsed()) return hrcsense::app::run_command(args);
+    if (info->parsed()) return hrcsense::app::info_command(args);
+    return hrcsense::app::bench_command(args);
+  } catch (const std::exception& e) {
+    return hrcsense::app::report_error(e);
+  }
+}

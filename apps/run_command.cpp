@@ -1,0 +1,111 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense CLI — `hrcsense run`: configured source → pipeline → JSON Lines (+ progress on stderr).
+#include "app_errors.hpp"
+#include "commands.hpp"
+#include "console_sink.hpp"
+#include "tee_sink.hpp"
+
+#include "hrcsense/config.hpp"
+#include "hrcsense/io.hpp"
+#include "hrcsense/sinks.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#ifndef HRCSENSE_VERSION
+#define HRCSENSE_VERSION "unknown"
+#endif
+#ifndef HRCSENSE_COMMIT
+#define HRCSENSE_COMMIT "unknown"
+#endif
+
+namespace hrcsense::app {
+namespace {
+
+// Set by SIGINT; the pipeline polls it and ends the run with a summary.
+std::atomic<bool> g_stop_requested{false};
+
+extern "C" void on_sigint(int /*signal*/) {
+  g_stop_requested.store(true);
+  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C kills, in case the run is stuck
+}
+
+// Loads background.path when it exists. Returns false when there is nothing to load.
+bool load_background_file(const Config& config, const SourceInfo& info, Pipeline& pipeline) {
+  if (config.background_path.empty() || !std::filesystem::exists(config.background_path)) return false;
+  BackgroundModel model = load_background(config.background_path);  // IoError: damaged file
+  if (model.width != info.intrinsics.width || model.height != info.intrinsics.height) {
+    throw IoError(config.background_path + ": background is " + std::to_string(model.width) + "x" +
+                  std::to_string(model.height) + " but the source is " + std::to_string(info.intrinsics.width) +
+                  "x" + std::to_string(info.intrinsics.height));
+  }
+  pipeline.set_background(std::move(model));
+  return true;
+}
+
+void save_learnt_background(const Config& config, const Pipeline& pipeline) {
+  if (config.background_path.empty()) return;
+  if (!pipeline.background_ready()) {
+    spdlog::warn("background not saved to {}: learning did not finish", config.background_path);
+    return;
+  }
+  const std::filesystem::path parent = std::filesystem::path(config.background_path).parent_path();
+  if (!parent.empty()) std::filesystem::create_directories(parent);
+  save_background(config.background_path, pipeline.background());
+  spdlog::info("background saved to {}", config.background_path);
+}
+
+}  // namespace
+
+int run_command(const CommandArgs& args) {
+  const Config config = load_config(args.config_path, args.sets);
+  std::unique_ptr<Source> source = make_source(config);
+  const SourceInfo info = source->info();
+
+  Pipeline pipeline(config.pipeline);
+  const bool background_loaded = load_background_file(config, info, pipeline);
+  if (background_loaded) spdlog::info("background loaded from {}", config.background_path);
+
+  std::ofstream file;
+  if (!args.out.empty()) {
+    const std::filesystem::path parent = std::filesystem::path(args.out).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
+    file.open(args.out, std::ios::out | std::ios::trunc);
+    if (!file) return report_error(args.out + ": cannot open for writing", kExitRuntime);
+  }
+  std::ostream& out = args.out.empty() ? std::cout : file;
+
+  JsonLinesSink jsonl(out, config.pipeline.backend);
+  ConsoleSink console;
+  TeeSink sinks{&jsonl, &console};
+
+  RunHeader header;
+  header.version = HRCSENSE_VERSION;
+  header.commit = HRCSENSE_COMMIT;
+  header.config_hash = config_hash(config);
+  header.source = info;
+
+  RunOptions options;
+  options.pace = config.source.pace;
+  options.max_frames = args.frames;
+  options.stop_requested = &g_stop_requested;
+  g_stop_requested.store(false);
+  std::signal(SIGINT, on_sigint);
+  const RunSummary summary = run_pipeline(*source, pipeline, sinks, options, header);
+  std::signal(SIGINT, SIG_DFL);
+
+  if (!background_loaded) save_learnt_background(config, pipeline);
+  out.flush();
+  if (!out) return report_error((args.out.empty() ? "stdout" : args.out) + ": write failed", kExitRuntime);
+  // The output ends with a stop line and a summary either way; the exit code tells scripts
+  // that the source failed (the run_pipeline's end_reason names the error).
+  if (summary.end_reason.rfind("source error", 0) == 0) return report_error(summary.end_reason, kExitRuntime);
+  return 0;
+}
+
+}  // namespace hrcsense::app

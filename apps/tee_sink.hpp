@@ -1,0 +1,31 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense CLI — a sink that forwards every call to several sinks, in order.
+#pragma once
+
+#include "hrcsense/pipeline.hpp"
+
+#include <initializer_list>
+#include <vector>
+
+namespace hrcsense::app {
+
+/// Forwards header, frames and summary to each sink in the order given. The sinks must
+/// outlive the tee.
+class TeeSink : public Sink {
+ public:
+  TeeSink(std::initializer_list<Sink*> sinks) : sinks_(sinks) {}
+  void header(const RunHeader& header) override {
+    for (Sink* sink : sinks_) sink->header(header);
+  }
+  void frame(const FrameResult& result) override {
+    for (Sink* sink : sinks_) sink->frame(result);
+  }
+  void summary(const RunSummary& summary) override {
+    for (Sink* sink : sinks_) sink->summary(summary);
+  }
+
+ private:
+  std::vector<Sink*> sinks_;
+};
+
+}  // namespace hrcsense::app

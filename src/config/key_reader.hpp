@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense config internals — typed reading of dotted keys from the merged YAML tree.
+#pragma once
+
+#include "hrcsense/config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace hrcsense::config_detail {
+
+/// Throws ConfigError "<where>: key '<key>': <what>".
+[[noreturn]] void fail(const std::string& where, const std::string& key, const std::string& what);
+
+/// The node at dotted `key` below `root`, or an undefined node when any part is missing.
+/// Never modifies `root` (yaml-cpp's non-const operator[] would insert).
+YAML::Node find_path(const YAML::Node& root, const std::string& key);
+
+/// Sets dotted `key` below `root` to `value`, creating maps on the way; a non-map value on
+/// the way is replaced by a map. Returns false if `key` has an empty segment.
+bool set_path(YAML::Node& root, const std::string& key, const YAML::Node& value);
+
+/// Shortest decimal text that reads back as the same float (so 0.1F prints as 0.1).
+std::string float_text(float value);
+/// Same for double.
+std::string double_text(double value);
+
+/// Lower bound a number must respect.
+enum class Bound { any, non_negative, positive };
+
+/// Reads typed keys from the merged configuration tree. Each read records the key as known
+/// (for the unknown-key check) and writes the value in effect, given or default, into the
+/// effective tree (for canonical_yaml). A missing key leaves the default untouched.
+class KeyReader {
+ public:
+  /// `where` names the file in error messages.
+  KeyReader(YAML::Node root, std::string where);
+
+  void text(const std::string& key, std::string& value);
+  /// A string that must be one of `allowed`.
+  void choice(const std::string& key, std::string& value, const std::vector<std::string>& allowed);
+  void flag(const std::string& key, bool& value);
+  void integer(const std::string& key, int64_t& value, int64_t min, int64_t max);
+  void integer(const std::string& key, int& value, int min, int max);
+  void integer(const std::string& key, uint64_t& value);
+  void number(const std::string& key, double& value, Bound bound);
+  void number(const std::string& key, float& value, Bound bound);
+  /// A list of exactly three numbers [x, y, z].
+  void vec3(const std::string& key, Eigen::Vector3f& value);
+  /// A list of [x, y, z] lists.
+  void vec3_list(const std::string& key, std::vector<Eigen::Vector3f>& value);
+  /// A list of numbers; `size` > 0 demands exactly that many (an empty list is always allowed).
+  void number_list(const std::string& key, std::vector<double>& value, size_t size);
+  /// A structured value parsed by the caller: records the key and returns its node
+  /// (undefined when absent). The caller records the effective value with `set_effective`.
+  YAML::Node raw(const std::string& key);
+  void set_effective(const std::string& key, const YAML::Node& value);
+
+  /// Throws ConfigError naming the file and `key`.
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+
+  const std::set<std::string>& known() const { return known_; }
+  const YAML::Node& effective() const { return effective_; }
+  const std::string& where() const { return where_; }
+
+ private:
+  YAML::Node lookup(const std::string& key);
+  double scalar_number(const std::string& key, const YAML::Node& node) const;
+
+  YAML::Node root_;
+  YAML::Node effective_;
+  std::string where_;
+  std::set<std::string> known_;
+};
+
+/// Reads `scene.objects` (a list of objects, see docs/CONFIG.md) into a Scene.
+/// `key` is the list's key, used to name items in errors ("scene.objects[1].shapes[0]").
+Scene read_scene_objects(const YAML::Node& objects, const std::string& where, const std::string& key);
+/// The scene in the same schema, normalised (defaults spelt out, numbers in shortest form),
+/// for the canonical configuration.
+YAML::Node scene_objects_node(const Scene& scene);
+
+}  // namespace hrcsense::config_detail

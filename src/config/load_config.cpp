@@ -1,0 +1,257 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense config — load_config: the YAML file, then --set overrides, then one typed read
+// per key into the stages' parameter structs (the table is read_all below).
+#include "key_reader.hpp"
+
+#include "hrcsense/camera.hpp"
+
+#include <cctype>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+
+namespace hrcsense {
+namespace {
+
+using config_detail::Bound;
+using config_detail::KeyReader;
+
+constexpr int64_t kMaxCount = std::numeric_limits<int64_t>::max();
+constexpr double kPi = 3.14159265358979323846;
+
+Pose pose_from_rpy(const Eigen::Vector3f& translation_m, const Eigen::Vector3f& rpy_deg) {
+  const Eigen::Vector3d rpy_rad = rpy_deg.cast<double>() * (kPi / 180.0);
+  // R = Rz(yaw) · Ry(pitch) · Rx(roll): roll about x first, then pitch, then yaw (fixed axes).
+  const Eigen::Matrix3d rotation = (Eigen::AngleAxisd(rpy_rad.z(), Eigen::Vector3d::UnitZ()) *
+                                    Eigen::AngleAxisd(rpy_rad.y(), Eigen::Vector3d::UnitY()) *
+                                    Eigen::AngleAxisd(rpy_rad.x(), Eigen::Vector3d::UnitX()))
+                                       .toRotationMatrix();
+  Pose pose = Pose::Identity();
+  pose.linear() = rotation;
+  pose.translation() = translation_m.cast<double>();
+  return pose;
+}
+
+[[noreturn]] void not_implemented(const KeyReader& r, const std::string& key, const std::string& value,
+                                  const std::string& use) {
+  throw ConfigError(r.where() + ": " + key + " '" + value + "' is not implemented yet; use " + use);
+}
+
+void read_source_and_sim(KeyReader& r, Config& c) {
+  r.choice("source.type", c.source.type, {"sim", "folder", "bag", "realsense"});
+  r.text("source.path", c.source.path);
+  r.flag("source.pace", c.source.pace);
+  r.flag("source.loop", c.source.loop);
+  r.integer("source.seed", c.source.seed);
+  r.number("source.stereo_baseline_mm", c.source.stereo_baseline_mm, Bound::non_negative);
+  c.sim.seed = c.source.seed;
+
+  r.integer("sim.width", c.sim.width, 1, 65535);
+  r.integer("sim.height", c.sim.height, 1, 65535);
+  if (!d435_depth_intrinsics(c.sim.width, c.sim.height)) {
+    r.fail("sim.width", std::to_string(c.sim.width) + "x" + std::to_string(c.sim.height) +
+                            " is not a D435 depth resolution; expected 1280x720, 848x480, 640x480, "
+                            "640x360, 480x270 or 424x240");
+  }
+  r.number("sim.fps", c.sim.fps, Bound::positive);
+  r.integer("sim.frames", c.sim.frames, 1, kMaxCount);
+  r.flag("sim.noise", c.sim.noise);
+  r.number("sim.disparity_noise_px", c.sim.disparity_noise_px, Bound::non_negative);
+  r.number("sim.baseline_mm", c.sim.baseline_mm, Bound::positive);
+
+  const YAML::Node objects = r.raw("scene.objects");
+  c.scene = config_detail::read_scene_objects(objects, r.where(), "scene.objects");
+  r.set_effective("scene.objects", config_detail::scene_objects_node(c.scene));
+}
+
+void read_camera_and_filters(KeyReader& r, Config& c) {
+  Eigen::Vector3f translation_m = c.pipeline.T_base_camera.translation().cast<float>();
+  Eigen::Vector3f rpy_deg = Eigen::Vector3f::Zero();
+  r.vec3("camera.T_base_camera.translation_m", translation_m);
+  r.vec3("camera.T_base_camera.rotation_rpy_deg", rpy_deg);
+  c.pipeline.T_base_camera = pose_from_rpy(translation_m, rpy_deg);
+
+  // Filters come later; every filters.* key other than the preset is refused when the
+  // tree is checked for unknown keys.
+  r.text("filters.preset", c.filters_preset);
+  if (c.filters_preset != "none") not_implemented(r, "filters.preset", c.filters_preset, "none");
+}
+
+void read_segmentation(KeyReader& r, Config& c) {
+  BackgroundParams& bg = c.pipeline.background;
+  r.integer("background.frames", bg.frames, 1, std::numeric_limits<int>::max());
+  r.text("background.path", c.background_path);
+  r.number("background.moving_k_sigma", bg.moving_k_sigma, Bound::positive);
+  r.number("background.moving_min_spread_m", bg.moving_min_spread_m, Bound::non_negative);
+  r.number("background.max_moving_share", bg.max_moving_share, Bound::non_negative);
+  if (bg.max_moving_share > 1.0F) r.fail("background.max_moving_share", "expected a share in [0, 1]");
+
+  ForegroundParams& fg = c.pipeline.foreground;
+  r.number("foreground.k_sigma", fg.k_sigma, Bound::positive);
+  r.number("foreground.min_margin_m", fg.min_margin_m, Bound::non_negative);
+  r.number("foreground.min_object_mm", fg.min_object_mm, Bound::non_negative);
+  r.vec3("foreground.workspace_base.min", fg.workspace_base.min);
+  r.vec3("foreground.workspace_base.max", fg.workspace_base.max);
+  if ((fg.workspace_base.min.array() > fg.workspace_base.max.array()).any()) {
+    r.fail("foreground.workspace_base", "expected min <= max on every axis");
+  }
+}
+
+void read_robot_and_safety(KeyReader& r, Config& c) {
+  r.choice("robot.model", c.robot_model, {"points", "ur5", "ur5e", "ur10e"});
+  if (c.robot_model != "points") not_implemented(r, "robot.model", c.robot_model, "points");
+  std::vector<Eigen::Vector3f> points_base;
+  float padding_m = 0.0F;
+  r.vec3_list("robot.points_base", points_base);
+  r.number("robot.padding_m", padding_m, Bound::non_negative);
+  r.number_list("robot.joints_rad", c.robot_joints_rad, 6);
+  r.choice("robot.base_frame", c.robot_base_frame, {"base", "base_link"});
+  c.pipeline.robot.capsules.clear();
+  for (size_t i = 0; i < points_base.size(); ++i) {
+    // A robot point is a capsule of length 0; padding makes it a sphere.
+    c.pipeline.robot.capsules.push_back(Capsule{points_base[i], points_base[i], padding_m, static_cast<int>(i)});
+  }
+
+  r.choice("proximity.backend", c.pipeline.backend, {"brute", "kdtree", "octree", "depth_space", "auto"});
+  if (c.pipeline.backend != "brute") not_implemented(r, "proximity.backend", c.pipeline.backend, "brute");
+  r.integer("proximity.octree.height", c.proximity_octree_height, 1, 10);
+
+  SafetyParams& safety = c.pipeline.safety;
+  r.number("safety.slow_distance_m", safety.slow_distance_m, Bound::non_negative);
+  r.number("safety.stop_distance_m", safety.stop_distance_m, Bound::non_negative);
+  r.number("safety.max_frame_age_s", safety.max_frame_age_s, Bound::positive);
+  if (safety.stop_distance_m > safety.slow_distance_m) {
+    r.fail("safety.stop_distance_m", "expected stop_distance_m <= slow_distance_m (" +
+                                         config_detail::float_text(safety.slow_distance_m) + ")");
+  }
+}
+
+// The table of every key: one typed read per key, in docs/CONFIG.md order.
+void read_all(KeyReader& r, Config& c) {
+  read_source_and_sim(r, c);
+  read_camera_and_filters(r, c);
+  read_segmentation(r, c);
+  read_robot_and_safety(r, c);
+}
+
+// Every key the reader knows, found by reading an empty tree (all reads are unconditional).
+const std::set<std::string>& known_keys() {
+  static const std::set<std::string> keys = [] {
+    KeyReader reader(YAML::Node(YAML::NodeType::Map), "<defaults>");
+    Config defaults;
+    read_all(reader, defaults);
+    return reader.known();
+  }();
+  return keys;
+}
+
+bool is_section(const std::string& key) {
+  const std::set<std::string>& known = known_keys();
+  const auto next = known.lower_bound(key + ".");
+  return next != known.end() && next->compare(0, key.size() + 1, key + ".") == 0;
+}
+
+bool is_filter_option(const std::string& key) {
+  return key.compare(0, 8, "filters.") == 0 && key != "filters.preset";
+}
+
+void check_keys(const YAML::Node& map, const std::string& prefix, const std::string& where) {
+  for (const auto& entry : map) {
+    const std::string key = prefix.empty() ? entry.first.Scalar() : prefix + "." + entry.first.Scalar();
+    if (known_keys().count(key) != 0) continue;
+    if (is_filter_option(key) && entry.second.IsMap()) {
+      check_keys(entry.second, key, where);  // name the option itself, e.g. filters.spatial.alpha
+      continue;
+    }
+    if (is_filter_option(key)) {
+      throw ConfigError(where + ": " + key + " is not implemented yet; use filters.preset none");
+    }
+    if (!is_section(key)) throw ConfigError(where + ": unknown key '" + key + "'");
+    if (entry.second.IsMap()) {
+      check_keys(entry.second, key, where);
+    } else if (!entry.second.IsNull()) {
+      config_detail::fail(where, key, "expected a map of keys");
+    }
+  }
+}
+
+YAML::Node load_file(const std::string& path) {
+  if (path.empty()) return YAML::Node(YAML::NodeType::Map);
+  std::ifstream file(path);
+  if (!file) throw ConfigError(path + ": cannot open configuration file");
+  YAML::Node root;
+  try {
+    root = YAML::Load(file);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                      ": YAML syntax error: " + e.msg);
+  }
+  if (root.IsNull() || !root.IsDefined()) return YAML::Node(YAML::NodeType::Map);
+  if (!root.IsMap()) throw ConfigError(path + ": expected a map of sections (source, sim, ...) at the top");
+  return root;
+}
+
+bool valid_key_text(const std::string& key) {
+  if (key.empty() || key.front() == '.' || key.back() == '.' || key.find("..") != std::string::npos) {
+    return false;
+  }
+  for (char ch : key) {
+    if (std::isalnum(static_cast<unsigned char>(ch)) == 0 && ch != '_' && ch != '.') return false;
+  }
+  return true;
+}
+
+void apply_override(YAML::Node& root, const std::string& text) {
+  const size_t eq = text.find('=');
+  const std::string key = text.substr(0, eq);
+  if (eq == std::string::npos || eq + 1 == text.size() || !valid_key_text(key)) {
+    throw ConfigError("--set '" + text + "': expected KEY=VALUE, e.g. safety.stop_distance_m=0.4");
+  }
+  YAML::Node value;
+  try {
+    value = YAML::Load(text.substr(eq + 1));
+  } catch (const YAML::Exception& e) {
+    throw ConfigError("--set '" + text + "': the value is not valid YAML: " + e.msg);
+  }
+  if (known_keys().count(key) == 0 && !is_section(key) && !is_filter_option(key)) {
+    throw ConfigError("--set '" + text + "': unknown key '" + key + "'");
+  }
+  config_detail::set_path(root, key, value);
+}
+
+}  // namespace
+
+Config load_config(const std::string& path, const std::vector<std::string>& overrides) {
+  YAML::Node root = load_file(path);
+  for (const std::string& text : overrides) apply_override(root, text);
+  const std::string where = path.empty() ? std::string("<defaults>") : path;
+  check_keys(root, "", where);
+
+  Config config;
+  config.file = path;
+  KeyReader reader(root, where);
+  try {
+    read_all(reader, config);
+  } catch (const YAML::Exception& e) {
+    // Any yaml-cpp conversion the typed readers did not anticipate still names the file.
+    throw ConfigError(where + ": " + e.what());
+  }
+  YAML::Emitter emitter;
+  emitter << reader.effective();
+  config.canonical_yaml = emitter.c_str();
+  config.canonical_yaml += '\n';
+  return config;
+}
+
+std::string config_hash(const Config& config) {
+  uint64_t hash = 0xcbf29ce484222325ULL;  // FNV-1a 64 offset basis
+  for (unsigned char byte : config.canonical_yaml) {
+    hash ^= byte;
+    hash *= 0x100000001b3ULL;  // FNV-1a 64 prime
+  }
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
+  return text;
+}
+
+}  // namespace hrcsense

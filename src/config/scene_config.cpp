@@ -1,0 +1,228 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense config — `scene.objects`: simulated objects made of planes, boxes, spheres, capsules.
+#include "key_reader.hpp"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace hrcsense::config_detail {
+namespace {
+
+// Errors inside the scene name the item by its position, e.g. scene.objects[2].shapes[0].
+struct SceneReader {
+  const std::string& where;
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    config_detail::fail(where, key, what);
+  }
+
+  void only_keys(const YAML::Node& map, const std::string& key,
+                 const std::vector<std::string>& allowed) const {
+    if (!map.IsMap()) fail(key, "expected a map");
+    for (const auto& entry : map) {
+      const std::string name = entry.first.Scalar();
+      bool ok = false;
+      for (const std::string& option : allowed) ok = ok || name == option;
+      if (!ok) throw ConfigError(where + ": unknown key '" + key + "." + name + "'");
+    }
+  }
+
+  YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& name) const {
+    const YAML::Node& const_map = map;
+    YAML::Node node = const_map[name];
+    if (!node.IsDefined() || node.IsNull()) fail(key + "." + name, "is required");
+    return node;
+  }
+
+  double number(const YAML::Node& node, const std::string& key) const {
+    double value = 0.0;
+    if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value)) {
+      fail(key, "expected a number");
+    }
+    return value;
+  }
+
+  Eigen::Vector3f vec3(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsSequence() || node.size() != 3) fail(key, "expected a list of 3 numbers [x, y, z]");
+    return {static_cast<float>(number(node[0], key)), static_cast<float>(number(node[1], key)),
+            static_cast<float>(number(node[2], key))};
+  }
+
+  float radius(const YAML::Node& map, const std::string& key) const {
+    const double r = number(required(map, key, "radius_m"), key + ".radius_m");
+    if (r <= 0.0) fail(key + ".radius_m", "expected a number > 0");
+    return static_cast<float>(r);
+  }
+
+  Shape shape(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsMap() || node.size() != 1) {
+      fail(key, "expected one of {plane: ...}, {box: ...}, {sphere: ...}, {capsule: ...}");
+    }
+    const std::string type = node.begin()->first.Scalar();
+    const YAML::Node body = node.begin()->second;
+    const std::string sub = key + "." + type;
+    Shape out;
+    if (type == "plane") {
+      only_keys(body, sub, {"point", "normal"});
+      out.type = Shape::Type::plane;
+      out.point = vec3(required(body, sub, "point"), sub + ".point");
+      const Eigen::Vector3f normal = vec3(required(body, sub, "normal"), sub + ".normal");
+      if (normal.norm() < 1e-6F) fail(sub + ".normal", "expected a non-zero vector");
+      out.normal = normal.normalized();
+    } else if (type == "box") {
+      only_keys(body, sub, {"min", "max"});
+      out.type = Shape::Type::box;
+      out.min = vec3(required(body, sub, "min"), sub + ".min");
+      out.max = vec3(required(body, sub, "max"), sub + ".max");
+      if ((out.min.array() > out.max.array()).any()) fail(sub, "expected min <= max on every axis");
+    } else if (type == "sphere") {
+      only_keys(body, sub, {"center", "radius_m"});
+      out.type = Shape::Type::sphere;
+      out.point = vec3(required(body, sub, "center"), sub + ".center");
+      out.radius_m = radius(body, sub);
+    } else if (type == "capsule") {
+      only_keys(body, sub, {"a", "b", "radius_m"});
+      out.type = Shape::Type::capsule;
+      out.a = vec3(required(body, sub, "a"), sub + ".a");
+      out.b = vec3(required(body, sub, "b"), sub + ".b");
+      out.radius_m = radius(body, sub);
+    } else {
+      fail(key, "unknown shape '" + type + "'; expected plane, box, sphere or capsule");
+    }
+    return out;
+  }
+
+  int64_t frame_number(const YAML::Node& map, const std::string& key, const char* name,
+                       int64_t fallback, int64_t min) const {
+    const YAML::Node& const_map = map;
+    const YAML::Node node = const_map[name];
+    if (!node.IsDefined() || node.IsNull()) return fallback;
+    int64_t value = 0;
+    if (!node.IsScalar() || !YAML::convert<int64_t>::decode(node, value) || value < min) {
+      fail(key + "." + name, "expected an integer >= " + std::to_string(min));
+    }
+    return value;
+  }
+
+  std::vector<Waypoint> path(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsSequence()) fail(key, "expected a list of {t_s, offset_m}");
+    std::vector<Waypoint> out;
+    for (size_t i = 0; i < node.size(); ++i) {
+      const std::string item = key + "[" + std::to_string(i) + "]";
+      only_keys(node[i], item, {"t_s", "offset_m"});
+      Waypoint point;
+      point.t_s = number(required(node[i], item, "t_s"), item + ".t_s");
+      point.offset_m = vec3(required(node[i], item, "offset_m"), item + ".offset_m");
+      if (!out.empty() && point.t_s < out.back().t_s) fail(item + ".t_s", "expected times in increasing order");
+      out.push_back(point);
+    }
+    return out;
+  }
+
+  SceneObject object(const YAML::Node& node, const std::string& key, size_t index) const {
+    only_keys(node, key, {"name", "static", "first_frame", "last_frame", "path", "shapes"});
+    SceneObject out;
+    const YAML::Node& map = node;
+    out.name = "object" + std::to_string(index);
+    if (map["name"].IsDefined() && !map["name"].IsNull()) {
+      if (!map["name"].IsScalar()) fail(key + ".name", "expected a string");
+      out.name = map["name"].Scalar();
+    }
+    if (map["static"].IsDefined() && !map["static"].IsNull() &&
+        (!map["static"].IsScalar() || !YAML::convert<bool>::decode(map["static"], out.is_static))) {
+      fail(key + ".static", "expected true or false");
+    }
+    out.first_frame = frame_number(map, key, "first_frame", 0, 0);
+    out.last_frame = frame_number(map, key, "last_frame", -1, -1);
+    if (out.last_frame >= 0 && out.last_frame < out.first_frame) {
+      fail(key + ".last_frame", "expected -1 or a frame >= first_frame");
+    }
+    if (map["path"].IsDefined() && !map["path"].IsNull()) out.path = path(map["path"], key + ".path");
+    const YAML::Node shapes = required(map, key, "shapes");
+    if (!shapes.IsSequence() || shapes.size() == 0) fail(key + ".shapes", "expected a non-empty list of shapes");
+    for (size_t i = 0; i < shapes.size(); ++i) {
+      out.shapes.push_back(shape(shapes[i], key + ".shapes[" + std::to_string(i) + "]"));
+    }
+    return out;
+  }
+};
+
+YAML::Node vec3_node(const Eigen::Vector3f& v) {
+  YAML::Node out(YAML::NodeType::Sequence);
+  out.SetStyle(YAML::EmitterStyle::Flow);
+  for (int i = 0; i < 3; ++i) out.push_back(float_text(v[i]));
+  return out;
+}
+
+YAML::Node shape_node(const Shape& shape) {
+  YAML::Node body(YAML::NodeType::Map);
+  body.SetStyle(YAML::EmitterStyle::Flow);
+  YAML::Node out(YAML::NodeType::Map);
+  switch (shape.type) {
+    case Shape::Type::plane:
+      body["point"] = vec3_node(shape.point);
+      body["normal"] = vec3_node(shape.normal);
+      out["plane"] = body;
+      break;
+    case Shape::Type::box:
+      body["min"] = vec3_node(shape.min);
+      body["max"] = vec3_node(shape.max);
+      out["box"] = body;
+      break;
+    case Shape::Type::sphere:
+      body["center"] = vec3_node(shape.point);
+      body["radius_m"] = float_text(shape.radius_m);
+      out["sphere"] = body;
+      break;
+    case Shape::Type::capsule:
+      body["a"] = vec3_node(shape.a);
+      body["b"] = vec3_node(shape.b);
+      body["radius_m"] = float_text(shape.radius_m);
+      out["capsule"] = body;
+      break;
+  }
+  return out;
+}
+
+}  // namespace
+
+YAML::Node scene_objects_node(const Scene& scene) {
+  YAML::Node objects(YAML::NodeType::Sequence);
+  if (scene.objects.empty()) objects.SetStyle(YAML::EmitterStyle::Flow);  // "objects: []"
+  for (const SceneObject& object : scene.objects) {
+    YAML::Node node(YAML::NodeType::Map);
+    node["name"] = object.name;
+    node["static"] = object.is_static;
+    node["first_frame"] = object.first_frame;
+    node["last_frame"] = object.last_frame;
+    YAML::Node path(YAML::NodeType::Sequence);
+    for (const Waypoint& point : object.path) {
+      YAML::Node waypoint(YAML::NodeType::Map);
+      waypoint.SetStyle(YAML::EmitterStyle::Flow);
+      waypoint["t_s"] = double_text(point.t_s);
+      waypoint["offset_m"] = vec3_node(point.offset_m);
+      path.push_back(waypoint);
+    }
+    if (object.path.empty()) path.SetStyle(YAML::EmitterStyle::Flow);
+    node["path"] = path;
+    YAML::Node shapes(YAML::NodeType::Sequence);
+    for (const Shape& shape : object.shapes) shapes.push_back(shape_node(shape));
+    node["shapes"] = shapes;
+    objects.push_back(node);
+  }
+  return objects;
+}
+
+Scene read_scene_objects(const YAML::Node& objects, const std::string& where, const std::string& key) {
+  Scene scene;
+  if (!objects.IsDefined() || objects.IsNull()) return scene;
+  const SceneReader reader{where};
+  if (!objects.IsSequence()) reader.fail(key, "expected a list of objects");
+  for (size_t i = 0; i < objects.size(); ++i) {
+    scene.objects.push_back(reader.object(objects[i], key + "[" + std::to_string(i) + "]", i));
+  }
+  return scene;
+}
+
+}  // namespace hrcsense::config_detail

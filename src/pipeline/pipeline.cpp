@@ -1,0 +1,124 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — the per-frame processing path: background → foreground → proximity → verdict.
+
+#include "hrcsense/pipeline.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <utility>
+
+namespace hrcsense {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double elapsed_us(Clock::time_point since) {
+  return std::chrono::duration<double, std::micro>(Clock::now() - since).count();
+}
+
+// Raw zeros ("no data") in the source frame, before any filter.
+size_t count_invalid(const DepthImage& depth) {
+  size_t invalid = 0;
+  for (const uint16_t raw : depth.pixels) invalid += raw == 0 ? 1U : 0U;
+  return invalid;
+}
+
+// Sets `verdict` to a stop with `reason`, reusing the reason's buffer.
+void set_stop(Verdict& verdict, const char* reason) {
+  verdict.state = VerdictState::stop;
+  verdict.speed_scale = 0.0F;
+  verdict.protective_distance_m = 0.0F;
+  verdict.reason.assign(reason);
+}
+
+// Runs `stage` and appends its duration under the static name `name`.
+template <typename Stage>
+void timed(FrameResult& result, const char* name, Stage&& stage) {
+  const Clock::time_point start = Clock::now();
+  stage();
+  result.timings.push_back({name, elapsed_us(start)});
+}
+
+// Resets the per-frame fields of `result`, keeping its buffers.
+void begin_result(const Frame& frame, FrameResult& result) {
+  result.frame = frame.index;
+  result.timestamp_ns = frame.timestamp_ns;
+  result.valid = false;
+  result.contact = Contact{};
+  result.foreground_points = 0;
+  result.invalid_pixels = 0;
+  result.timings.clear();  // keeps its capacity: four stages after the first frame
+  result.truth.reset();
+  if (frame.truth) result.truth = frame.truth->contact;
+}
+
+// The stop verdict of a learning frame, with the learner's last restart message if any.
+// Formatted into a stack buffer and assigned, so the reason's buffer is reused.
+void set_learning(Verdict& verdict, int frames_seen, int frames_total, const std::string& message) {
+  char text[96];
+  std::snprintf(text, sizeof text, "learning background (%d/%d frames)", frames_seen, frames_total);
+  set_stop(verdict, text);
+  if (!message.empty()) {
+    verdict.reason.append("; restarted: ");
+    verdict.reason.append(message);
+  }
+}
+
+// Adds a frame to the learner and sets the learning verdict. The frame that completes the
+// model is a learning frame too, so it stays invalid like the ones before it.
+void learn_background(BackgroundLearner& learner, const Frame& frame, Verdict& verdict) {
+  const int frames_total = learner.params.frames;
+  const bool completed = learner.add(frame) == BackgroundLearner::Status::ready;
+  set_learning(verdict, completed ? frames_total : learner.frames_seen(), frames_total, learner.message());
+}
+
+bool same_size(const BackgroundModel& model, const DepthImage& depth) {
+  return model.width == depth.width && model.height == depth.height;
+}
+
+// Latency from the frame entering processing to its result.
+void finish(FrameResult& result, Clock::time_point start) { result.latency_us = elapsed_us(start); }
+
+void finish_stop(FrameResult& result, const char* reason, Clock::time_point start) {
+  set_stop(result.verdict, reason);
+  finish(result, start);
+}
+
+}  // namespace
+
+Pipeline::Pipeline(PipelineParams params) : params_(std::move(params)) {
+  learner_.params = params_.background;
+  extractor_.params = params_.foreground;
+}
+
+void Pipeline::set_background(BackgroundModel model) {
+  preset_model_ = std::move(model);
+  preset_background_ = true;
+}
+
+const BackgroundModel& Pipeline::background() const {
+  return preset_background_ ? preset_model_ : learner_.model();
+}
+
+// One line per stage; every early return leaves a stop verdict with its reason.
+void Pipeline::process(const Frame& frame, FrameResult& result) {
+  const Clock::time_point start = Clock::now();
+  begin_result(frame, result);
+  result.invalid_pixels = count_invalid(frame.depth);
+  if (result.invalid_pixels == frame.depth.pixels.size()) return finish_stop(result, "no valid depth", start);
+  if (!background_ready()) {
+    timed(result, "background", [&] { learn_background(learner_, frame, result.verdict); });
+    return finish(result, start);
+  }
+  if (!same_size(background(), frame.depth)) return finish_stop(result, "background size mismatch", start);
+  timed(result, "foreground", [&] { extractor_.extract(frame, background(), params_.T_base_camera, foreground_); });
+  timed(result, "proximity", [&] {
+    result.contact = closest_contact_brute(foreground_.points_base, foreground_.points_camera, params_.robot);
+  });
+  timed(result, "safety", [&] { result.verdict = verdict_for_contact(params_.safety, result.contact); });
+  result.foreground_points = foreground_.points_base.size();
+  result.valid = true;
+  finish(result, start);
+}
+
+}  // namespace hrcsense

@@ -1,0 +1,239 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — the three threads around the processing path: capture, processing and output,
+// joined by single-slot mailboxes, with a watchdog and a stop result at the end of every run.
+
+#include "hrcsense/pipeline.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace hrcsense {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+// A frame with the steady-clock time at which the source delivered it, for the frame's age.
+struct Captured {
+  Frame frame;
+  Clock::time_point captured_at{};
+};
+
+// Why capture ended: the reason of the final stop result and the summary's end_reason.
+struct CaptureOutcome {
+  int64_t frames_in = 0;
+  std::string final_reason = "source ended";
+  std::string end_reason = "end of source";
+};
+
+// Latencies kept for the percentiles. Preallocated; beyond its capacity the oldest entries
+// are overwritten, so the percentiles then describe the most recent frames.
+struct LatencyLog {
+  std::vector<float> us;
+  size_t next = 0;
+  bool wrapped = false;
+
+  explicit LatencyLog(size_t capacity) : us(std::max<size_t>(capacity, 1)) {}
+  void add(double latency_us) {
+    us[next] = static_cast<float>(latency_us);
+    next = (next + 1) % us.size();
+    wrapped = wrapped || next == 0;
+  }
+  /// Nearest-rank percentile, q in [0, 1]; 0 when empty. Reorders the log (end of run only).
+  double percentile(double q) {
+    const size_t n = wrapped ? us.size() : next;
+    if (n == 0) return 0.0;
+    const size_t rank = std::min(n - 1, static_cast<size_t>(q * static_cast<double>(n)));
+    std::nth_element(us.begin(), us.begin() + static_cast<std::ptrdiff_t>(rank), us.begin() + static_cast<std::ptrdiff_t>(n));
+    return us[rank];
+  }
+};
+
+// When paced, frame i is due at its timestamp relative to the first frame; sources without
+// usable (increasing) timestamps fall back to the nominal rate.
+Clock::time_point due_time(Clock::time_point start, int64_t first_ns, const Frame& frame, int64_t n,
+                           double nominal_fps) {
+  double offset_s = static_cast<double>(frame.timestamp_ns - first_ns) * 1e-9;
+  if (n > 0 && offset_s <= 0.0 && nominal_fps > 0.0) offset_s = static_cast<double>(n) / nominal_fps;
+  return start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(offset_s));
+}
+
+bool stop_requested(const RunOptions& options) {
+  return options.stop_requested != nullptr && options.stop_requested->load();
+}
+
+// Reads the source until it ends, fails, or the run is stopped; then closes `frames`.
+void capture_loop(Source& source, const RunOptions& options, Mailbox<Captured>& frames, CaptureOutcome& outcome) {
+  const double nominal_fps = source.info().nominal_fps;
+  Captured slot;
+  Clock::time_point start{};
+  int64_t first_ns = 0;
+  for (int64_t n = 0;; ++n) {
+    if (stop_requested(options)) {
+      outcome.final_reason = outcome.end_reason = "stop requested";
+      break;
+    }
+    if (options.max_frames >= 0 && n >= options.max_frames) {
+      outcome.final_reason = outcome.end_reason = "frame limit reached";
+      break;
+    }
+    Source::Status status = Source::Status::error;
+    std::string error;
+    try {
+      status = source.next(slot.frame);
+      if (status == Source::Status::error) error = source.error();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    if (status == Source::Status::end) break;  // the defaults say "source ended"
+    if (status == Source::Status::error) {
+      outcome.final_reason = outcome.end_reason = "source error: " + (error.empty() ? std::string("unknown") : error);
+      break;
+    }
+    ++outcome.frames_in;
+    if (options.pace) {
+      if (n == 0) {
+        start = Clock::now();
+        first_ns = slot.frame.timestamp_ns;
+      }
+      std::this_thread::sleep_until(due_time(start, first_ns, slot.frame, n, nominal_fps));
+    }
+    slot.captured_at = Clock::now();
+    if (options.pace) {
+      frames.put(slot);  // latest wins; a frame not yet taken is dropped and counted
+    } else if (!frames.put_wait(slot)) {
+      break;
+    }
+  }
+  frames.close();
+}
+
+// What the processing thread counts.
+struct ProcessingStats {
+  int64_t processed = 0;
+  LatencyLog latencies;
+  std::string error;
+};
+
+// Processes every frame it takes; a frame older than max_frame_age_s at the end of its
+// processing becomes a stop. Closes `results` when `frames` is closed and drained.
+void processing_loop(Pipeline& pipeline, const RunOptions& options, double max_frame_age_s,
+                     Mailbox<Captured>& frames, Mailbox<FrameResult>& results, ProcessingStats& stats) {
+  Captured in;
+  FrameResult result;
+  try {
+    while (frames.take(in)) {
+      pipeline.process(in.frame, result);
+      if (seconds_since(in.captured_at) > max_frame_age_s) result.verdict = stop_verdict("stale frame");
+      ++stats.processed;
+      stats.latencies.add(result.latency_us);
+      if (options.pace) {
+        results.put(result);
+      } else if (!results.put_wait(result)) {
+        break;
+      }
+    }
+  } catch (const std::exception& e) {
+    stats.error = std::string("processing error: ") + e.what();
+    frames.close();  // the capture thread must not wait for a consumer that is gone
+  }
+  results.close();
+}
+
+// A stop result that stands for no source frame (watchdog, end of run): it repeats the last
+// frame's index and timestamp, so that the output's frame numbers never go backwards.
+void write_stop(Sink& sink, FrameResult& scratch, const FrameResult& last, const std::string& reason) {
+  scratch.frame = last.frame;
+  scratch.timestamp_ns = last.timestamp_ns;
+  scratch.valid = false;
+  scratch.verdict = stop_verdict(reason);
+  scratch.contact = Contact{};
+  scratch.foreground_points = 0;
+  scratch.invalid_pixels = 0;
+  scratch.timings.clear();
+  scratch.truth.reset();
+  scratch.latency_us = 0.0;
+  sink.frame(scratch);
+}
+
+void tally(RunSummary& summary, const FrameResult& result) {
+  summary.frames_valid += result.valid ? 1 : 0;
+  switch (result.verdict.state) {
+    case VerdictState::run: ++summary.verdict_run; break;
+    case VerdictState::slow: ++summary.verdict_slow; break;
+    case VerdictState::stop: ++summary.verdict_stop; break;
+  }
+  if (result.contact.valid && (summary.min_distance_m < 0.0F || result.contact.distance_m < summary.min_distance_m)) {
+    summary.min_distance_m = result.contact.distance_m;
+  }
+}
+
+// Writes every result; when none arrives within max_frame_age_s, writes a watchdog stop.
+// Returns the last result written (for the final stop's frame index).
+FrameResult output_loop(Sink& sink, double max_frame_age_s, Mailbox<FrameResult>& results, RunSummary& summary) {
+  FrameResult result, last, watchdog;
+  Clock::time_point last_arrival = Clock::now();
+  for (;;) {
+    if (results.take_for(result, max_frame_age_s)) {
+      sink.frame(result);
+      tally(summary, result);
+      last_arrival = Clock::now();
+      std::swap(last, result);
+      continue;
+    }
+    if (results.closed()) break;
+    char reason[96];
+    std::snprintf(reason, sizeof reason, "no frame for %.3f s (max_frame_age_s %.3f)", seconds_since(last_arrival),
+                  max_frame_age_s);
+    write_stop(sink, watchdog, last, reason);
+  }
+  return last;
+}
+
+}  // namespace
+
+RunSummary run_pipeline(Source& source, Pipeline& pipeline, Sink& sink, const RunOptions& options,
+                        const RunHeader& header) {
+  const Clock::time_point start = Clock::now();
+  const double max_frame_age_s = pipeline.params().safety.max_frame_age_s;
+  const int64_t expected = options.max_frames >= 0 ? options.max_frames : source.info().frame_count;
+  constexpr int64_t kDefaultLatencyCapacity = 1 << 20;
+  ProcessingStats stats{0, LatencyLog(static_cast<size_t>(expected > 0 ? expected : kDefaultLatencyCapacity)), {}};
+  Mailbox<Captured> frames;
+  Mailbox<FrameResult> results;
+  CaptureOutcome outcome;
+  RunSummary summary;
+
+  sink.header(header);
+  std::thread capture([&] { capture_loop(source, options, frames, outcome); });
+  std::thread processing([&] { processing_loop(pipeline, options, max_frame_age_s, frames, results, stats); });
+  const FrameResult last = output_loop(sink, max_frame_age_s, results, summary);
+  processing.join();
+  capture.join();
+
+  // Fail safe: whatever ended the run, the last word to the robot is a stop.
+  if (!stats.error.empty()) outcome.final_reason = outcome.end_reason = stats.error;
+  FrameResult scratch;
+  write_stop(sink, scratch, last, outcome.final_reason);
+
+  summary.frames_in = outcome.frames_in;
+  summary.frames_processed = stats.processed;
+  summary.frames_dropped = frames.dropped() + results.dropped();
+  summary.wall_s = seconds_since(start);
+  summary.fps = summary.wall_s > 0.0 ? static_cast<double>(summary.frames_processed) / summary.wall_s : 0.0;
+  summary.latency_p50_us = stats.latencies.percentile(0.50);
+  summary.latency_p99_us = stats.latencies.percentile(0.99);
+  summary.end_reason = outcome.end_reason;
+  sink.summary(summary);
+  return summary;
+}
+
+}  // namespace hrcsense

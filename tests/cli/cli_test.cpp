@@ -1,0 +1,239 @@
+// SPDX-License-Identifier: Apache-2.0
+// Tests of the `hrcsense` executable: exit codes, one-line errors, JSON Lines from `run`, `info`.
+#include "hrcsense/camera.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+#else
+constexpr bool kSanitized = false;
+#endif
+
+struct Outcome {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+  std::vector<std::string> err_lines() const {
+    std::vector<std::string> lines;
+    std::istringstream in(err);
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    return lines;
+  }
+};
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Runs the CLI in its own temporary folder, capturing stdout and stderr.
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("hrcsense_cli_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ignored;
+    fs::remove_all(dir_, ignored);
+  }
+
+  Outcome run(const std::string& arguments) const {
+    const std::string command = "cd '" + dir_.string() + "' && '" + HRCSENSE_CLI + "' " + arguments +
+                                " > stdout.txt 2> stderr.txt";
+    const int status = std::system(command.c_str());
+    Outcome outcome;
+    outcome.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    outcome.out = read_text(dir_ / "stdout.txt");
+    outcome.err = read_text(dir_ / "stderr.txt");
+    return outcome;
+  }
+
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(dir_ / name) << text;
+    return name;
+  }
+
+  // Thesis-box, shortened; smaller frames under the sanitizers, which are slow.
+  static std::string thesis_box(const std::string& extra) {
+    std::string args = std::string("--config '") + HRCSENSE_SOURCE_DIR + "/config/thesis-box.yaml' " + extra;
+    if (kSanitized) args += " --set sim.width=424 --set sim.height=240";
+    return args;
+  }
+
+  static void expect_one_error_line(const Outcome& outcome, const std::vector<std::string>& needles) {
+    const std::vector<std::string> lines = outcome.err_lines();
+    ASSERT_EQ(lines.size(), 1U) << outcome.err;
+    EXPECT_EQ(lines[0].rfind("hrcsense: error: ", 0), 0U) << lines[0];
+    for (const std::string& needle : needles) {
+      EXPECT_NE(lines[0].find(needle), std::string::npos) << "'" << needle << "' not in: " << lines[0];
+    }
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(Cli, UnknownConfigKeyIsAUsageError) {
+  write("walk.yaml", "safety:\n  stop_distanse_m: 0.3\n");
+  const Outcome outcome = run("run --config walk.yaml");
+  EXPECT_EQ(outcome.exit_code, 2);
+  expect_one_error_line(outcome, {"walk.yaml", "unknown key 'safety.stop_distanse_m'"});
+  EXPECT_TRUE(outcome.out.empty());
+}
+
+TEST_F(Cli, MissingConfigFileIsAUsageError) {
+  const Outcome outcome = run("run --config nowhere.yaml");
+  EXPECT_EQ(outcome.exit_code, 2);
+  expect_one_error_line(outcome, {"nowhere.yaml"});
+}
+
+TEST_F(Cli, BadCommandLineIsAUsageError) {
+  Outcome outcome = run("run --frames -3");
+  EXPECT_EQ(outcome.exit_code, 2);
+  expect_one_error_line(outcome, {"--frames"});
+  outcome = run("frobnicate");
+  EXPECT_EQ(outcome.exit_code, 2);
+  expect_one_error_line(outcome, {"frobnicate"});
+  outcome = run("run --set sim.fps");
+  EXPECT_EQ(outcome.exit_code, 2);
+  expect_one_error_line(outcome, {"sim.fps", "KEY=VALUE"});
+}
+
+TEST_F(Cli, DamagedBackgroundFileIsARuntimeError) {
+  write("bg.bin", "this is not a background model, just text of some length\n");
+  const Outcome outcome = run("run --set sim.frames=3 --set background.path=bg.bin");
+  EXPECT_EQ(outcome.exit_code, 1);
+  expect_one_error_line(outcome, {"bg.bin"});
+}
+
+TEST_F(Cli, RunWritesHeaderFramesAndSummaryWithTheBindingNames) {
+  const Outcome outcome =
+      run("run " + thesis_box("--frames 130 --set background.frames=20 --out results/run.jsonl"));
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  EXPECT_TRUE(outcome.out.empty());  // results went to --out, in a folder the run created
+
+  std::vector<json> lines;
+  std::istringstream in(read_text(dir_ / "results" / "run.jsonl"));
+  for (std::string line; std::getline(in, line);) lines.push_back(json::parse(line));
+  // Header, one line per source frame, then stop results that stand for no new source frame
+  // (the end of the run, a watchdog), then the summary.
+  ASSERT_GE(lines.size(), 1U + 130U + 1U);
+  for (size_t i = 131; i + 1 < lines.size(); ++i) {
+    EXPECT_EQ(lines[i]["type"], "frame");
+    EXPECT_EQ(lines[i]["verdict"], "stop");
+    EXPECT_FALSE(lines[i]["valid"].get<bool>());
+  }
+
+  const json& header = lines.front();
+  EXPECT_EQ(header["type"], "header");
+  for (const char* key : {"version", "commit", "config_hash", "source", "intrinsics"}) {
+    EXPECT_TRUE(header.contains(key)) << key;
+  }
+  for (const char* key : {"width", "height", "fx", "fy", "ppx", "ppy", "model", "coeffs"}) {
+    EXPECT_TRUE(header["intrinsics"].contains(key)) << key;
+  }
+  EXPECT_EQ(header["config_hash"].get<std::string>().size(), 16U);
+  EXPECT_EQ(header["source"]["type"], "sim");
+
+  const char* frame_keys[] = {"frame", "timestamp_ns", "timestamp_s", "valid", "verdict", "verdict_reason",
+                              "distance_m", "closest_camera", "closest_base", "closest_robot_base", "robot_link",
+                              "backend", "foreground_points", "invalid_pixels", "timings_us", "truth"};
+  bool saw_box = false;
+  for (size_t i = 1; i <= 130; ++i) {
+    const json& frame = lines[i];
+    ASSERT_EQ(frame["type"], "frame");
+    for (const char* key : frame_keys) ASSERT_TRUE(frame.contains(key)) << key << " in line " << i;
+    EXPECT_EQ(frame["frame"], static_cast<int64_t>(i - 1));  // every frame, in order
+    const std::string verdict = frame["verdict"];
+    EXPECT_TRUE(verdict == "run" || verdict == "slow" || verdict == "stop") << verdict;
+    if (i - 1 < 20) {
+      EXPECT_FALSE(frame["valid"].get<bool>());  // learning the background
+      EXPECT_EQ(verdict, "stop");
+    }
+    if (i - 1 >= 105 && !frame["distance_m"].is_null()) {
+      // The box's nearest vertex (0.5, 0, 1) is 1.2247 m from the robot point (config/thesis-box.yaml).
+      EXPECT_NEAR(frame["distance_m"].get<double>(), 1.2247, 0.02) << i;
+      saw_box = true;
+    }
+  }
+  EXPECT_TRUE(saw_box);
+
+  const json& summary = lines.back();
+  EXPECT_EQ(summary["type"], "summary");
+  for (const char* key : {"frames_in", "frames_processed", "frames_dropped", "frames_valid", "verdict_run",
+                          "verdict_slow", "verdict_stop", "wall_s", "fps", "latency_p50_us", "latency_p99_us",
+                          "min_distance_m", "end_reason"}) {
+    EXPECT_TRUE(summary.contains(key)) << key;
+  }
+  EXPECT_EQ(summary["frames_in"], 130);
+  EXPECT_EQ(summary["frames_processed"], 130);
+  EXPECT_EQ(summary["frames_dropped"], 0);  // unpaced: every frame is processed
+}
+
+TEST_F(Cli, LearntBackgroundIsSavedThenLoaded) {
+  Outcome outcome = run("run " + thesis_box("--frames 12 --set background.frames=10 --set background.path=bg/model.bin"));
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  ASSERT_TRUE(fs::exists(dir_ / "bg" / "model.bin"));
+
+  // The second run starts with the saved model: its first frame is already valid.
+  outcome = run("run " + thesis_box("--frames 2 --set background.frames=10 --set background.path=bg/model.bin"));
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  std::istringstream in(outcome.out);
+  std::string header_line, first_frame_line;
+  std::getline(in, header_line);
+  std::getline(in, first_frame_line);
+  EXPECT_TRUE(json::parse(first_frame_line)["valid"].get<bool>()) << first_frame_line;
+
+  // A model of another size does not fit the source.
+  outcome = run("run " + thesis_box("--frames 2 --set background.path=bg/model.bin --set sim.width=640"));
+  EXPECT_EQ(outcome.exit_code, 1);
+  expect_one_error_line(outcome, {"bg/model.bin", "640x"});
+}
+
+TEST_F(Cli, InfoDescribesTheSimulatedSource) {
+  const Outcome outcome =
+      run(std::string("info --config '") + HRCSENSE_SOURCE_DIR + "/config/thesis-box.yaml'");
+  ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
+  const hrcsense::Intrinsics in = *hrcsense::d435_depth_intrinsics(848, 480);
+  char fx[64];
+  std::snprintf(fx, sizeof fx, "fx=%.4f fy=%.4f ppx=%.4f ppy=%.4f", static_cast<double>(in.fx),
+                static_cast<double>(in.fy), static_cast<double>(in.ppx), static_cast<double>(in.ppy));
+  for (const std::string& needle : {std::string("sim"), std::string("848x480"), std::string(fx),
+                                   std::string("box: moving"), std::string("wall: static"), std::string("400")}) {
+    EXPECT_NE(outcome.out.find(needle), std::string::npos) << "'" << needle << "' not in:\n" << outcome.out;
+  }
+  const Outcome recording = run("info some/recording.bag");
+  EXPECT_EQ(recording.exit_code, 2);
+  expect_one_error_line(recording, {"recording.bag", "sim"});
+}
+
+}  // namespace

@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: Apache-2.0
+// Hand-built frames for the pipeline tests: a flat wall, optionally a square object in front
+// of it, seen by an undistorted 80x60 camera whose frame is the robot base frame.
+#pragma once
+
+#include "hrcsense/pipeline.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace hrcsense::test {
+
+inline constexpr int kWidth = 80;
+inline constexpr int kHeight = 60;
+inline constexpr float kWallM = 2.0F;
+inline constexpr int kLearnFrames = 3;
+
+inline Intrinsics fake_intrinsics() {
+  Intrinsics intr;
+  intr.width = kWidth;
+  intr.height = kHeight;
+  intr.fx = intr.fy = 100.0F;
+  intr.ppx = 39.5F;  // the optical axis passes between pixels 39 and 40
+  intr.ppy = 29.5F;
+  return intr;
+}
+
+/// Object depth 0: wall only; < 0: no valid depth at all; else a 40x40 px square at that depth.
+inline void fill_frame(int64_t index, float object_m, Frame& out) {
+  out.index = index;
+  out.timestamp_ns = index * 33'333'333;
+  out.intrinsics = fake_intrinsics();
+  out.stereo_baseline_mm = 50.0F;
+  out.depth.resize(kWidth, kHeight);
+  const auto wall = static_cast<uint16_t>(std::lround(kWallM * 1000.0F));
+  const auto object = static_cast<uint16_t>(std::lround(object_m * 1000.0F));
+  for (int v = 0; v < kHeight; ++v) {
+    for (int u = 0; u < kWidth; ++u) {
+      const bool in_object = object_m > 0.0F && u >= 20 && u < 60 && v >= 10 && v < 50;
+      uint16_t raw = in_object ? object : wall;
+      if (object_m < 0.0F) raw = 0;
+      out.depth.pixels[static_cast<size_t>(v) * kWidth + u] = raw;
+    }
+  }
+}
+
+/// Distance from the robot point at the camera origin to the object at depth z: the nearest
+/// pixel centres are half a pixel off the axis in u and v, so x = y = 0.5 / fx · z.
+inline double expected_distance_m(double z_m) {
+  const double off = 0.5 / 100.0 * z_m;
+  return std::sqrt(2.0 * off * off + z_m * z_m);
+}
+
+/// Robot: one point at the camera origin; thresholds 1.0 m (slow) and 0.5 m (stop).
+inline PipelineParams fake_params(double max_frame_age_s = 0.5) {
+  PipelineParams params;
+  params.background.frames = kLearnFrames;
+  Capsule point;
+  point.link = 2;
+  params.robot.capsules.push_back(point);
+  params.safety.slow_distance_m = 1.0F;
+  params.safety.stop_distance_m = 0.5F;
+  params.safety.max_frame_age_s = max_frame_age_s;
+  return params;
+}
+
+/// What the fake source does at one step.
+struct Step {
+  float object_m = 0.0F;   ///< see fill_frame
+  double sleep_s = 0.0;    ///< before delivering
+  bool fail = false;       ///< report an error instead of a frame
+};
+
+class FakeSource : public Source {
+ public:
+  explicit FakeSource(std::vector<Step> steps) : steps_(std::move(steps)) {}
+  SourceInfo info() const override {
+    SourceInfo info;
+    info.type = "fake";
+    info.intrinsics = fake_intrinsics();
+    info.frame_count = static_cast<int64_t>(steps_.size());
+    return info;
+  }
+  Status next(Frame& out) override {
+    if (next_ >= steps_.size()) return Status::end;
+    const Step& step = steps_[next_];
+    if (step.sleep_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(step.sleep_s));
+    if (step.fail) return Status::error;
+    fill_frame(static_cast<int64_t>(next_), step.object_m, out);
+    ++next_;
+    return Status::frame;
+  }
+  std::string error() const override { return "cable unplugged"; }
+
+ private:
+  std::vector<Step> steps_;
+  size_t next_ = 0;
+};
+
+/// Keeps everything it is given.
+struct CollectingSink : Sink {
+  RunHeader header_seen;
+  std::vector<FrameResult> results;
+  RunSummary summary_seen;
+  int headers = 0, summaries = 0;
+
+  void header(const RunHeader& h) override {
+    header_seen = h;
+    ++headers;
+  }
+  void frame(const FrameResult& r) override { results.push_back(r); }
+  void summary(const RunSummary& s) override {
+    summary_seen = s;
+    ++summaries;
+  }
+  /// Results that stand for a source frame: not the watchdog's, not the final stop.
+  std::vector<FrameResult> frame_results() const {
+    std::vector<FrameResult> out;
+    for (size_t i = 0; i + 1 < results.size(); ++i) {
+      if (results[i].verdict.reason.rfind("no frame for", 0) != 0) out.push_back(results[i]);
+    }
+    return out;
+  }
+};
+
+/// `learn` wall frames, then the given steps.
+inline std::vector<Step> after_learning(std::vector<Step> steps) {
+  std::vector<Step> all(kLearnFrames, Step{});
+  all.insert(all.end(), steps.begin(), steps.end());
+  return all;
+}
+
+}  // namespace hrcsense::test

@@ -1,0 +1,218 @@
+// SPDX-License-Identifier: Apache-2.0
+// Tests of JsonLinesSink: each line parses back (nlohmann) with every binding field.
+#include "hrcsense/sinks.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace hrcsense {
+namespace {
+
+using nlohmann::json;
+
+std::vector<json> parse_lines(const std::string& text) {
+  std::vector<json> lines;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) lines.push_back(json::parse(line));
+  return lines;
+}
+
+void expect_vec3(const json& value, const Eigen::Vector3f& expected) {
+  ASSERT_TRUE(value.is_array()) << value;
+  ASSERT_EQ(value.size(), 3U);
+  for (int i = 0; i < 3; ++i) {
+    // Written floats read back to the same float: far below 0.1 mm.
+    EXPECT_EQ(static_cast<float>(value[static_cast<size_t>(i)].get<double>()), expected[i]) << value;
+  }
+}
+
+FrameResult contact_result() {
+  FrameResult r;
+  r.frame = 123;
+  r.timestamp_ns = 4'100'000'001;
+  r.valid = true;
+  r.verdict.state = VerdictState::slow;
+  r.verdict.speed_scale = 0.4375F;
+  r.verdict.reason = "person at \"0.72 m\"\n";
+  r.contact.valid = true;
+  r.contact.distance_m = 0.7234567F;
+  r.contact.closest_camera = {0.1234567F, -0.25F, 1.0001F};
+  r.contact.closest_base = {-1.5F, 2.0000999F, 0.3F};
+  r.contact.closest_robot_base = {-0.5F, -0.5F, 0.5F};
+  r.contact.robot_link = 3;
+  r.foreground_points = 1492;
+  r.invalid_pixels = 17;
+  r.latency_us = 812.5;
+  r.timings = {{"foreground", 700.25}, {"proximity", 4.5}};
+  Contact truth;
+  truth.valid = true;
+  truth.distance_m = 0.725F;
+  truth.closest_base = {-1.5F, 2.0F, 0.301F};
+  r.truth = truth;
+  return r;
+}
+
+TEST(JsonLinesSink, HeaderCarriesVersionSourceAndIntrinsics) {
+  std::ostringstream out;
+  JsonLinesSink sink(out);
+  RunHeader header;
+  header.version = "9.8.7";
+  header.commit = "abc123";
+  header.config_hash = "0123456789abcdef";
+  header.source.type = "sim";
+  header.source.description = "a scene";
+  header.source.frame_count = 400;
+  header.source.nominal_fps = 30.0;
+  header.source.stereo_baseline_mm = 49.864F;
+  Intrinsics& in = header.source.intrinsics;
+  in.width = 848;
+  in.height = 480;
+  in.fx = 418.2654F;
+  in.fy = 418.2655F;
+  in.ppx = 424.1575F;
+  in.ppy = 238.2404F;
+  in.model = Distortion::brown_conrady;
+  in.coeffs = {0.1F, -0.2F, 0.0F, 0.0F, 0.05F};
+  sink.header(header);
+
+  const std::vector<json> lines = parse_lines(out.str());
+  ASSERT_EQ(lines.size(), 1U);
+  const json& h = lines[0];
+  EXPECT_EQ(h["type"], "header");
+  EXPECT_EQ(h["version"], "9.8.7");
+  EXPECT_EQ(h["commit"], "abc123");
+  EXPECT_EQ(h["config_hash"], "0123456789abcdef");
+  EXPECT_EQ(h["source"]["type"], "sim");
+  EXPECT_EQ(h["source"]["description"], "a scene");
+  EXPECT_EQ(h["source"]["frame_count"], 400);
+  EXPECT_EQ(h["source"]["nominal_fps"], 30.0);
+  EXPECT_EQ(h["source"]["stereo_baseline_mm"].get<float>(), 49.864F);
+  const json& i = h["intrinsics"];
+  EXPECT_EQ(i["width"], 848);
+  EXPECT_EQ(i["height"], 480);
+  EXPECT_EQ(i["fx"].get<float>(), 418.2654F);
+  EXPECT_EQ(i["fy"].get<float>(), 418.2655F);
+  EXPECT_EQ(i["ppx"].get<float>(), 424.1575F);
+  EXPECT_EQ(i["ppy"].get<float>(), 238.2404F);
+  EXPECT_EQ(i["model"], "Brown Conrady");  // the SDK's name
+  ASSERT_EQ(i["coeffs"].size(), 5U);
+  EXPECT_EQ(i["coeffs"][0].get<float>(), 0.1F);
+  EXPECT_EQ(i["coeffs"][1].get<float>(), -0.2F);
+  EXPECT_EQ(i["coeffs"][4].get<float>(), 0.05F);
+}
+
+TEST(JsonLinesSink, FrameWithContactHasEveryField) {
+  std::ostringstream out;
+  JsonLinesSink sink(out, "brute");
+  sink.frame(contact_result());
+  const std::vector<json> lines = parse_lines(out.str());
+  ASSERT_EQ(lines.size(), 1U);
+  const json& f = lines[0];
+  EXPECT_EQ(f["type"], "frame");
+  EXPECT_EQ(f["frame"], 123);
+  EXPECT_EQ(f["timestamp_ns"].get<int64_t>(), 4'100'000'001);
+  EXPECT_EQ(f["timestamp_s"].get<double>(), 4.100000001);
+  EXPECT_EQ(f["valid"], true);
+  EXPECT_EQ(f["verdict"], "slow");
+  EXPECT_EQ(f["verdict_reason"], "person at \"0.72 m\"\n");  // escaped and read back
+  EXPECT_EQ(f["speed_scale"].get<double>(), 0.4375);
+  EXPECT_EQ(f["distance_m"].get<float>(), 0.7234567F);
+  expect_vec3(f["closest_camera"], {0.1234567F, -0.25F, 1.0001F});
+  expect_vec3(f["closest_base"], {-1.5F, 2.0000999F, 0.3F});
+  expect_vec3(f["closest_robot_base"], {-0.5F, -0.5F, 0.5F});
+  EXPECT_EQ(f["robot_link"], 3);
+  EXPECT_EQ(f["backend"], "brute");
+  EXPECT_EQ(f["foreground_points"], 1492);
+  EXPECT_EQ(f["invalid_pixels"], 17);
+  EXPECT_EQ(f["latency_us"].get<double>(), 812.5);
+  ASSERT_EQ(f["timings_us"].size(), 2U);
+  EXPECT_EQ(f["timings_us"]["foreground"].get<double>(), 700.25);
+  EXPECT_EQ(f["timings_us"]["proximity"].get<double>(), 4.5);
+  EXPECT_EQ(f["truth"]["distance_m"].get<float>(), 0.725F);
+  expect_vec3(f["truth"]["closest_base"], {-1.5F, 2.0F, 0.301F});
+}
+
+TEST(JsonLinesSink, FrameWithoutContactWritesNulls) {
+  std::ostringstream out;
+  JsonLinesSink sink(out);
+  FrameResult r = contact_result();
+  r.contact.valid = false;
+  r.truth->valid = false;
+  r.timings.clear();
+  r.timestamp_ns = 3'000'000'000;
+  sink.frame(r);
+  r.truth.reset();  // a source without ground truth: no truth member at all
+  sink.frame(r);
+  const std::vector<json> lines = parse_lines(out.str());
+  ASSERT_EQ(lines.size(), 2U);
+  const json& f = lines[0];
+  EXPECT_EQ(f["timestamp_s"].get<double>(), 3.0);
+  for (const char* key : {"distance_m", "closest_camera", "closest_base", "closest_robot_base", "robot_link"}) {
+    ASSERT_TRUE(f.contains(key)) << key;
+    EXPECT_TRUE(f[key].is_null()) << key;
+  }
+  EXPECT_TRUE(f["timings_us"].is_object());
+  EXPECT_TRUE(f["timings_us"].empty());
+  EXPECT_TRUE(f["truth"]["distance_m"].is_null());
+  EXPECT_TRUE(f["truth"]["closest_base"].is_null());
+  EXPECT_FALSE(lines[1].contains("truth"));
+}
+
+TEST(JsonLinesSink, SummaryHasEveryRunSummaryField) {
+  std::ostringstream out;
+  JsonLinesSink sink(out);
+  RunSummary s;
+  s.frames_in = 130;
+  s.frames_processed = 129;
+  s.frames_dropped = 1;
+  s.frames_valid = 110;
+  s.verdict_run = 100;
+  s.verdict_slow = 9;
+  s.verdict_stop = 20;
+  s.wall_s = 2.5;
+  s.fps = 51.6;
+  s.latency_p50_us = 1019.25;
+  s.latency_p99_us = 1941.75;
+  s.min_distance_m = 1.2196938F;
+  s.end_reason = "end of source";
+  sink.summary(s);
+  s.min_distance_m = -1.0F;
+  sink.summary(s);
+  const std::vector<json> lines = parse_lines(out.str());
+  ASSERT_EQ(lines.size(), 2U);
+  const json& j = lines[0];
+  EXPECT_EQ(j["type"], "summary");
+  EXPECT_EQ(j["frames_in"], 130);
+  EXPECT_EQ(j["frames_processed"], 129);
+  EXPECT_EQ(j["frames_dropped"], 1);
+  EXPECT_EQ(j["frames_valid"], 110);
+  EXPECT_EQ(j["verdict_run"], 100);
+  EXPECT_EQ(j["verdict_slow"], 9);
+  EXPECT_EQ(j["verdict_stop"], 20);
+  EXPECT_EQ(j["wall_s"].get<double>(), 2.5);
+  EXPECT_EQ(j["fps"].get<double>(), 51.6);
+  EXPECT_EQ(j["latency_p50_us"].get<double>(), 1019.25);
+  EXPECT_EQ(j["latency_p99_us"].get<double>(), 1941.75);
+  EXPECT_EQ(j["min_distance_m"].get<float>(), 1.2196938F);
+  EXPECT_EQ(j["end_reason"], "end of source");
+  EXPECT_TRUE(lines[1]["min_distance_m"].is_null());  // never any foreground
+}
+
+TEST(JsonLinesSink, NonFiniteNumbersBecomeNull) {
+  std::ostringstream out;
+  JsonLinesSink sink(out);
+  FrameResult r = contact_result();
+  r.contact.distance_m = std::numeric_limits<float>::quiet_NaN();
+  sink.frame(r);
+  const json f = json::parse(out.str());
+  EXPECT_TRUE(f["distance_m"].is_null());
+}
+
+}  // namespace
+}  // namespace hrcsense

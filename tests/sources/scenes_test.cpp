@@ -1,0 +1,109 @@
+// SPDX-License-Identifier: Apache-2.0
+// The shipped scene files (config/*.yaml) do what their comments promise, checked numerically.
+
+#include "hrcsense/config.hpp"
+#include "hrcsense/sim.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace hrcsense {
+namespace {
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr int64_t kStep = 3;  // sanitizers: every third frame (the closest approach lasts 30)
+#else
+constexpr int64_t kStep = 1;
+#endif
+
+std::string scene_path(const char* name) { return std::string(HRCSENSE_SOURCE_DIR) + "/config/" + name; }
+
+TEST(Scenes, WalkApproachesTheRobotPointTo029Metres) {
+  // The truth does not depend on the noise; without it rendering is faster.
+  const Config config = load_config(scene_path("walk.yaml"), {"sim.noise=false"});
+  const Simulator sim = make_simulator(config);
+  ASSERT_EQ(sim.robot.capsules.size(), 1U);
+  const double frames_s = static_cast<double>(sim.params.frames) / sim.params.fps;
+  EXPECT_GE(frames_s, 10.0);
+  EXPECT_LE(frames_s, 15.0);
+  EXPECT_NEAR(sim.robot.capsules[0].a.norm(), 1.6F, 0.1F);  // the robot point, ~1.6 m from the camera
+
+  Frame f;
+  float min_analytic_m = INFINITY;
+  float min_truth_m = INFINITY;
+  float start_m = -1.0F;
+  float min_depth_m = INFINITY;
+  float max_depth_m = 0.0F;
+  int64_t first_seen = -1;
+  int64_t last_seen = -1;
+  // Every frame around the entry (the start distance), every kStep-th elsewhere.
+  for (int64_t i = 0; i < sim.params.frames; i += (i >= 100 && i < 140) ? 1 : kStep) {
+    sim.render(i, f);
+    const GroundTruth& truth = *f.truth;
+    for (size_t p = 0; p < truth.labels.size(); ++p) {
+      if (truth.labels[p] == kStaticLabel) continue;
+      min_depth_m = std::min(min_depth_m, truth.depth_m[p]);
+      max_depth_m = std::max(max_depth_m, truth.depth_m[p]);
+    }
+    ASSERT_EQ(truth.analytic_contact.valid, truth.contact.valid) << "frame " << i;
+    if (!truth.analytic_contact.valid) continue;
+    if (first_seen < 0) {
+      first_seen = i;
+      start_m = truth.analytic_contact.distance_m;
+    }
+    last_seen = i;
+    min_analytic_m = std::min(min_analytic_m, truth.analytic_contact.distance_m);
+    min_truth_m = std::min(min_truth_m, truth.contact.distance_m);
+  }
+  std::printf("walk: person in view frames %lld-%lld, start %.3f m, closest %.4f m (pixels %.4f m), depth %.2f-%.2f m\n",
+              static_cast<long long>(first_seen), static_cast<long long>(last_seen), start_m, min_analytic_m,
+              min_truth_m, min_depth_m, max_depth_m);
+  ASSERT_GE(first_seen, 100) << "the person must not appear while the background is learnt";
+  EXPECT_LT(first_seen, 130);
+  EXPECT_LT(last_seen, sim.params.frames - 30) << "the person leaves the view before the end";
+  EXPECT_GE(start_m, 2.5F);
+  EXPECT_LE(start_m, 2.7F);
+  EXPECT_GE(min_analytic_m, 0.28F);
+  EXPECT_LE(min_analytic_m, 0.30F);
+  // The rendered pixels reach the closest approach within a pixel's footprint.
+  EXPECT_GE(min_truth_m, min_analytic_m - 1e-5F);
+  EXPECT_LE(min_truth_m, min_analytic_m + 0.005F);
+  EXPECT_GE(min_depth_m, 1.0F);
+  EXPECT_LE(max_depth_m, 2.5F);
+}
+
+TEST(Scenes, ThesisBoxContactIsTheFrontTopLeftVertex) {
+  const Config config = load_config(scene_path("thesis-box.yaml"), {"sim.noise=false"});
+  const Simulator sim = make_simulator(config);
+  ASSERT_GE(sim.params.frames, 400);
+  ASSERT_EQ(sim.params.width, 848);
+  ASSERT_EQ(sim.params.height, 480);
+  ASSERT_TRUE(sim.T_base_camera.isApprox(Pose::Identity()));
+  const Eigen::Vector3f vertex(0.5F, 0.0F, 1.0F);
+  const Eigen::Vector3f robot_point(-0.5F, -0.5F, 0.5F);
+  const float expected_m = (vertex - robot_point).norm();  // sqrt(1.5) = 1.2247 m
+
+  Frame f;
+  for (const int64_t i : {int64_t{0}, int64_t{99}}) {
+    sim.render(i, f);
+    EXPECT_FALSE(f.truth->contact.valid) << "no box while learning, frame " << i;
+  }
+  for (int64_t i = 100; i < sim.params.frames; i += 50 * kStep) {
+    sim.render(i, f);
+    const GroundTruth& truth = *f.truth;
+    ASSERT_TRUE(truth.contact.valid) << "frame " << i;
+    ASSERT_TRUE(truth.analytic_contact.valid) << "frame " << i;
+    EXPECT_LT((truth.contact.closest_base - vertex).norm(), 0.003F) << "frame " << i;
+    EXPECT_NEAR(truth.contact.distance_m, expected_m, 0.003F) << "frame " << i;
+    EXPECT_NEAR(truth.analytic_contact.distance_m, expected_m, 1e-5F) << "frame " << i;
+    EXPECT_LT((truth.analytic_contact.closest_base - vertex).norm(), 1e-6F) << "frame " << i;
+    EXPECT_LT((truth.analytic_contact.closest_robot_base - robot_point).norm(), 1e-6F) << "frame " << i;
+  }
+}
+
+}  // namespace
+}  // namespace hrcsense
