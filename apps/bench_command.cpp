@@ -51,8 +51,8 @@ double prerender(Source& source, int64_t count, std::vector<Frame>& frames) {
     // Keep only the true contact (what a run copies): the per-pixel truth would multiply the
     // memory held by the pre-rendered frames.
     if (frames.back().truth) {
-      frames.back().truth->depth_m = {};
-      frames.back().truth->labels = {};
+      std::vector<float>().swap(frames.back().truth->depth_m);  // `= {}` would keep the capacity
+      std::vector<uint16_t>().swap(frames.back().truth->labels);
     }
   }
   return std::chrono::duration<double>(Clock::now() - start).count();

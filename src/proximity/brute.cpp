@@ -71,15 +71,20 @@ float min_axis_distance_sq(const Segment& s, const float* x, const float* y, con
 
 // Lowest point index whose surface distance equals `target_m` exactly; n when none does.
 // Several points can share the reported (float) distance, e.g. all points inside the capsule
-// at 0. The cheap bound on d2 skips the sqrt for all points clearly farther away; its slack
-// is far above float rounding.
+// at 0. Blocks whose smallest d2 is clearly beyond the target (by a slack far above float
+// rounding) are skipped with the vectorised loop; only the block with the hit is scanned.
 size_t first_index_at(const Segment& s, const float* x, const float* y, const float* z, size_t n,
                       float target_m) {
+  constexpr size_t kBlock = 256;
   const float reach_m = target_m + s.radius_m;
   const float bound_sq = reach_m * reach_m * 1.0001F + 1e-12F;
-  for (size_t i = 0; i < n; ++i) {
-    const float d2 = axis_distance_sq(s, x[i], y[i], z[i]);
-    if (d2 <= bound_sq && surface_distance(s, d2) == target_m) return i;
+  for (size_t begin = 0; begin < n; begin += kBlock) {
+    const size_t end = std::min(n, begin + kBlock);
+    if (!(min_axis_distance_sq(s, x + begin, y + begin, z + begin, end - begin) <= bound_sq)) continue;
+    for (size_t i = begin; i < end; ++i) {
+      const float d2 = axis_distance_sq(s, x[i], y[i], z[i]);
+      if (d2 <= bound_sq && surface_distance(s, d2) == target_m) return i;
+    }
   }
   return n;
 }

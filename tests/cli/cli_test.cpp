@@ -85,9 +85,9 @@ class Cli : public ::testing::Test {
 
   // Thesis-box, shortened; smaller frames under the sanitizers, which are slow.
   static std::string thesis_box(const std::string& extra) {
-    std::string args = std::string("--config '") + HRCSENSE_SOURCE_DIR + "/config/thesis-box.yaml' " + extra;
-    if (kSanitized) args += " --set sim.width=424 --set sim.height=240";
-    return args;
+    std::string args = std::string("--config '") + HRCSENSE_SOURCE_DIR + "/config/thesis-box.yaml' ";
+    if (kSanitized) args += "--set sim.width=424 --set sim.height=240 ";
+    return args + extra;  // last, so that the test's own overrides win
   }
 
   static void expect_one_error_line(const Outcome& outcome, const std::vector<std::string>& needles) {
@@ -214,9 +214,10 @@ TEST_F(Cli, LearntBackgroundIsSavedThenLoaded) {
   EXPECT_TRUE(json::parse(first_frame_line)["valid"].get<bool>()) << first_frame_line;
 
   // A model of another size does not fit the source.
-  outcome = run("run " + thesis_box("--frames 2 --set background.path=bg/model.bin --set sim.width=640"));
+  outcome = run("run " + thesis_box("--frames 2 --set background.path=bg/model.bin --set sim.width=640 "
+                                     "--set sim.height=480"));
   EXPECT_EQ(outcome.exit_code, 1);
-  expect_one_error_line(outcome, {"bg/model.bin", "640x"});
+  expect_one_error_line(outcome, {"bg/model.bin", "640x480"});
 }
 
 TEST_F(Cli, InfoDescribesTheSimulatedSource) {
