@@ -156,6 +156,9 @@ struct StageTiming {
 /// Everything a sink needs about one processed frame.
 struct FrameResult {
   int64_t frame = 0;          ///< source frame index
+  /// false for a verdict that stands for no new source frame (watchdog timeout, end of run);
+  /// it then repeats the last frame's index and timestamp.
+  bool source_frame = true;
   int64_t timestamp_ns = 0;
   bool valid = false;         ///< usable depth, processed, background ready
   Verdict verdict;

@@ -100,9 +100,14 @@ void read_segmentation(KeyReader& r, Config& c) {
 void read_robot_and_safety(KeyReader& r, Config& c) {
   r.choice("robot.model", c.robot_model, {"points", "ur5", "ur5e", "ur10e"});
   if (c.robot_model != "points") not_implemented(r, "robot.model", c.robot_model, "points");
-  std::vector<Eigen::Vector3f> points_base;
+  // Default: the 2020 thesis's robot point (-0.5, 0.5, 0.5) m, given there with y up.
+  std::vector<Eigen::Vector3f> points_base{Eigen::Vector3f(-0.5F, -0.5F, 0.5F)};
   float padding_m = 0.0F;
   r.vec3_list("robot.points_base", points_base);
+  // Without a robot every distance would be "infinite" and every verdict run: refuse.
+  if (c.robot_model == "points" && points_base.empty()) {
+    r.fail("robot.points_base", "expected at least one point [x, y, z] for robot.model points");
+  }
   r.number("robot.padding_m", padding_m, Bound::non_negative);
   r.number_list("robot.joints_rad", c.robot_joints_rad, 6);
   r.choice("robot.base_frame", c.robot_base_frame, {"base", "base_link"});

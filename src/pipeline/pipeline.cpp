@@ -111,6 +111,7 @@ void Pipeline::process(const Frame& frame, FrameResult& result) {
     return finish(result, start);
   }
   if (!same_size(background(), frame.depth)) return finish_stop(result, "background size mismatch", start);
+  if (params_.robot.capsules.empty()) return finish_stop(result, "no robot model", start);
   timed(result, "foreground", [&] { extractor_.extract(frame, background(), params_.T_base_camera, foreground_); });
   timed(result, "proximity", [&] {
     result.contact = closest_contact_brute(foreground_.points_base, foreground_.points_camera, params_.robot);

@@ -151,6 +151,7 @@ void processing_loop(Pipeline& pipeline, const RunOptions& options, double max_f
 // A stop result that stands for no source frame (watchdog, end of run): it repeats the last
 // frame's index and timestamp, so that the output's frame numbers never go backwards.
 void write_stop(Sink& sink, FrameResult& scratch, const FrameResult& last, const std::string& reason) {
+  scratch.source_frame = false;
   scratch.frame = last.frame;
   scratch.timestamp_ns = last.timestamp_ns;
   scratch.valid = false;

@@ -180,7 +180,7 @@ void JsonLinesSink::frame(const FrameResult& result) {
   const Contact& contact = result.contact;
   line.assign("{");
   put_key(line, "type");
-  put_string(line, "frame");
+  put_string(line, result.source_frame ? "frame" : "verdict");
   put_key(line, "frame");
   put_int(line, result.frame);
   put_key(line, "timestamp_ns");

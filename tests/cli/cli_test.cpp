@@ -146,9 +146,13 @@ TEST_F(Cli, RunWritesHeaderFramesAndSummaryWithTheBindingNames) {
   for (std::string line; std::getline(in, line);) lines.push_back(json::parse(line));
   // Header, one line per source frame, then stop results that stand for no new source frame
   // (the end of the run, a watchdog), then the summary.
-  ASSERT_GE(lines.size(), 1U + 130U + 1U);
-  for (size_t i = 131; i + 1 < lines.size(); ++i) {
+  ASSERT_GE(lines.size(), 1U + 130U + 1U + 1U);
+  for (size_t i = 1; i <= 130; ++i) {
     EXPECT_EQ(lines[i]["type"], "frame");
+    EXPECT_EQ(lines[i]["frame"], i - 1);
+  }
+  for (size_t i = 131; i + 1 < lines.size(); ++i) {
+    EXPECT_EQ(lines[i]["type"], "verdict");
     EXPECT_EQ(lines[i]["verdict"], "stop");
     EXPECT_FALSE(lines[i]["valid"].get<bool>());
   }

@@ -50,6 +50,7 @@ TEST(ConfigErrors, IllTypedValuesNameFileKeyAndExpectation) {
   check("foreground: {k_sigma: -1}\n", "'foreground.k_sigma'", "> 0");
   check("foreground: {workspace_base: {min: [0, 0, 1], max: [1, 1, 0]}}\n", "'foreground.workspace_base'", "min <= max");
   check("robot: {points_base: [[0, 0]]}\n", "'robot.points_base'", "[x, y, z]");
+  check("robot: {points_base: []}\n", "'robot.points_base'", "at least one point");
   check("robot: {padding_m: -0.1}\n", "'robot.padding_m'", ">= 0");
   check("robot: {joints_rad: [0, 1, 2]}\n", "'robot.joints_rad'", "6 numbers");
   check("robot: {base_frame: tool0}\n", "'robot.base_frame'", "base, base_link");

@@ -32,7 +32,8 @@ TEST(Config, DefaultsWithoutFileMatchTheStructDefaults) {
   EXPECT_FLOAT_EQ(config.pipeline.foreground.k_sigma, pipeline.foreground.k_sigma);
   EXPECT_FLOAT_EQ(config.pipeline.safety.slow_distance_m, pipeline.safety.slow_distance_m);
   EXPECT_FLOAT_EQ(config.pipeline.safety.stop_distance_m, pipeline.safety.stop_distance_m);
-  EXPECT_TRUE(config.pipeline.robot.capsules.empty());
+  ASSERT_EQ(config.pipeline.robot.capsules.size(), 1U);  // the thesis's robot point, y down
+  EXPECT_EQ(config.pipeline.robot.capsules[0].a, Eigen::Vector3f(-0.5F, -0.5F, 0.5F));
   EXPECT_EQ(config.pipeline.backend, "brute");
   EXPECT_TRUE(config.pipeline.T_base_camera.isApprox(Pose::Identity()));
   EXPECT_EQ(config.robot_base_frame, "base");

@@ -117,6 +117,26 @@ TEST(Pipeline, PresetBackgroundSkipsLearning) {
   EXPECT_NEAR(result.contact.distance_m, expected_distance_m(0.3), 1e-4);
 }
 
+// No robot to measure against must not read as "nothing near the robot".
+TEST(Pipeline, EmptyRobotModelIsStop) {
+  Pipeline learner(fake_params());
+  Frame frame;
+  FrameResult result;
+  for (int i = 0; i < test::kLearnFrames; ++i) {
+    fill_frame(i, 0.0F, frame);
+    learner.process(frame, result);
+  }
+  PipelineParams params = fake_params();
+  params.robot.capsules.clear();
+  Pipeline pipeline(params);
+  pipeline.set_background(learner.background());
+  fill_frame(0, 0.0F, frame);  // an empty cell: without the rule this would be run
+  pipeline.process(frame, result);
+  EXPECT_FALSE(result.valid);
+  EXPECT_EQ(result.verdict.state, VerdictState::stop);
+  EXPECT_EQ(result.verdict.reason, "no robot model");
+}
+
 TEST(Pipeline, BackgroundOfAnotherSizeIsStop) {
   Pipeline pipeline(fake_params());
   BackgroundModel model;

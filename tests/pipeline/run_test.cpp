@@ -56,6 +56,8 @@ TEST(RunPipeline, UnpacedProcessesEveryFrameWithExpectedVerdicts) {
   EXPECT_EQ(last.verdict.state, VerdictState::stop);
   EXPECT_EQ(last.verdict.reason, "source ended");
   EXPECT_FALSE(last.valid);
+  EXPECT_FALSE(last.source_frame);  // it stands for no new source frame
+  for (size_t i = 0; i + 1 < sink.results.size(); ++i) EXPECT_TRUE(sink.results[i].source_frame);
 
   EXPECT_EQ(summary.frames_in, 7);
   EXPECT_EQ(summary.frames_processed, 7);

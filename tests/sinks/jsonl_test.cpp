@@ -216,3 +216,26 @@ TEST(JsonLinesSink, NonFiniteNumbersBecomeNull) {
 
 }  // namespace
 }  // namespace hrcsense
+
+namespace hrcsense {
+namespace {
+
+// A stop that stands for no new source frame is its own line type, so frames can be counted.
+TEST(JsonLinesSink, VerdictWithoutSourceFrameHasItsOwnType) {
+  std::ostringstream out;
+  JsonLinesSink sink(out, "brute");
+  FrameResult result;
+  result.frame = 7;
+  result.source_frame = false;
+  result.verdict = stop_verdict("source ended");
+  sink.frame(result);
+  const std::vector<json> lines = parse_lines(out.str());
+  ASSERT_EQ(lines.size(), 1U);
+  EXPECT_EQ(lines[0]["type"], "verdict");
+  EXPECT_EQ(lines[0]["frame"], 7);
+  EXPECT_EQ(lines[0]["verdict"], "stop");
+  EXPECT_EQ(lines[0]["verdict_reason"], "source ended");
+}
+
+}  // namespace
+}  // namespace hrcsense
