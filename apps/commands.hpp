@@ -15,10 +15,13 @@ struct CommandArgs {
   int64_t frames = -1;              ///< --frames N; -1: the source's length
   std::string out;                  ///< --out FILE; empty: stdout
   std::string input;                ///< positional path (info on a recording)
+  std::string shared;               ///< verify-filters --shared DIR; empty: ../shared
 };
 
 int run_command(const CommandArgs& args);
 int info_command(const CommandArgs& args);
 int bench_command(const CommandArgs& args);
+/// verify-filters CASES_JSON [--shared DIR]: one stdout line per case, last "N/M cases bit-exact".
+int verify_filters_command(const CommandArgs& args);
 
 }  // namespace hrcsense::app

@@ -5,8 +5,11 @@
 
 #include "hrcsense/camera.hpp"
 #include "hrcsense/config.hpp"
+#include "hrcsense/recordings.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 namespace hrcsense::app {
@@ -24,6 +27,30 @@ void print_scene(const Scene& scene) {
     std::printf("  %s: %s%s, %zu shape(s)\n", object.name.c_str(), object.is_static ? "static" : "moving",
                 when.c_str(), object.shapes.size());
   }
+}
+
+// The D435 effects in force (docs/SIMULATOR.md) and the fill rate they give this scene.
+void print_sensor_effects(const Simulator& simulator) {
+  const SimParams& p = simulator.params;
+  const Intrinsics in = simulator.intrinsics();
+  const double fxb_px_m = static_cast<double>(in.fx) * p.baseline_mm * 1e-3;
+  const double min_range_m = p.min_range_m > 0.0F ? p.min_range_m
+                             : p.max_disparity_px > 0.0F ? fxb_px_m / p.max_disparity_px
+                                                        : 0.0;
+  std::printf("stereo: left band %s, occlusion shadows %s, minimum range %.3f m\n", p.left_band ? "on" : "off",
+              p.occlusion_shadows ? "on" : "off", min_range_m);
+  if (p.noise) {
+    std::printf("dropouts: edges %.0f %%, flying pixels %.0f %%, speckle %.2f %%, dark %.0f %%, shiny %.0f %%, "
+                "low texture %.0f %%; disparity step 1/%.0f px, correlated sigma %.3f px\n",
+                100.0 * p.edge_dropout, 100.0 * p.flying_pixels, 100.0 * p.speckle, 100.0 * p.dark_dropout,
+                100.0 * p.shiny_dropout, 100.0 * p.low_texture_dropout,
+                p.disparity_step_px > 0.0F ? 1.0 / p.disparity_step_px : 0.0,
+                static_cast<double>(p.correlated_noise_px));
+  }
+  // Valid pixels / pixels in the image over the first frames (the Depth Quality Tool's fill rate).
+  const int64_t frames = std::min<int64_t>(p.frames, 10);
+  std::printf("fill rate: %.1f %% (frames 0-%lld)\n", 100.0 * sim_fill_rate(simulator, 0, frames),
+              static_cast<long long>(frames - 1));
 }
 
 int print_sim(const Config& config) {
@@ -44,9 +71,49 @@ int print_sim(const Config& config) {
     std::printf("noise: none (exact depth quantised to %.3g mm)\n", static_cast<double>(sim.depth_scale_m) * 1000.0);
   }
   std::printf("frames: %lld (%.3f s)\n", static_cast<long long>(sim.frames), static_cast<double>(sim.frames) / sim.fps);
+  print_sensor_effects(simulator);
   print_scene(config.scene);
   std::printf("robot: %s, %zu capsule(s)\n", config.robot_model.c_str(), config.pipeline.robot.capsules.size());
   std::printf("config hash: %s\n", config_hash(config).c_str());
+  return 0;
+}
+
+// A recording (.bag file or folder): what summarize_recording found, one line per fact.
+int print_recording(const std::string& path) {
+  const RecordingSummary s = summarize_recording(path);
+  std::printf("recording: %s\n", s.path.c_str());
+  std::printf("format: %s", s.format.c_str());
+  if (s.format == "bag") {
+    std::printf(" (%s, file version %d)", s.indexed ? "indexed" : "no usable index, scanned", s.file_version);
+  }
+  std::printf("\ncompression: %s\n", s.compression.c_str());
+  for (const RecordingStream& stream : s.streams) {
+    const Intrinsics& in = stream.intrinsics;
+    const std::string size = in.width > 0 ? std::to_string(in.width) + "x" + std::to_string(in.height) : "size unknown";
+    std::printf("stream %s: %s %s, %lld frame(s)", stream.name.c_str(), size.c_str(), stream.encoding.c_str(),
+                static_cast<long long>(stream.frames));
+    if (stream.last_ns > stream.first_ns) {
+      std::printf(", %.3f s", static_cast<double>(stream.last_ns - stream.first_ns) * 1e-9);
+    } else {
+      std::printf(", duration unknown");
+    }
+    if (in.fx > 0.0F) {
+      std::printf(", fx=%.4f fy=%.4f ppx=%.4f ppy=%.4f model=%s", static_cast<double>(in.fx),
+                  static_cast<double>(in.fy), static_cast<double>(in.ppx), static_cast<double>(in.ppy),
+                  std::string(distortion_name(in.model)).c_str());
+    }
+    std::printf("\n");
+  }
+  std::printf("depth units: %g m\n", static_cast<double>(s.depth_units_m));
+  if (s.stereo_baseline_mm > 0.0F) std::printf("stereo baseline: %.3f mm\n", static_cast<double>(s.stereo_baseline_mm));
+  if (s.T_color_depth) {
+    const Eigen::Vector3d t = s.T_color_depth->translation();
+    const Eigen::Quaterniond q(s.T_color_depth->linear());
+    std::printf("extrinsics depth->color: t=[%.6f, %.6f, %.6f] m, q(xyzw)=[%.7f, %.7f, %.7f, %.7f]\n", t.x(), t.y(),
+                t.z(), q.x(), q.y(), q.z(), q.w());
+  }
+  std::fflush(stdout);
+  if (!s.damage.empty()) return report_error("damaged recording: " + s.damage, kExitRuntime);
   return 0;
 }
 
@@ -54,11 +121,17 @@ int print_sim(const Config& config) {
 
 int info_command(const CommandArgs& args) {
   if (!args.input.empty() && args.config_path.empty()) {
-    return report_error("cannot read recording '" + args.input +
-                            "': source types in this build: sim; not yet available: folder, bag, realsense",
-                        kExitUsage);
+    // A path that is not there is a mistake on the command line, not damaged data.
+    if (!std::filesystem::exists(args.input)) {
+      return report_error(args.input + ": no such recording (expected a .bag file or a folder)", kExitUsage);
+    }
+    return print_recording(args.input);
   }
   const Config config = load_config(args.config_path, args.sets);
+  if (config.source.type == "folder" || config.source.type == "bag") {
+    if (config.source.path.empty()) make_source(config);  // throws: source.path is required
+    return print_recording(config.source.path);
+  }
   if (config.source.type != "sim") {
     make_source(config);  // throws the "not available in this build yet" error
   }

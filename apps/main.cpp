@@ -40,15 +40,21 @@ int main(int argc, char** argv) {
 
   CLI::App* info = app.add_subcommand("info", "describe a configured source or a recording");
   add_common_flags(*info, args);
-  info->add_option("path", args.input, "a recording (not readable in this build yet)");
+  info->add_option("path", args.input, "a recording: a RealSense .bag file or a folder of depth PNGs");
 
   CLI::App* bench = app.add_subcommand("bench", "time the processing path on pre-rendered frames");
   add_common_flags(*bench, args);
 
+  CLI::App* verify_filters =
+      app.add_subcommand("verify-filters", "compare hrcsense's depth filters with RealSense SDK goldens");
+  verify_filters->add_option("cases", args.input, "cases.json of an SDK golden set")->required();
+  verify_filters->add_option("--shared", args.shared, "folder the cases' input paths are relative to (default ../shared)");
+
   // CLI11 would only say "a subcommand is required" for a misspelt one; name it instead.
   const std::string first = argc > 1 ? argv[1] : "";
-  if (!first.empty() && first[0] != '-' && first != "run" && first != "info" && first != "bench") {
-    return hrcsense::app::report_error(std::string("unknown command '") + argv[1] + "'; expected run, info or bench",
+  if (!first.empty() && first[0] != '-' && first != "run" && first != "info" && first != "bench" &&
+      first != "verify-filters") {
+    return hrcsense::app::report_error(std::string("unknown command '") + argv[1] + "'; expected run, info, bench or verify-filters",
                                        hrcsense::app::kExitUsage);
   }
   try {
@@ -61,6 +67,7 @@ int main(int argc, char** argv) {
   try {
     if (run->parsed()) return hrcsense::app::run_command(args);
     if (info->parsed()) return hrcsense::app::info_command(args);
+    if (verify_filters->parsed()) return hrcsense::app::verify_filters_command(args);
     return hrcsense::app::bench_command(args);
   } catch (const std::exception& e) {
     return hrcsense::app::report_error(e);

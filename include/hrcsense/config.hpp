@@ -34,7 +34,7 @@ struct Config {
   SourceConfig source;
   SimParams sim;                   ///< `sim.*`: the simulated camera
   Scene scene;                     ///< `scene.objects`: the simulated scene
-  std::string filters_preset = "none";  ///< only `none` until the filters land
+  std::string filters_preset = "none";  ///< `filters.preset`: none, sdk or thesis (chain in pipeline.filters)
   std::string background_path;     ///< `background.path`: load if it exists, else save after learning
   PipelineParams pipeline;         ///< camera pose, robot, background, foreground, proximity, safety
   std::string robot_model = "points";

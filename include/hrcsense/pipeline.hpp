@@ -2,6 +2,7 @@
 // hrcsense — sources, sinks, the per-frame processing path and the threads around it.
 #pragma once
 
+#include "hrcsense/filters.hpp"
 #include "hrcsense/proximity.hpp"
 #include "hrcsense/safety.hpp"
 #include "hrcsense/segmentation.hpp"
@@ -153,6 +154,7 @@ class Mailbox {
 
 /// Everything the processing path needs, already parsed (see config.hpp).
 struct PipelineParams {
+  FilterChainParams filters;  ///< depth filters run before segmentation; empty order: none
   Pose T_base_camera = Pose::Identity();
   RobotModel robot;
   BackgroundParams background;
@@ -185,6 +187,8 @@ class Pipeline {
   BackgroundModel preset_model_;
   ForegroundExtractor extractor_;
   Foreground foreground_;
+  FilterChain filters_;  ///< params_.filters; its temporal state spans frames
+  Frame filtered_;       ///< the filtered copy of the current frame (buffers reused)
 };
 
 struct RunOptions {

@@ -87,21 +87,49 @@ struct Foreground {
   PointCloud points_base;     ///< robot base frame, metres
 };
 
-/// Extracts the foreground; holds scratch buffers so that it does not allocate per frame.
+/// Extracts the foreground. set_background() solves the background test once per pixel into
+/// a raw-depth threshold, so that the per-frame test is one 16-bit comparison; the extractor
+/// also holds scratch buffers, so that extract() does not allocate after its first frame.
 struct ForegroundExtractor {
   ForegroundParams params;
 
-  /// Fills `out` from `frame` against `background`, with `T_base_camera` for the base frame.
-  /// Precondition: background and frame have the same size.
-  void extract(const Frame& frame, const BackgroundModel& background, const Pose& T_base_camera,
-               Foreground& out);
+  /// Prepares the test against `background` for frames of its size from a camera with focal
+  /// length `fx_px` (px), stereo baseline `stereo_baseline_mm` (0 when unknown: no noise-model
+  /// margin) and depth unit `depth_scale_m` (metres per raw unit, > 0), with the current
+  /// `params` (k_sigma ≥ 0). Allocates and takes a few milliseconds at 848x480: call it once
+  /// per background, and again when the camera or `params` change.
+  void set_background(const BackgroundModel& background, float fx_px, float stereo_baseline_mm,
+                      float depth_scale_m);
+  /// Forgets the prepared background; extract() fails until the next set_background().
+  void clear_background() { prepared_ = false; }
+  /// Whether set_background() prepared the test for frames like `frame` (same size, fx,
+  /// baseline and depth unit) with the current `params`.
+  bool prepared_for(const Frame& frame) const;
+
+  /// Fills `out` from `frame` against the prepared background, with `T_base_camera` for the
+  /// base frame. Returns false, with an empty mask and clouds, when !prepared_for(frame): the
+  /// caller must then treat the frame as unusable (a stop), never as free of foreground.
+  bool extract(const Frame& frame, const Pose& T_base_camera, Foreground& out);
 
  private:
+  // What set_background() was called with; prepared_for() compares frames and params to it.
+  bool prepared_ = false;
+  int width_ = 0, height_ = 0;
+  float fx_px_ = 0.0F, stereo_baseline_mm_ = 0.0F, depth_scale_m_ = 0.0F;
+  ForegroundParams prepared_params_;
+  // Per pixel: candidate iff uint16(raw − 1) < nearer_count_[i]; unknown_[i] holds the mask's
+  // "unknown background" state where the background was never valid, else 0.
+  std::vector<uint16_t> nearer_count_;
+  std::vector<uint8_t> unknown_;
+  // The flood fill's jump limit per raw depth (65536 entries), in raw units, rounded up.
+  std::vector<int32_t> jump_limit_raw_;
   // Scratch reused across frames (sized once per image size): the flood fill's queue of
-  // packed (v << 16 | u) pixels, and the pinhole rays (u − ppx) / fx and (v − ppy) / fy.
+  // packed (v << 16 | u) pixels, the pinhole rays (u − ppx) / fx and (v − ppy) / fy, and which
+  // mask states each row holds after the background test.
   std::vector<int32_t> stack_;
   std::vector<float> ray_x_;
   std::vector<float> ray_y_;
+  std::vector<uint8_t> row_states_;
 };
 
 }  // namespace hrcsense

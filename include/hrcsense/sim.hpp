@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — a plain simulated depth camera: a scene of planes, boxes, spheres and capsules,
-// ray-cast into a 16-bit depth image with stereo-like disparity noise, plus ground truth.
+// hrcsense — a simulated D435: a scene of planes, boxes, spheres and capsules, ray-cast into a
+// 16-bit depth image with the D435's stereo artefacts (docs/SIMULATOR.md), plus ground truth.
 #pragma once
 
 #include "hrcsense/camera.hpp"
@@ -31,6 +31,14 @@ struct Waypoint {
   Eigen::Vector3f offset_m = Eigen::Vector3f::Zero(); ///< translation of the whole object
 };
 
+/// Surface properties that cost a D435 its depth (specs/d435-sensor-model.md §4 rules 4–5):
+/// pixels of such an object drop out in patches at SimParams' per-material rates.
+struct Material {
+  bool dark = false;         ///< absorbs the projector's near infrared (black fabric, rubber)
+  bool shiny = false;        ///< specular: the pattern is reflected away (metal, glass)
+  bool low_texture = false;  ///< featureless and beyond the projector's help
+};
+
 /// One scene object. Several shapes may form one object (a person made of capsules).
 struct SceneObject {
   std::string name;
@@ -41,19 +49,38 @@ struct SceneObject {
   int64_t first_frame = 0;        ///< first frame in which the object exists
   int64_t last_frame = -1;        ///< last frame in which it exists; -1: until the end
   std::vector<Waypoint> path;     ///< empty: never moves; else linear interpolation, held at the ends
+  Material material;              ///< default: a well-textured matte surface
 };
 
-/// The simulated camera and its noise.
+/// The simulated camera and its D435 effects. Defaults are the D435's and are pinned in
+/// docs/SIMULATOR.md. `noise` switches every random effect at once (disparity noise and its
+/// quantisation, dropouts, flying pixels, speckle); the geometric ones (left band, occlusion
+/// shadows, minimum range) follow from the stereo layout and have their own switches.
 struct SimParams {
   int width = 848;                   ///< 640x480, 848x480 or 1280x720 (D435 intrinsics)
   int height = 480;
   double fps = 30.0;                 ///< nominal frame rate; timestamps are index / fps
   int64_t frames = 600;              ///< length of the simulated sequence
   uint64_t seed = 1;                 ///< noise seed; same seed, same frames
-  bool noise = true;                 ///< false: exact depth (still quantised to 1 mm)
-  float disparity_noise_px = kD435SubpixelRmsPx;  ///< σ of the Gaussian noise on disparity
-  float baseline_mm = kD435BaselineMm;            ///< stereo baseline used for the noise model
+  bool noise = true;                 ///< false: exact depth (still quantised to 1 mm) where valid
+  float disparity_noise_px = kD435SubpixelRmsPx;  ///< σ of the Gaussian noise on disparity, new every frame
+  float baseline_mm = kD435BaselineMm;            ///< stereo baseline: right imager at +B along x
   float depth_scale_m = 0.001F;      ///< metres per raw unit (quantisation step)
+  float disparity_step_px = 1.0F / 32.0F;  ///< disparity quantisation (SDK: 5 fractional bits); 0: off
+  bool left_band = true;             ///< no depth where the right imager does not see (first fx·B/Z columns)
+  bool occlusion_shadows = true;     ///< no depth where a nearer surface hides the point from the right imager
+  float max_disparity_px = 110.0F;   ///< search range: nearer than fx·B/max_disparity_px, no depth; 0: off
+  float min_range_m = 0.0F;          ///< > 0: this minimum range instead of the one from max_disparity_px
+  float edge_jump_px = 1.5F;         ///< a larger true-disparity step between 4-neighbours is a depth edge
+  float edge_dropout = 0.25F;        ///< share of pixels beside a depth edge with no depth (fixed per seed)
+  float flying_pixels = 0.15F;       ///< share of the other edge pixels mixed towards the far/near side
+  float dark_dropout = 0.6F;         ///< share of a Material::dark surface with no depth
+  float shiny_dropout = 0.35F;       ///< share of a Material::shiny surface with no depth
+  float low_texture_dropout = 0.5F;  ///< share of a Material::low_texture surface with no depth
+  int material_cell_px = 4;          ///< material dropouts come in square patches of this side, pixels
+  float speckle = 0.002F;            ///< share of pixels dropped at random, new every frame
+  float correlated_noise_px = 0.0F;  ///< σ of a smooth disparity error fixed per seed; 0: off
+  int correlated_cell_px = 32;       ///< correlation length of that error, pixels (≥ 2)
 };
 
 /// A scene: objects plus the camera's pose in the base frame.
@@ -70,6 +97,15 @@ struct SimScratch {
   std::vector<float> ray_y;        ///< per pixel: y/z of the pixel's ray, camera frame
   std::vector<Shape> shapes_base;  ///< this frame's existing shapes, moved along their paths
   std::vector<uint16_t> shape_labels;  ///< label of each entry of shapes_base
+  std::vector<uint16_t> shape_ids;     ///< 1 + scene object index of each entry of shapes_base
+  std::vector<uint16_t> object_ids;    ///< per pixel: 1 + index of the object hit, 0: nothing
+  std::vector<uint16_t> label_of_id;   ///< label per object id (index 0: nothing hit)
+  std::vector<uint8_t> material_of_id; ///< Material as bits (1 dark, 2 shiny, 4 low texture) per id
+  std::vector<float> disparity_px;     ///< per pixel: noise-free disparity fx·B/Z, 0: nothing hit
+  std::vector<uint8_t> hidden;         ///< per pixel: 1 where the stereo geometry gives no depth
+  std::vector<float> normal_draws;     ///< this frame's N(0, 1) draw per pixel
+  std::vector<float> correlated_px;    ///< fixed correlated disparity error (empty when off)
+  uint64_t correlated_key = 0;         ///< what correlated_px was computed for
   PointCloud points_base;          ///< noise-free non-static pixels, base frame (truth contact)
   PointCloud points_camera;        ///< the same points, camera frame
 };
@@ -91,5 +127,9 @@ struct Simulator {
   /// Reuses out's buffers, so rendering into the same Frame does not allocate.
   void render(int64_t index, Frame& out) const;
 };
+
+/// Fill rate as the Depth Quality Tool defines it: valid pixels / pixels in the image, over
+/// frames first .. first+count-1 of the simulator. count ≥ 1.
+double sim_fill_rate(const Simulator& sim, int64_t first, int64_t count);
 
 }  // namespace hrcsense

@@ -79,6 +79,15 @@ class KeyReader {
   std::set<std::string> known_;
 };
 
+/// Reads the simulator's D435 effect keys (`sim.left_band`, `sim.edge_dropout`, ...; see
+/// docs/SIMULATOR.md) into `sim`.
+void read_sim_effects(KeyReader& r, SimParams& sim);
+
+/// Reads `filters.preset`, `filters.order` and `filters.<block>.<option>` (docs/CONFIG.md) into
+/// `config.filters_preset` and `config.pipeline.filters`; a value outside the SDK's range is an
+/// error naming the key and the range.
+void read_filters(KeyReader& r, Config& config);
+
 /// Reads `scene.objects` (a list of objects, see docs/CONFIG.md) into a Scene.
 /// `key` is the list's key, used to name items in errors ("scene.objects[1].shapes[0]").
 Scene read_scene_objects(const YAML::Node& objects, const std::string& where, const std::string& key);

@@ -58,6 +58,7 @@ void read_source_and_sim(KeyReader& r, Config& c) {
   r.flag("sim.noise", c.sim.noise);
   r.number("sim.disparity_noise_px", c.sim.disparity_noise_px, Bound::non_negative);
   r.number("sim.baseline_mm", c.sim.baseline_mm, Bound::positive);
+  config_detail::read_sim_effects(r, c.sim);
 
   const YAML::Node objects = r.raw("scene.objects");
   c.scene = config_detail::read_scene_objects(objects, r.where(), "scene.objects");
@@ -71,10 +72,7 @@ void read_camera_and_filters(KeyReader& r, Config& c) {
   r.vec3("camera.T_base_camera.rotation_rpy_deg", rpy_deg);
   c.pipeline.T_base_camera = pose_from_rpy(translation_m, rpy_deg);
 
-  // Filters come later; every filters.* key other than the preset is refused when the
-  // tree is checked for unknown keys.
-  r.text("filters.preset", c.filters_preset);
-  if (c.filters_preset != "none") not_implemented(r, "filters.preset", c.filters_preset, "none");
+  config_detail::read_filters(r, c);
 }
 
 void read_segmentation(KeyReader& r, Config& c) {
@@ -156,21 +154,10 @@ bool is_section(const std::string& key) {
   return next != known.end() && next->compare(0, key.size() + 1, key + ".") == 0;
 }
 
-bool is_filter_option(const std::string& key) {
-  return key.compare(0, 8, "filters.") == 0 && key != "filters.preset";
-}
-
 void check_keys(const YAML::Node& map, const std::string& prefix, const std::string& where) {
   for (const auto& entry : map) {
     const std::string key = prefix.empty() ? entry.first.Scalar() : prefix + "." + entry.first.Scalar();
     if (known_keys().count(key) != 0) continue;
-    if (is_filter_option(key) && entry.second.IsMap()) {
-      check_keys(entry.second, key, where);  // name the option itself, e.g. filters.spatial.alpha
-      continue;
-    }
-    if (is_filter_option(key)) {
-      throw ConfigError(where + ": " + key + " is not implemented yet; use filters.preset none");
-    }
     if (!is_section(key)) throw ConfigError(where + ": unknown key '" + key + "'");
     if (entry.second.IsMap()) {
       check_keys(entry.second, key, where);
@@ -218,7 +205,7 @@ void apply_override(YAML::Node& root, const std::string& text) {
   } catch (const YAML::Exception& e) {
     throw ConfigError("--set '" + text + "': the value is not valid YAML: " + e.msg);
   }
-  if (known_keys().count(key) == 0 && !is_section(key) && !is_filter_option(key)) {
+  if (known_keys().count(key) == 0 && !is_section(key)) {
     throw ConfigError("--set '" + text + "': unknown key '" + key + "'");
   }
   config_detail::set_path(root, key, value);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense config — the source and simulator a configuration describes.
 #include "hrcsense/config.hpp"
+#include "hrcsense/recordings.hpp"
 
 #include <memory>
 #include <utility>
@@ -19,7 +20,15 @@ Simulator make_simulator(const Config& config) {
 
 std::unique_ptr<Source> make_source(const Config& config) {
   if (config.source.type == "sim") return std::make_unique<SimSource>(make_simulator(config));
-  // Recorded and live sources are named in the configuration schema but not built yet.
+  if (config.source.type == "folder" || config.source.type == "bag") {
+    if (config.source.path.empty()) {
+      throw ConfigError((config.file.empty() ? std::string("configuration") : config.file) + ": source.path: required for source.type " + config.source.type);
+    }
+    RecordingParams params{config.source.path, config.source.loop, config.source.stereo_baseline_mm};
+    if (config.source.type == "folder") return std::make_unique<FolderSource>(params);
+    return std::make_unique<BagSource>(params);
+  }
+  // Live sources are named in the configuration schema but not built yet.
   throw ConfigError("source.type '" + config.source.type + "' is not available in this build yet");
 }
 

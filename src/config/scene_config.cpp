@@ -120,8 +120,33 @@ struct SceneReader {
     return out;
   }
 
+  /// `material: [dark, shiny, low_texture]` (any of them; a single flag may stand alone).
+  Material material(const YAML::Node& node, const std::string& key) const {
+    Material out;
+    const auto set_flag = [&](const YAML::Node& item) {
+      const std::string flag = item.IsScalar() ? item.Scalar() : std::string();
+      if (flag == "dark") {
+        out.dark = true;
+      } else if (flag == "shiny") {
+        out.shiny = true;
+      } else if (flag == "low_texture") {
+        out.low_texture = true;
+      } else {
+        fail(key, "unknown material '" + flag + "'; expected dark, shiny or low_texture");
+      }
+    };
+    if (node.IsScalar()) {
+      set_flag(node);
+    } else if (node.IsSequence()) {
+      for (size_t i = 0; i < node.size(); ++i) set_flag(node[i]);
+    } else {
+      fail(key, "expected a list of dark, shiny, low_texture");
+    }
+    return out;
+  }
+
   SceneObject object(const YAML::Node& node, const std::string& key, size_t index) const {
-    only_keys(node, key, {"name", "static", "first_frame", "last_frame", "path", "shapes"});
+    only_keys(node, key, {"name", "static", "first_frame", "last_frame", "path", "material", "shapes"});
     SceneObject out;
     const YAML::Node& map = node;
     out.name = "object" + std::to_string(index);
@@ -139,6 +164,9 @@ struct SceneReader {
       fail(key + ".last_frame", "expected -1 or a frame >= first_frame");
     }
     if (map["path"].IsDefined() && !map["path"].IsNull()) out.path = path(map["path"], key + ".path");
+    if (map["material"].IsDefined() && !map["material"].IsNull()) {
+      out.material = material(map["material"], key + ".material");
+    }
     const YAML::Node shapes = required(map, key, "shapes");
     if (!shapes.IsSequence() || shapes.size() == 0) fail(key + ".shapes", "expected a non-empty list of shapes");
     for (size_t i = 0; i < shapes.size(); ++i) {
@@ -206,12 +234,40 @@ YAML::Node scene_objects_node(const Scene& scene) {
     }
     if (object.path.empty()) path.SetStyle(YAML::EmitterStyle::Flow);
     node["path"] = path;
+    YAML::Node material(YAML::NodeType::Sequence);
+    material.SetStyle(YAML::EmitterStyle::Flow);
+    if (object.material.dark) material.push_back("dark");
+    if (object.material.shiny) material.push_back("shiny");
+    if (object.material.low_texture) material.push_back("low_texture");
+    node["material"] = material;
     YAML::Node shapes(YAML::NodeType::Sequence);
     for (const Shape& shape : object.shapes) shapes.push_back(shape_node(shape));
     node["shapes"] = shapes;
     objects.push_back(node);
   }
   return objects;
+}
+
+void read_sim_effects(KeyReader& r, SimParams& sim) {
+  const auto share = [&r](const std::string& key, float& value) {
+    r.number(key, value, Bound::non_negative);
+    if (value > 1.0F) r.fail(key, "expected a share between 0 and 1, got " + float_text(value));
+  };
+  r.number("sim.disparity_step_px", sim.disparity_step_px, Bound::non_negative);
+  r.flag("sim.left_band", sim.left_band);
+  r.flag("sim.occlusion_shadows", sim.occlusion_shadows);
+  r.number("sim.max_disparity_px", sim.max_disparity_px, Bound::non_negative);
+  r.number("sim.min_range_m", sim.min_range_m, Bound::non_negative);
+  r.number("sim.edge_jump_px", sim.edge_jump_px, Bound::positive);
+  share("sim.edge_dropout", sim.edge_dropout);
+  share("sim.flying_pixels", sim.flying_pixels);
+  share("sim.dark_dropout", sim.dark_dropout);
+  share("sim.shiny_dropout", sim.shiny_dropout);
+  share("sim.low_texture_dropout", sim.low_texture_dropout);
+  r.integer("sim.material_cell_px", sim.material_cell_px, 1, 256);
+  share("sim.speckle", sim.speckle);
+  r.number("sim.correlated_noise_px", sim.correlated_noise_px, Bound::non_negative);
+  r.integer("sim.correlated_cell_px", sim.correlated_cell_px, 2, 4096);
 }
 
 Scene read_scene_objects(const YAML::Node& objects, const std::string& where, const std::string& key) {

@@ -3,6 +3,7 @@
 
 #include "hrcsense/pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <utility>
@@ -17,9 +18,19 @@ double elapsed_us(Clock::time_point since) {
 }
 
 // Raw zeros ("no data") in the source frame, before any filter.
+// Counted in 16-bit blocks, which vectorise 8 pixels to an instruction (a size_t counter
+// would widen every comparison to 64 bits: three times slower).
 size_t count_invalid(const DepthImage& depth) {
+  const uint16_t* raw = depth.pixels.data();
+  const size_t n = depth.pixels.size();
   size_t invalid = 0;
-  for (const uint16_t raw : depth.pixels) invalid += raw == 0 ? 1U : 0U;
+  size_t i = 0;
+  while (i < n) {
+    const size_t block_end = std::min(n, i + 65535);  // a block's count fits 16 bits
+    uint16_t block = 0;
+    for (; i < block_end; ++i) block += raw[i] == 0 ? 1 : 0;
+    invalid += block;
+  }
   return invalid;
 }
 
@@ -76,6 +87,27 @@ bool same_size(const BackgroundModel& model, const DepthImage& depth) {
   return model.width == depth.width && model.height == depth.height;
 }
 
+// The foreground against the background. Prepares the extractor's per-pixel tables first when
+// the background or the camera changed: once per background, a few milliseconds at 848x480.
+bool extract_foreground(ForegroundExtractor& extractor, const BackgroundModel& background, const Frame& frame,
+                        const Pose& T_base_camera, Foreground& out) {
+  if (!extractor.prepared_for(frame)) {
+    extractor.set_background(background, frame.intrinsics.fx, frame.stereo_baseline_mm, frame.depth.depth_scale_m);
+  }
+  return extractor.extract(frame, T_base_camera, out);
+}
+
+// The depth filters, one timing per block named after it; the source frame itself when the
+// chain is empty (no copy).
+const Frame& run_filters(FilterChain& chain, const Frame& frame, Frame& filtered, FrameResult& result) {
+  if (chain.params.order.empty()) return frame;
+  chain.start(frame, filtered);
+  for (size_t i = 0; i < chain.block_count(); ++i) {
+    timed(result, filter_block_name(chain.block(i)), [&] { chain.run_block(i, filtered); });
+  }
+  return filtered;
+}
+
 // Latency from the frame entering processing to its result.
 void finish(FrameResult& result, Clock::time_point start) { result.latency_us = elapsed_us(start); }
 
@@ -89,11 +121,13 @@ void finish_stop(FrameResult& result, const char* reason, Clock::time_point star
 Pipeline::Pipeline(PipelineParams params) : params_(std::move(params)) {
   learner_.params = params_.background;
   extractor_.params = params_.foreground;
+  filters_.params = params_.filters;
 }
 
 void Pipeline::set_background(BackgroundModel model) {
   preset_model_ = std::move(model);
   preset_background_ = true;
+  extractor_.clear_background();  // its tables belong to the previous model
 }
 
 const BackgroundModel& Pipeline::background() const {
@@ -101,18 +135,23 @@ const BackgroundModel& Pipeline::background() const {
 }
 
 // One line per stage; every early return leaves a stop verdict with its reason.
-void Pipeline::process(const Frame& frame, FrameResult& result) {
+void Pipeline::process(const Frame& source_frame, FrameResult& result) {
   const Clock::time_point start = Clock::now();
-  begin_result(frame, result);
-  result.invalid_pixels = count_invalid(frame.depth);
-  if (result.invalid_pixels == frame.depth.pixels.size()) return finish_stop(result, "no valid depth", start);
+  begin_result(source_frame, result);
+  result.invalid_pixels = count_invalid(source_frame.depth);
+  if (result.invalid_pixels == source_frame.depth.pixels.size()) return finish_stop(result, "no valid depth", start);
+  const Frame& frame = run_filters(filters_, source_frame, filtered_, result);
   if (!background_ready()) {
     timed(result, "background", [&] { learn_background(learner_, frame, result.verdict); });
     return finish(result, start);
   }
   if (!same_size(background(), frame.depth)) return finish_stop(result, "background size mismatch", start);
   if (params_.robot.capsules.empty()) return finish_stop(result, "no robot model", start);
-  timed(result, "foreground", [&] { extractor_.extract(frame, background(), params_.T_base_camera, foreground_); });
+  bool extracted = false;
+  timed(result, "foreground", [&] {
+    extracted = extract_foreground(extractor_, background(), frame, params_.T_base_camera, foreground_);
+  });
+  if (!extracted) return finish_stop(result, "foreground extraction failed", start);
   timed(result, "proximity", [&] {
     result.contact = closest_contact_brute(foreground_.points_base, foreground_.points_camera, params_.robot);
   });

@@ -2,6 +2,8 @@
 // hrcsense — foreground extraction: background subtraction, speckle removal by physical size,
 // deprojection into camera- and base-frame point clouds.
 
+#include "foreground_tables.hpp"
+
 #include "hrcsense/camera.hpp"
 #include "hrcsense/segmentation.hpp"
 
@@ -13,76 +15,75 @@
 namespace hrcsense {
 namespace {
 
+using segmentation_detail::kJumpMinM;
+using segmentation_detail::kJumpSigmas;
+
 // Mask states while a frame is processed; only kNone and kForeground survive extract().
-// The values are bit-distinct so that a scan can test 8 pixels at once for one state.
+// Each state is its own bit, so that a scan can test many pixels at once for one state.
 constexpr uint8_t kNone = 0;
 constexpr uint8_t kForeground = 1;  // final: kept after speckle removal
 constexpr uint8_t kCandidate = 2;   // passed the background test, not yet flood-filled
-constexpr uint8_t kVisited = 3;     // in the blob being flood-filled
 constexpr uint8_t kUnknown = 4;     // valid depth where the background was never valid
-
-// Neighbouring foreground pixels belong to one object unless their depths jump by more than
-// max(kJumpMinM, kJumpSigmas · σ_model(z)) at the farther of the two depths.
-constexpr float kJumpMinM = 0.05F;
-constexpr float kJumpSigmas = 4.0F;
-
-/// σ_model(z) / z² for the frame's camera, metres⁻¹; 0 when the baseline is unknown.
-float sigma_per_z2(const Frame& frame, float subpixel_rms_px) {
-  if (frame.stereo_baseline_mm <= 0.0F || frame.intrinsics.fx <= 0.0F) return 0.0F;
-  return static_cast<float>(
-      stereo_depth_sigma_m(1.0, frame.intrinsics.fx, frame.stereo_baseline_mm, subpixel_rms_px));
-}
-
-/// Whether any of the 8 mask bytes starting at `i` has a bit of `bits` set.
-bool any_bits8(const uint8_t* mask, size_t i, uint64_t bits) {
-  uint64_t word;
-  std::memcpy(&word, mask + i, sizeof word);
-  return (word & bits) != 0;
-}
+constexpr uint8_t kVisited = 8;     // in the blob being flood-filled
 
 constexpr uint64_t kEveryByte = 0x0101010101010101ULL;
 
-/// Calls `visit(i)` for every pixel whose mask has a bit of `state_bits` set, in raster order.
-/// Skips 8 pixels at a time, since foreground is sparse.
+/// Whether any of the 16 mask bytes starting at `i` has a bit of `bits` (repeated per byte) set.
+bool any_bits16(const uint8_t* mask, size_t i, uint64_t bits) {
+  uint64_t word[2];
+  std::memcpy(word, mask + i, sizeof word);
+  return ((word[0] | word[1]) & bits) != 0;
+}
+
+/// Calls `visit(i)` for every pixel in [begin, end) whose mask has a bit of `state_bits` set,
+/// in raster order. Skips 16 pixels at a time, since foreground is sparse.
 template <typename Visit>
-void for_each_marked(const uint8_t* mask, size_t n, uint8_t state_bits, Visit visit) {
+void for_each_marked(const uint8_t* mask, size_t begin, size_t end, uint8_t state_bits, Visit& visit) {
   const uint64_t bits = kEveryByte * state_bits;
-  size_t i = 0;
-  for (; i + 8 <= n; i += 8) {
-    if (!any_bits8(mask, i, bits)) continue;
-    for (size_t j = i; j < i + 8; ++j) {
+  size_t i = begin;
+  for (; i + 16 <= end; i += 16) {
+    if (!any_bits16(mask, i, bits)) continue;
+    for (size_t j = i; j < i + 16; ++j) {
       if ((mask[j] & state_bits) != 0) visit(j);
     }
   }
-  for (; i < n; ++i) {
+  for (; i < end; ++i) {
     if ((mask[i] & state_bits) != 0) visit(i);
   }
 }
 
-/// The background test for every pixel: kCandidate, kUnknown or kNone. Branch-free so that
-/// it vectorises.
-void classify(const DepthImage& depth, const BackgroundModel& background, const ForegroundParams& params,
-              float sigma_z2, uint8_t* mask) {
-  const size_t n = depth.pixels.size();
-  const uint16_t* raw = depth.pixels.data();
-  const float* mean_m = background.mean_m.data();
-  const float* spread_m = background.spread_m.data();
-  const float scale_m = depth.depth_scale_m;
-  const float k_sigma = params.k_sigma;
-  const float k_model = params.k_sigma * sigma_z2;
-  const float min_margin_m = params.min_margin_m;
-  for (size_t i = 0; i < n; ++i) {
-    const float z = static_cast<float>(raw[i]) * scale_m;
-    const float m = mean_m[i];
-    const float a = k_sigma * spread_m[i];
-    const float b = k_model * z * z;
-    const float ab = a > b ? a : b;
-    const float margin = ab > min_margin_m ? ab : min_margin_m;
-    // Bitwise & instead of && keeps the loop free of branches.
-    const unsigned valid = raw[i] != 0;
-    const unsigned known = m > 0.0F;
-    const unsigned nearer = z < m - margin;
-    mask[i] = static_cast<uint8_t>((valid & known & nearer) * kCandidate | (valid & (known ^ 1U)) * kUnknown);
+/// for_each_marked over the rows [v_begin, v_end) whose `row_states` have a bit of `state_bits`.
+template <typename Visit>
+void for_each_marked_in_rows(const uint8_t* mask, const uint8_t* row_states, size_t width, size_t v_begin,
+                             size_t v_end, uint8_t state_bits, Visit visit) {
+  for (size_t v = v_begin; v < v_end; ++v) {
+    if ((row_states[v] & state_bits) != 0) for_each_marked(mask, v * width, (v + 1) * width, state_bits, visit);
+  }
+}
+
+/// The background test for every pixel, one 16-bit comparison each: kCandidate where the raw
+/// depth is valid and below the pixel's threshold, kUnknown where it is valid and the
+/// background unknown, else kNone. Also ORs each row's states into `row_states`, so that the
+/// scans after it skip empty rows. Branch-free so that it vectorises.
+void classify(const DepthImage& depth, const uint16_t* nearer_count, const uint8_t* unknown, uint8_t* mask,
+              uint8_t* row_states) {
+  const size_t width = static_cast<size_t>(depth.width);
+  for (size_t v = 0; v < static_cast<size_t>(depth.height); ++v) {
+    // Row pointers that do not alias, so that the loop needs no run-time overlap checks.
+    const uint16_t* __restrict raw = depth.pixels.data() + v * width;
+    const uint16_t* __restrict count = nearer_count + v * width;
+    const uint8_t* __restrict unknown_row = unknown + v * width;
+    uint8_t* __restrict out = mask + v * width;
+    unsigned states = 0;
+    for (size_t u = 0; u < width; ++u) {
+      // raw − 1 wraps 0 ("no data") to 65535, which no count exceeds.
+      const uint8_t candidate = static_cast<uint16_t>(raw[u] - 1U) < count[u] ? kCandidate : kNone;
+      const uint8_t valid = raw[u] != 0 ? 0xFF : 0x00;  // a mask, not a branch around a load
+      const uint8_t state = static_cast<uint8_t>(candidate | (unknown_row[u] & valid));
+      out[u] = state;
+      states |= state;
+    }
+    row_states[v] = static_cast<uint8_t>(states);
   }
 }
 
@@ -105,96 +106,121 @@ bool camera_point(const Rays& rays, int u, int v, float z_m, Eigen::Vector3f& p_
   return p.has_value();
 }
 
-/// Connection rule of the flood fill: neighbours join when their depths differ by less than
-/// the jump limit max(kJumpMinM, kJumpSigmas · σ_model(z)) at the farther of the two depths.
-struct Connectivity {
-  float jump_min_raw;   ///< kJumpMinM in raw units
-  float jump_per_raw2;  ///< the σ term in raw units per raw unit²
-  /// The jump limit at raw depth r, rounded up: for integer steps d, d < limit ⇔ d < ceil(limit).
-  int limit_raw(int r) const {
-    const float far = static_cast<float>(r);
-    const float limit = std::max(jump_min_raw, jump_per_raw2 * far * far);
-    const int whole = static_cast<int>(limit);  // std::ceil is a library call without SSE4.1
-    return whole + (static_cast<float>(whole) < limit ? 1 : 0);
-  }
+/// Queues neighbour `ni` (packed `packed_n`) of a pixel at raw depth r, whose jump limit is
+/// limit_r, if it is an unvisited candidate within the jump limit at the farther of the two
+/// depths (foreground_tables.hpp).
+inline void join(const uint16_t* raw, uint8_t* mask, int32_t* queue, const int32_t* limit, size_t ni,
+                 int32_t packed_n, int r, int limit_r, size_t& tail) {
+  if (mask[ni] != kCandidate) return;
+  const int rn = raw[ni];
+  const int step = rn > r ? rn - r : r - rn;
+  // The limit at r covers every neighbour not farther than r; only a neighbour both farther
+  // and beyond that limit needs its own (larger) limit.
+  if (step >= limit_r && (rn < r || step >= limit[rn])) return;
+  mask[ni] = kVisited;
+  queue[tail++] = packed_n;
+}
+
+/// The blob a flood fill found: queue[0, count) lists its pixels.
+struct Blob {
+  size_t count = 0;
+  uint64_t raw_sum = 0;  ///< sum of its raw depths
+  int v_max = 0;         ///< its lowest row
 };
 
-/// Flood-fills the blob of candidates around `seed` (packed) into queue[0, returned count) and
-/// adds its raw depths to `raw_sum`. Entries pack a pixel as v << 16 | u, so that bounds need
-/// no division. `queue` must have room for every pixel.
-size_t fill_blob(const DepthImage& depth, const Connectivity& link, int32_t seed, uint8_t* mask,
-                 int32_t* queue, uint64_t& raw_sum) {
+/// Flood-fills the blob of candidates around `seed` (packed v << 16 | u) into `queue`, which
+/// must have room for every pixel. `limit` is the jump limit per raw depth.
+Blob fill_blob(const DepthImage& depth, const int32_t* limit, int32_t seed, uint8_t* mask, int32_t* queue) {
+  // Locals rather than members or references: every byte store into the mask may alias
+  // anything for the compiler, which would otherwise reload them per pixel.
+  const uint16_t* raw = depth.pixels.data();
   const int width = depth.width;
   const int height = depth.height;
-  const uint16_t* raw = depth.pixels.data();
+  const size_t w = static_cast<size_t>(width);
+  constexpr int32_t kRow = 1 << 16;  // one row down, packed
   size_t tail = 0;
   queue[tail++] = seed;
-  mask[static_cast<size_t>(seed >> 16) * width + (seed & 0xFFFF)] = kVisited;
+  mask[static_cast<size_t>(seed >> 16) * w + static_cast<size_t>(seed & 0xFFFF)] = kVisited;
   // A queue that keeps its popped entries: afterwards it lists the whole blob.
   for (size_t head = 0; head < tail; ++head) {
     const int32_t packed = queue[head];
     const int u = packed & 0xFFFF;
     const int v = packed >> 16;
-    const int r = raw[static_cast<size_t>(v) * width + u];
-    raw_sum += static_cast<uint64_t>(r);
-    // The limit at r covers every neighbour not farther than r; only a neighbour both farther
-    // and beyond that limit needs its own (larger) limit.
-    const int limit = link.limit_raw(r);
-    const int u0 = u > 0 ? u - 1 : 0;
-    const int u1 = u + 1 < width ? u + 1 : u;
-    const int v0 = v > 0 ? v - 1 : 0;
-    const int v1 = v + 1 < height ? v + 1 : v;
-    for (int nv = v0; nv <= v1; ++nv) {
-      const size_t row = static_cast<size_t>(nv) * width;
-      for (int nu = u0; nu <= u1; ++nu) {
-        if (mask[row + nu] != kCandidate) continue;
-        const int rn = raw[row + nu];
-        const int step = rn > r ? rn - r : r - rn;
-        if (step >= limit && (rn < r || step >= link.limit_raw(rn))) continue;
-        mask[row + nu] = kVisited;
-        queue[tail++] = nv << 16 | nu;
+    const size_t i = static_cast<size_t>(v) * w + static_cast<size_t>(u);
+    const int r = raw[i];
+    const int limit_r = limit[r];
+    if (u > 0 && u + 1 < width && v > 0 && v + 1 < height) {
+      // Inside the image (nearly every pixel): fixed offsets, no bounds.
+      join(raw, mask, queue, limit, i - w - 1, packed - kRow - 1, r, limit_r, tail);
+      join(raw, mask, queue, limit, i - w, packed - kRow, r, limit_r, tail);
+      join(raw, mask, queue, limit, i - w + 1, packed - kRow + 1, r, limit_r, tail);
+      join(raw, mask, queue, limit, i - 1, packed - 1, r, limit_r, tail);
+      join(raw, mask, queue, limit, i + 1, packed + 1, r, limit_r, tail);
+      join(raw, mask, queue, limit, i + w - 1, packed + kRow - 1, r, limit_r, tail);
+      join(raw, mask, queue, limit, i + w, packed + kRow, r, limit_r, tail);
+      join(raw, mask, queue, limit, i + w + 1, packed + kRow + 1, r, limit_r, tail);
+      continue;
+    }
+    for (int nv = v > 0 ? v - 1 : 0; nv <= (v + 1 < height ? v + 1 : v); ++nv) {
+      for (int nu = u > 0 ? u - 1 : 0; nu <= (u + 1 < width ? u + 1 : u); ++nu) {
+        join(raw, mask, queue, limit, static_cast<size_t>(nv) * w + static_cast<size_t>(nu), nv << 16 | nu, r,
+             limit_r, tail);
       }
     }
   }
-  return tail;
+  // Sums in a pass of their own: inside the fill they would be two more live registers.
+  Blob blob{tail, 0, seed >> 16};
+  for (size_t j = 0; j < tail; ++j) {
+    const int v = queue[j] >> 16;
+    blob.raw_sum += raw[static_cast<size_t>(v) * w + static_cast<size_t>(queue[j] & 0xFFFF)];
+    blob.v_max = v > blob.v_max ? v : blob.v_max;
+  }
+  return blob;
 }
+
+/// Which pixels are left after speckle removal.
+struct Kept {
+  size_t count = 0;  ///< kForeground pixels
+  size_t v_begin = 0, v_end = 0;  ///< they lie in rows [v_begin, v_end)
+};
 
 /// Removes blobs smaller than `min_object_mm` and marks the rest kForeground. A blob's size is
 /// the side of a square of the same pixel area at the blob's mean depth:
-/// sqrt(pixel count) · mean_z / fx, in millimetres. Returns the number of kept pixels.
-size_t remove_speckles(const Frame& frame, float jump_per_z2, float min_object_mm, uint8_t* mask,
-                       std::vector<int32_t>& queue) {
+/// sqrt(pixel count) · mean_z / fx, in millimetres.
+Kept remove_speckles(const Frame& frame, const int32_t* jump_limit_raw, float min_object_mm,
+                     const uint8_t* row_states, uint8_t* mask, int32_t* queue) {
   const DepthImage& depth = frame.depth;
-  const int width = depth.width;
-  const float scale_m = depth.depth_scale_m;
-  const Connectivity link{kJumpMinM / scale_m, jump_per_z2 * scale_m};
-  const double mm_per_raw_px = 1000.0 * scale_m / frame.intrinsics.fx;
-  size_t kept = 0;
-  for_each_marked(mask, depth.pixels.size(), kCandidate, [&](size_t i) {
-    const int32_t seed = static_cast<int32_t>(i / static_cast<size_t>(width)) << 16 |
-                         static_cast<int32_t>(i % static_cast<size_t>(width));
-    uint64_t raw_sum = 0;
-    const size_t count = fill_blob(depth, link, seed, mask, queue.data(), raw_sum);
+  const size_t width = static_cast<size_t>(depth.width);
+  const double mm_per_raw_px = 1000.0 * depth.depth_scale_m / frame.intrinsics.fx;
+  Kept kept;
+  for_each_marked_in_rows(mask, row_states, width, 0, static_cast<size_t>(depth.height), kCandidate, [&](size_t i) {
+    const int v = static_cast<int>(i / width);
+    const Blob blob = fill_blob(depth, jump_limit_raw, v << 16 | static_cast<int32_t>(i % width), mask, queue);
     // sqrt(count) · (raw_sum / count) · scale / fx, in mm.
-    const double size_mm = static_cast<double>(raw_sum) / std::sqrt(static_cast<double>(count)) * mm_per_raw_px;
+    const double size_mm =
+        static_cast<double>(blob.raw_sum) / std::sqrt(static_cast<double>(blob.count)) * mm_per_raw_px;
     const bool keep = size_mm >= min_object_mm;
     const uint8_t state = keep ? kForeground : kNone;
-    for (size_t j = 0; j < count; ++j) {
-      mask[static_cast<size_t>(queue[j] >> 16) * width + (queue[j] & 0xFFFF)] = state;
+    for (size_t j = 0; j < blob.count; ++j) {
+      mask[static_cast<size_t>(queue[j] >> 16) * width + static_cast<size_t>(queue[j] & 0xFFFF)] = state;
     }
-    if (keep) kept += count;
+    if (!keep) return;
+    // Seeds come in raster order, so the first kept seed's row is the first kept row.
+    if (kept.count == 0) kept.v_begin = static_cast<size_t>(v);
+    kept.v_end = std::max(kept.v_end, static_cast<size_t>(blob.v_max) + 1);
+    kept.count += blob.count;
   });
   return kept;
 }
 
 /// Deprojects every kForeground pixel into `cloud` (camera frame), in raster order. Pixels that
 /// cannot be deprojected (a distortion model the SDK cannot invert) leave the mask.
-void deproject_mask(const DepthImage& depth, const Rays& rays, size_t kept, uint8_t* mask, PointCloud& cloud) {
+void deproject_mask(const DepthImage& depth, const Rays& rays, const Kept& kept, uint8_t* mask, PointCloud& cloud) {
   // Resizing within the reserved capacity does not allocate; shrinking writes nothing.
-  cloud.x.resize(kept);
-  cloud.y.resize(kept);
-  cloud.z.resize(kept);
-  cloud.pixel.resize(kept);
+  cloud.x.resize(kept.count);
+  cloud.y.resize(kept.count);
+  cloud.z.resize(kept.count);
+  cloud.pixel.resize(kept.count);
   float* x = cloud.x.data();
   float* y = cloud.y.data();
   float* z = cloud.z.data();
@@ -203,7 +229,7 @@ void deproject_mask(const DepthImage& depth, const Rays& rays, size_t kept, uint
   const float scale_m = depth.depth_scale_m;
   const size_t width = static_cast<size_t>(depth.width);
   size_t count = 0;
-  for_each_marked(mask, depth.pixels.size(), kForeground, [&](size_t i) {
+  auto visit = [&](size_t i) {
     const int u = static_cast<int>(i % width);
     const int v = static_cast<int>(i / width);
     Eigen::Vector3f p;
@@ -216,7 +242,8 @@ void deproject_mask(const DepthImage& depth, const Rays& rays, size_t kept, uint
     z[count] = p.z();
     pixel[count] = static_cast<uint32_t>(i);
     ++count;
-  });
+  };
+  for_each_marked(mask, kept.v_begin * width, kept.v_end * width, kForeground, visit);
   cloud.x.resize(count);
   cloud.y.resize(count);
   cloud.z.resize(count);
@@ -249,43 +276,83 @@ void transform_points(const Eigen::Matrix3f& R, const Eigen::Vector3f& t, const 
 
 }  // namespace
 
-void ForegroundExtractor::extract(const Frame& frame, const BackgroundModel& background,
-                                  const Pose& T_base_camera, Foreground& out) {
+void ForegroundExtractor::set_background(const BackgroundModel& background, float fx_px, float stereo_baseline_mm,
+                                         float depth_scale_m) {
+  namespace detail = segmentation_detail;
+  const size_t n = static_cast<size_t>(background.width) * static_cast<size_t>(background.height);
+  assert(background.mean_m.size() == n && background.spread_m.size() == n);
+  const float sigma_z2 = detail::sigma_per_z2(fx_px, stereo_baseline_mm, params.subpixel_rms_px);
+  const detail::NearerTest test{depth_scale_m, params.k_sigma, params.k_sigma * sigma_z2, params.min_margin_m};
+  nearer_count_.resize(n);
+  unknown_.resize(n);
+  detail::build_nearer_table(background, test, kUnknown, nearer_count_.data(), unknown_.data());
+  jump_limit_raw_.resize(65536);
+  detail::build_jump_limits(depth_scale_m, kJumpSigmas * sigma_z2, jump_limit_raw_.data());
+  width_ = background.width;
+  height_ = background.height;
+  fx_px_ = fx_px;
+  stereo_baseline_mm_ = stereo_baseline_mm;
+  depth_scale_m_ = depth_scale_m;
+  prepared_params_ = params;
+  prepared_ = true;
+}
+
+bool ForegroundExtractor::prepared_for(const Frame& frame) const {
+  // Only the parameters the tables depend on; the others are read per frame.
+  return prepared_ && frame.depth.width == width_ && frame.depth.height == height_ &&
+         frame.depth.pixels.size() == nearer_count_.size() && frame.intrinsics.fx == fx_px_ &&
+         frame.stereo_baseline_mm == stereo_baseline_mm_ && frame.depth.depth_scale_m == depth_scale_m_ &&
+         params.k_sigma == prepared_params_.k_sigma && params.min_margin_m == prepared_params_.min_margin_m &&
+         params.subpixel_rms_px == prepared_params_.subpixel_rms_px;
+}
+
+bool ForegroundExtractor::extract(const Frame& frame, const Pose& T_base_camera, Foreground& out) {
+  if (!prepared_for(frame)) {
+    out.mask.clear();
+    out.points_camera.clear();
+    out.points_base.clear();
+    return false;
+  }
   const DepthImage& depth = frame.depth;
   const Intrinsics& intr = frame.intrinsics;
   const size_t width = static_cast<size_t>(depth.width);
-  const size_t n = width * static_cast<size_t>(depth.height);
-  assert(background.mean_m.size() == n && background.spread_m.size() == n && depth.pixels.size() == n);
+  const size_t height = static_cast<size_t>(depth.height);
+  const size_t n = width * height;
   assert(depth.width < 65536 && depth.height < 32768);  // the flood fill packs v << 16 | u
   // Allocates only for the first frame of a size; afterwards these keep their capacity.
   out.mask.resize(n);
   out.points_camera.reserve(n);
   out.points_base.reserve(n);
   stack_.resize(n);
-  ray_x_.resize(static_cast<size_t>(depth.width));
-  ray_y_.resize(static_cast<size_t>(depth.height));
-  for (int u = 0; u < depth.width; ++u) ray_x_[static_cast<size_t>(u)] = (static_cast<float>(u) - intr.ppx) / intr.fx;
-  for (int v = 0; v < depth.height; ++v) ray_y_[static_cast<size_t>(v)] = (static_cast<float>(v) - intr.ppy) / intr.fy;
+  row_states_.resize(height);
+  ray_x_.resize(width);
+  ray_y_.resize(height);
+  for (size_t u = 0; u < width; ++u) ray_x_[u] = (static_cast<float>(u) - intr.ppx) / intr.fx;
+  for (size_t v = 0; v < height; ++v) ray_y_[v] = (static_cast<float>(v) - intr.ppy) / intr.fy;
   const Rays rays{&intr, is_pinhole(intr), ray_x_.data(), ray_y_.data()};
 
-  const float sigma_z2 = sigma_per_z2(frame, params.subpixel_rms_px);
   const Eigen::Matrix3f R = T_base_camera.linear().cast<float>();
   const Eigen::Vector3f t = T_base_camera.translation().cast<float>();
   uint8_t* mask = out.mask.data();
-  classify(depth, background, params, sigma_z2, mask);
+  classify(depth, nearer_count_.data(), unknown_.data(), mask, row_states_.data());
 
   // Where the background is unknown, only the configured workspace says whether it matters.
-  for_each_marked(mask, n, kUnknown, [&](size_t i) {
+  for_each_marked_in_rows(mask, row_states_.data(), width, 0, height, kUnknown, [&](size_t i) {
     const int u = static_cast<int>(i % width);
     const int v = static_cast<int>(i / width);
     Eigen::Vector3f p_camera;
     const bool ok = camera_point(rays, u, v, static_cast<float>(depth.pixels[i]) * depth.depth_scale_m, p_camera);
     mask[i] = ok && params.workspace_base.contains(R * p_camera + t) ? kCandidate : kNone;
   });
+  for (size_t v = 0; v < height; ++v) {
+    if ((row_states_[v] & kUnknown) != 0) row_states_[v] |= kCandidate;
+  }
 
-  const size_t kept = remove_speckles(frame, kJumpSigmas * sigma_z2, params.min_object_mm, mask, stack_);
+  const Kept kept = remove_speckles(frame, jump_limit_raw_.data(), params.min_object_mm, row_states_.data(), mask,
+                                    stack_.data());
   deproject_mask(depth, rays, kept, mask, out.points_camera);
   transform_points(R, t, out.points_camera, out.points_base);
+  return true;
 }
 
 }  // namespace hrcsense

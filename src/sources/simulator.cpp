@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — the simulated depth camera: ray casting, stereo disparity noise, ground truth.
+// hrcsense — the simulated depth camera: ray casting, the D435 sensor model, ground truth.
 
 #include "hrcsense/proximity.hpp"
 #include "hrcsense/sim.hpp"
 #include "sim_geometry.hpp"
 #include "sim_noise.hpp"
+#include "sim_sensor.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,9 +16,6 @@ namespace hrcsense {
 namespace {
 
 using sim_detail::kNoHit;
-using sim_detail::mix64;
-
-constexpr uint64_t kGolden = 0x9E3779B97F4A7C15ULL;
 
 bool exists_at(const SceneObject& object, int64_t index) {
   return object.first_frame <= index && (object.last_frame == -1 || index <= object.last_frame);
@@ -129,26 +127,39 @@ void place_shapes(const Simulator& sim, int64_t index, SimScratch& scratch) {
   for (const SceneObject& object : sim.scene.objects) total += object.shapes.size();
   scratch.shapes_base.reserve(total);  // the first frame sizes for all, so later ones never grow
   scratch.shape_labels.reserve(total);
+  scratch.shape_ids.reserve(total);
   scratch.shapes_base.clear();
   scratch.shape_labels.clear();
+  scratch.shape_ids.clear();
+  // Per object id (0: nothing hit): its label and its material bits. Same size every frame.
+  scratch.label_of_id.assign(sim.scene.objects.size() + 1, kStaticLabel);
+  scratch.material_of_id.assign(sim.scene.objects.size() + 1, 0);
   const double t_s = static_cast<double>(index) / sim.params.fps;
   uint16_t next_label = 1;
-  for (const SceneObject& object : sim.scene.objects) {
+  for (size_t k = 0; k < sim.scene.objects.size(); ++k) {
+    const SceneObject& object = sim.scene.objects[k];
     const uint16_t label = object.is_static ? kStaticLabel : next_label++;
+    const auto id = static_cast<uint16_t>(k + 1);
+    scratch.label_of_id[id] = label;
+    const Material& m = object.material;
+    scratch.material_of_id[id] = static_cast<uint8_t>((m.dark ? sim_detail::kDarkBit : 0) |
+                                                      (m.shiny ? sim_detail::kShinyBit : 0) |
+                                                      (m.low_texture ? sim_detail::kLowTextureBit : 0));
     if (!exists_at(object, index)) continue;
     const Eigen::Vector3f offset_m = path_offset(object.path, t_s);
     for (const Shape& shape : object.shapes) {
       scratch.shapes_base.push_back(translated(shape, offset_m));
       scratch.shape_labels.push_back(label);
+      scratch.shape_ids.push_back(id);
     }
   }
 }
 
-/// Z-buffers one shape over its pixel rectangle: keeps the nearest depth and its label.
+/// Z-buffers one shape over its pixel rectangle: keeps the nearest depth and its object id.
 /// `d` is the pixel's ray in whichever frame `hit` expects; t is Z either way.
 template <typename Hit>
-void cast(const PixelRect& r, const SimScratch& scratch, const Eigen::Matrix3f& R, uint16_t label, Hit hit,
-          float* z_m, uint16_t* labels) {
+void cast(const PixelRect& r, const SimScratch& scratch, const Eigen::Matrix3f& R, uint16_t id, Hit hit,
+          float* z_m, uint16_t* ids) {
   const int width = scratch.width;
   for (int v = r.v0; v < r.v1; ++v) {
     for (int u = r.u0; u < r.u1; ++u) {
@@ -157,15 +168,14 @@ void cast(const PixelRect& r, const SimScratch& scratch, const Eigen::Matrix3f& 
       const float t = hit(d);
       if (t < z_m[i]) {
         z_m[i] = t;
-        labels[i] = label;
+        ids[i] = id;
       }
     }
   }
 }
 
 /// Planes cover the whole image, so they get a flat loop on the camera-frame normal.
-void cast_plane(const Shape& plane_camera, const SimScratch& scratch, uint16_t label, float* z_m,
-                uint16_t* labels) {
+void cast_plane(const Shape& plane_camera, const SimScratch& scratch, uint16_t id, float* z_m, uint16_t* ids) {
   const float nx = plane_camera.normal.x(), ny = plane_camera.normal.y(), nz = plane_camera.normal.z();
   const float num = plane_camera.normal.dot(plane_camera.point);
   const size_t n = scratch.ray_x.size();
@@ -176,13 +186,14 @@ void cast_plane(const Shape& plane_camera, const SimScratch& scratch, uint16_t l
     const float t = num / (nx * rx[i] + ny * ry[i] + nz);
     const bool nearer = t > 0.0F && t < z_m[i];
     z_m[i] = nearer ? t : z_m[i];
-    labels[i] = nearer ? label : labels[i];
+    ids[i] = nearer ? id : ids[i];
   }
 }
 
-/// Renders every placed shape into the z-buffer `z_m` (+inf where nothing is hit).
+/// Renders every placed shape into the z-buffer `z_m` (+inf where nothing is hit) and the
+/// object ids `ids` (0 where nothing is hit).
 void cast_all(const SimScratch& scratch, const Intrinsics& in, const PoseF& T_base_camera, float* z_m,
-              uint16_t* labels) {
+              uint16_t* ids) {
   PoseF T_camera_base;
   T_camera_base.R = T_base_camera.R.transpose();
   T_camera_base.t = -(T_camera_base.R * T_base_camera.t);
@@ -190,7 +201,7 @@ void cast_all(const SimScratch& scratch, const Intrinsics& in, const PoseF& T_ba
   const Eigen::Vector3f origin_base = T_base_camera.t;
   for (size_t k = 0; k < scratch.shapes_base.size(); ++k) {
     const Shape& s = scratch.shapes_base[k];
-    const uint16_t label = scratch.shape_labels[k];
+    const uint16_t id = scratch.shape_ids[k];
     const PixelRect r = screen_bounds(s, in, T_camera_base);
     if (r.u0 >= r.u1 || r.v0 >= r.v1) continue;
     // Boxes are axis-aligned in the base frame, so they are cast there; the rest in the camera
@@ -203,47 +214,23 @@ void cast_all(const SimScratch& scratch, const Intrinsics& in, const PoseF& T_ba
     const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
     switch (s.type) {
       case Shape::Type::plane:
-        cast_plane(c, scratch, label, z_m, labels);
+        cast_plane(c, scratch, id, z_m, ids);
         break;
       case Shape::Type::box:
-        cast(r, scratch, T_base_camera.R, label,
-             [&](const Eigen::Vector3f& d) { return sim_detail::hit_box(s, origin_base, d); }, z_m, labels);
+        cast(r, scratch, T_base_camera.R, id,
+             [&](const Eigen::Vector3f& d) { return sim_detail::hit_box(s, origin_base, d); }, z_m, ids);
         break;
       case Shape::Type::sphere:
-        cast(r, scratch, I, label,
+        cast(r, scratch, I, id,
              [&](const Eigen::Vector3f& d) { return sim_detail::hit_sphere(c.point, c.radius_m, zero, d); }, z_m,
-             labels);
+             ids);
         break;
       case Shape::Type::capsule:
-        cast(r, scratch, I, label, [&](const Eigen::Vector3f& d) { return sim_detail::hit_capsule(c, zero, d); },
-             z_m, labels);
+        cast(r, scratch, I, id, [&](const Eigen::Vector3f& d) { return sim_detail::hit_capsule(c, zero, d); },
+             z_m, ids);
         break;
     }
   }
-}
-
-/// Turns the true depth into raw units: disparity noise (if enabled), then rounding to the
-/// depth unit. Z' = fx·B / (fx·B/Z + σ·n) = Z / (1 + σ·n·Z/(fx·B)).
-void write_depth(const SimParams& p, float fx_px, int64_t index, std::vector<float>& z_m, DepthImage& depth) {
-  const auto inv_scale = static_cast<float>(1.0 / static_cast<double>(p.depth_scale_m));
-  const float noise_per_m = p.disparity_noise_px / (fx_px * p.baseline_mm * 1e-3F);
-  const uint64_t frame_seed = mix64(mix64(p.seed) ^ (static_cast<uint64_t>(index) * kGolden));
-  const auto quantise = [&](float z, float n) -> uint16_t {
-    if (!(z > 0.0F) || !(z < kNoHit)) return 0;
-    float z_noisy = z;
-    if (p.noise) {
-      const float scale = 1.0F + noise_per_m * z * n;
-      if (!(scale > 0.0F)) return 0;  // the noisy disparity d' <= 0: no match
-      z_noisy = z / scale;
-    }
-    const float raw = z_noisy * inv_scale + 0.5F;  // round to nearest, as raw >= 0.5 here
-    return raw >= 1.0F && raw < 65536.0F ? static_cast<uint16_t>(raw) : 0;
-  };
-  // One draw per pixel, hit or not, so that a pixel's noise does not depend on the scene.
-  sim_detail::NormalStream normal(frame_seed);
-  const size_t n = z_m.size();
-  for (size_t i = 0; i < n; ++i) depth.pixels[i] = quantise(z_m[i], p.noise ? normal.next() : 0.0F);
-  for (float& z : z_m) z = z < kNoHit ? z : 0.0F;
 }
 
 /// Closest robot contact over the analytic surfaces of the existing non-static shapes.
@@ -320,11 +307,32 @@ void Simulator::render(int64_t index, Frame& out) const {
   GroundTruth& truth = *out.truth;
   const size_t n = static_cast<size_t>(in.width) * in.height;
   truth.depth_m.assign(n, kNoHit);
-  truth.labels.assign(n, kStaticLabel);
+  truth.labels.resize(n);
+  scratch.object_ids.assign(n, 0);
 
-  cast_all(scratch, in, T_base_camera_f, truth.depth_m.data(), truth.labels.data());
-  write_depth(params, in.fx, index, truth.depth_m, out.depth);
+  cast_all(scratch, in, T_base_camera_f, truth.depth_m.data(), scratch.object_ids.data());
+  sim_detail::write_sensor_depth(params, in.fx, index, truth.depth_m.data(), scratch, out.depth);
+  for (size_t i = 0; i < n; ++i) {
+    truth.labels[i] = scratch.label_of_id[scratch.object_ids[i]];
+    truth.depth_m[i] = truth.depth_m[i] < kNoHit ? truth.depth_m[i] : 0.0F;
+  }
   fill_truth_contacts(*this, T_base_camera_f, truth);
+}
+
+}  // namespace hrcsense
+
+namespace hrcsense {
+
+double sim_fill_rate(const Simulator& sim, int64_t first, int64_t count) {
+  Frame frame;
+  size_t valid = 0;
+  size_t total = 0;
+  for (int64_t i = first; i < first + std::max<int64_t>(count, 1); ++i) {
+    sim.render(i, frame);
+    for (const uint16_t raw : frame.depth.pixels) valid += raw != 0 ? 1U : 0U;
+    total += frame.depth.pixels.size();
+  }
+  return total == 0 ? 0.0 : static_cast<double>(valid) / static_cast<double>(total);
 }
 
 }  // namespace hrcsense

@@ -238,7 +238,7 @@ TEST_F(Cli, InfoDescribesTheSimulatedSource) {
   }
   const Outcome recording = run("info some/recording.bag");
   EXPECT_EQ(recording.exit_code, 2);
-  expect_one_error_line(recording, {"recording.bag", "sim"});
+  expect_one_error_line(recording, {"some/recording.bag", "no such recording"});
 }
 
 }  // namespace

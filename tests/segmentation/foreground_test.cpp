@@ -27,8 +27,9 @@ Foreground extract(const Frame& frame, const ForegroundParams& params = {},
                    const BackgroundModel& background = wall_background(), const Pose& pose = Pose::Identity()) {
   ForegroundExtractor extractor;
   extractor.params = params;
+  extractor.set_background(background, frame.intrinsics.fx, frame.stereo_baseline_mm, frame.depth.depth_scale_m);
   Foreground out;
-  extractor.extract(frame, background, pose, out);
+  EXPECT_TRUE(extractor.extract(frame, pose, out));
   return out;
 }
 
@@ -199,7 +200,8 @@ TEST(ForegroundExtractor, ReusesBuffersAfterFirstFrame) {
   const BackgroundModel background = wall_background();
   Frame frame = wall_frame(12);
   fill_rect(frame, 10, 10, 20, 20, 1000);
-  extractor.extract(frame, background, Pose::Identity(), out);
+  extractor.set_background(background, kFx, kBaselineMm, frame.depth.depth_scale_m);
+  ASSERT_TRUE(extractor.extract(frame, Pose::Identity(), out));
   ASSERT_EQ(out.points_camera.size(), 400U);
   const uint8_t* mask = out.mask.data();
   const float* x = out.points_camera.x.data();
@@ -207,7 +209,7 @@ TEST(ForegroundExtractor, ReusesBuffersAfterFirstFrame) {
   for (int f = 13; f < 16; ++f) {
     Frame bigger = wall_frame(f);
     fill_rect(bigger, 0, 0, 40 + f, 40, 1000);  // more points than the first frame
-    extractor.extract(bigger, background, Pose::Identity(), out);
+    ASSERT_TRUE(extractor.extract(bigger, Pose::Identity(), out));
     EXPECT_EQ(out.points_camera.size(), static_cast<size_t>((40 + f) * 40));
     EXPECT_EQ(out.mask.data(), mask);
     EXPECT_EQ(out.points_camera.x.data(), x);

@@ -44,12 +44,17 @@ Simulator cell(uint64_t seed, int64_t box_frame) {
   sim.T_base_camera = Pose::Identity();
   sim.T_base_camera.linear() << 1, 0, 0, 0, -1, 0, 0, 0, -1;  // camera x = base x, z = base −z
   sim.T_base_camera.translation() = Eigen::Vector3d(0.0, 0.0, 2.0);
-  SceneObject statics{"cell", {}, true, 0, -1, {}};
+  SceneObject statics;
+  statics.name = "cell";
   statics.shapes.push_back(plane({0, 0, 0}, {0, 0, 1}));     // floor
   statics.shapes.push_back(plane({0, 0.9F, 0}, {0, 1, 0}));  // back wall
   statics.shapes.push_back(box({-0.6F, -0.5F, 0.0F}, {0.6F, 0.5F, 0.75F}));
   sim.scene.objects.push_back(statics);
-  SceneObject parcel{"box", {box({-0.15F, -0.15F, 0.75F}, {0.15F, 0.15F, 1.0F})}, false, box_frame, -1, {}};
+  SceneObject parcel;
+  parcel.name = "box";
+  parcel.shapes.push_back(box({-0.15F, -0.15F, 0.75F}, {0.15F, 0.15F, 1.0F}));
+  parcel.is_static = false;
+  parcel.first_frame = box_frame;
   sim.scene.objects.push_back(parcel);
   return sim;
 }
@@ -73,11 +78,12 @@ TEST(SimulatedScene, EmptyCellHasNoForeground) {
   Frame frame;
   const BackgroundModel background = learn(sim, frame);
   ForegroundExtractor extractor;
+  extractor.set_background(background, frame.intrinsics.fx, frame.stereo_baseline_mm, frame.depth.depth_scale_m);
   Foreground fg;
   size_t worst = 0;
   for (int64_t i = kLearnFrames; i < kLearnFrames + kEmptyFrames; ++i) {
     sim.render(i, frame);
-    extractor.extract(frame, background, sim.T_base_camera, fg);
+    ASSERT_TRUE(extractor.extract(frame, sim.T_base_camera, fg));
     worst = std::max(worst, fg.points_base.size());
   }
   EXPECT_EQ(worst, 0U);
@@ -91,10 +97,11 @@ TEST(SimulatedScene, AppearingBoxMatchesTruth) {
     Frame frame;
     const BackgroundModel background = learn(sim, frame);
     ForegroundExtractor extractor;
+    extractor.set_background(background, frame.intrinsics.fx, frame.stereo_baseline_mm, frame.depth.depth_scale_m);
     Foreground fg;
     for (int64_t i = kLearnFrames; i < kLearnFrames + 10; ++i) {
       sim.render(i, frame);
-      extractor.extract(frame, background, sim.T_base_camera, fg);
+      ASSERT_TRUE(extractor.extract(frame, sim.T_base_camera, fg));
       size_t both = 0;
       size_t either = 0;
       for (size_t p = 0; p < fg.mask.size(); ++p) {

@@ -2,6 +2,7 @@
 // The shipped scene files (config/*.yaml) do what their comments promise, checked numerically.
 
 #include "hrcsense/config.hpp"
+#include "hrcsense/io.hpp"
 #include "hrcsense/sim.hpp"
 
 #include <gtest/gtest.h>
@@ -102,6 +103,88 @@ TEST(Scenes, ThesisBoxContactIsTheFrontTopLeftVertex) {
     EXPECT_NEAR(truth.analytic_contact.distance_m, expected_m, 1e-5F) << "frame " << i;
     EXPECT_LT((truth.analytic_contact.closest_base - vertex).norm(), 1e-6F) << "frame " << i;
     EXPECT_LT((truth.analytic_contact.closest_robot_base - robot_point).norm(), 1e-6F) << "frame " << i;
+  }
+}
+
+TEST(Scenes, InfoPrintsTheFillRate) {
+  const std::string command = std::string(HRCSENSE_CLI) + " info --config " + scene_path("walk.yaml") + " 2>&1";
+  std::FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  char buffer[512];
+  while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) output += buffer;
+  ASSERT_EQ(pclose(pipe), 0) << output;
+  const size_t at = output.find("\nfill rate: ");
+  ASSERT_NE(at, std::string::npos) << output;
+  double percent = 0.0;
+  ASSERT_EQ(std::sscanf(output.c_str() + at, "\nfill rate: %lf %%", &percent), 1) << output;
+  EXPECT_GE(percent, 70.0);
+  EXPECT_LE(percent, 98.0);
+  // The same figure as the library's, to the printed digit.
+  const Simulator sim = make_simulator(load_config(scene_path("walk.yaml"), {}));
+  EXPECT_NEAR(percent, 100.0 * sim_fill_rate(sim, 0, 10), 0.051);
+}
+
+TEST(Scenes, SensorKeysAndMaterialsAreRead) {
+  const Config config = load_config(scene_path("walk.yaml"), {"sim.edge_dropout=0.5", "sim.left_band=false",
+                                                              "sim.min_range_m=0.3", "sim.correlated_noise_px=0.02"});
+  EXPECT_FLOAT_EQ(config.sim.edge_dropout, 0.5F);
+  EXPECT_FALSE(config.sim.left_band);
+  EXPECT_FLOAT_EQ(config.sim.min_range_m, 0.3F);
+  EXPECT_FLOAT_EQ(config.sim.correlated_noise_px, 0.02F);
+  EXPECT_TRUE(config.sim.occlusion_shadows);  // untouched keys keep their defaults
+  const auto workbench = std::find_if(config.scene.objects.begin(), config.scene.objects.end(),
+                                      [](const SceneObject& o) { return o.name == "workbench"; });
+  ASSERT_NE(workbench, config.scene.objects.end());
+  EXPECT_TRUE(workbench->material.dark);
+  EXPECT_FALSE(workbench->material.shiny);
+  // The effective configuration round-trips the material.
+  EXPECT_NE(config.canonical_yaml.find("material: [dark]"), std::string::npos);
+  const auto error_of = [](const std::vector<std::string>& sets) {
+    try {
+      load_config("", sets);
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error_of({"sim.edge_dropout=1.5"}).find("sim.edge_dropout"), std::string::npos);
+  EXPECT_NE(error_of({"scene.objects=[{shapes: [{sphere: {center: [0,0,1], radius_m: 0.1}}], material: [velvet]}]"})
+                .find("scene.objects[0].material"),
+            std::string::npos);
+}
+
+/// Valid share of a real D435 depth frame (the Depth Quality Tool's fill rate, whole image).
+double real_fill_rate(const std::string& file) {
+  DepthImage depth;
+  read_depth_png(std::string(HRCSENSE_SHARED_DIR) + "/data/librealsense_d435_single_frame/" + file, depth);
+  const auto valid = std::count_if(depth.pixels.begin(), depth.pixels.end(), [](uint16_t raw) { return raw != 0; });
+  return static_cast<double>(valid) / static_cast<double>(depth.pixels.size());
+}
+
+// The shipped scenes lose depth like a real D435 does: between 70 % and 98 % valid over the
+// first frames (docs/SIMULATOR.md reports the figures beside the real frame's).
+TEST(Scenes, FillRateOfTheShippedScenesIsD435Like) {
+  for (const char* name : {"walk.yaml", "thesis-box.yaml"}) {
+    const Simulator sim = make_simulator(load_config(scene_path(name), {}));
+    const double fill = sim_fill_rate(sim, 0, 3);
+    std::printf("%s: fill rate %.1f %%\n", name, 100.0 * fill);
+    EXPECT_GE(fill, 0.70) << name;
+    EXPECT_LE(fill, 0.98) << name;
+  }
+}
+
+TEST(Scenes, RealD435FrameFillRate) {
+  const std::string dir = std::string(HRCSENSE_SHARED_DIR) + "/data/librealsense_d435_single_frame";
+  if (std::FILE* file = std::fopen((dir + "/depth_0.png").c_str(), "rb")) {
+    std::fclose(file);
+  } else {
+    GTEST_SKIP() << dir << " is absent";
+  }
+  for (const char* frame : {"depth_0.png", "depth_1.png"}) {
+    const double fill = real_fill_rate(frame);
+    std::printf("real D435 %s: fill rate %.1f %%\n", frame, 100.0 * fill);
+    EXPECT_NEAR(fill, 0.93, 0.02) << frame;  // the recording's README: about 93 % valid
   }
 }
 

@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense config — the depth filter chain: filters.preset, filters.order and
+// filters.<block>.<option> with the RealSense SDK's option ranges (specs/depth-filters.md).
+#include "key_reader.hpp"
+
+#include <algorithm>
+
+namespace hrcsense::config_detail {
+namespace {
+
+bool contains(const std::vector<FilterBlock>& order, FilterBlock block) {
+  return std::find(order.begin(), order.end(), block) != order.end();
+}
+
+// A float option with the SDK's inclusive range; the error names the key and the range.
+void ranged(KeyReader& r, const std::string& key, float& value, float min, float max, const char* range) {
+  r.number(key, value, Bound::any);
+  if (!(value >= min && value <= max)) {
+    r.fail(key, float_text(value) + " is outside the SDK's range " + range);
+  }
+}
+
+std::vector<FilterBlock> read_order(KeyReader& r, const std::vector<FilterBlock>& preset_order, bool& given) {
+  const YAML::Node node = r.raw("filters.order");
+  given = node.IsDefined() && !node.IsNull();
+  std::vector<FilterBlock> order = preset_order;
+  if (given) {
+    if (!node.IsSequence()) r.fail("filters.order", "expected a list of block names, e.g. [threshold, spatial]");
+    order.clear();
+    for (const YAML::Node& item : node) {
+      const auto block = item.IsScalar() ? filter_block_from_name(item.Scalar()) : std::nullopt;
+      if (!block) {
+        r.fail("filters.order", "unknown block '" + (item.IsScalar() ? item.Scalar() : std::string("?")) +
+                                    "'; expected threshold, decimation, to_disparity, spatial, temporal, "
+                                    "to_depth or hole_filling");
+      }
+      order.push_back(*block);
+    }
+  }
+  return order;
+}
+
+// `enabled` switches a block of the order off; without filters.order it can also switch a
+// block on, in the documented position.
+std::vector<FilterBlock> apply_enabled(KeyReader& r, const std::vector<FilterBlock>& order, bool order_given) {
+  bool enabled[kFilterBlocks.size()] = {};
+  for (const FilterBlock block : kFilterBlocks) {
+    const std::string key = std::string("filters.") + filter_block_name(block) + ".enabled";
+    bool& on = enabled[static_cast<size_t>(block)];
+    on = contains(order, block);
+    r.flag(key, on);
+    if (on && order_given && !contains(order, block)) r.fail(key, "the block is not in filters.order; add it there");
+  }
+  std::vector<FilterBlock> result;
+  for (const FilterBlock block : order_given ? order : std::vector<FilterBlock>(kFilterBlocks.begin(), kFilterBlocks.end())) {
+    if (enabled[static_cast<size_t>(block)]) result.push_back(block);
+  }
+  return result;
+}
+
+void read_options(KeyReader& r, FilterChainParams& f) {
+  ranged(r, "filters.threshold.min", f.threshold.min_m, 0.0F, 16.0F, "[0, 16] m");
+  ranged(r, "filters.threshold.max", f.threshold.max_m, 0.0F, 16.0F, "[0, 16] m");
+  if (f.threshold.min_m > f.threshold.max_m) {
+    r.fail("filters.threshold.min", "expected min <= max (" + float_text(f.threshold.max_m) + " m)");
+  }
+  r.integer("filters.decimation.magnitude", f.decimation.magnitude, 1, 8);
+  ranged(r, "filters.spatial.alpha", f.spatial.alpha, 0.25F, 1.0F, "[0.25, 1]");
+  r.integer("filters.spatial.delta", f.spatial.delta, 1, 50);
+  r.integer("filters.spatial.magnitude", f.spatial.magnitude, 1, 5);
+  r.integer("filters.spatial.holes_fill", f.spatial.holes_fill, 0, 5);
+  ranged(r, "filters.temporal.alpha", f.temporal.alpha, 0.0F, 1.0F, "[0, 1]");
+  r.integer("filters.temporal.delta", f.temporal.delta, 1, 100);
+  r.integer("filters.temporal.persistence", f.temporal.persistence, 0, 8);
+  r.integer("filters.hole_filling.mode", f.hole_filling.mode, 0, 2);
+}
+
+}  // namespace
+
+void read_filters(KeyReader& r, Config& c) {
+  r.choice("filters.preset", c.filters_preset, {"none", "sdk", "thesis"});
+  FilterChainParams& f = c.pipeline.filters;
+  f = *filter_preset(c.filters_preset);
+  bool order_given = false;
+  const std::vector<FilterBlock> order = read_order(r, f.order, order_given);
+  f.order = apply_enabled(r, order, order_given);
+  const std::string problem = check_filter_order(f.order);
+  if (!problem.empty()) r.fail("filters.order", problem);
+  YAML::Node effective(YAML::NodeType::Sequence);
+  for (const FilterBlock block : f.order) effective.push_back(filter_block_name(block));
+  r.set_effective("filters.order", effective);
+  read_options(r, f);
+}
+
+}  // namespace hrcsense::config_detail

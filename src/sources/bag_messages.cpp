@@ -1,0 +1,121 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — the SDK's topics and messages in a bag: classification and ROS1 deserialisation.
+#include "bag_messages.hpp"
+
+#include "hrcsense/camera.hpp"
+
+#include <cmath>
+
+namespace hrcsense::bag {
+namespace {
+
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "bag fields are read as little-endian");
+
+/// Largest image side accepted, as for PNGs: no camera is near it, and a damaged size field
+/// cannot make a frame buffer huge.
+constexpr uint32_t kMaxSidePx = 16384;
+
+}  // namespace
+
+TopicRole classify_topic(std::string_view topic) {
+  TopicRole out;
+  if (topic == "/file_version") {
+    out.role = Role::file_version;
+    return out;
+  }
+  // /device_<d>/sensor_<s>/<rest>
+  if (topic.rfind("/device_", 0) != 0) return out;
+  const size_t sensor = topic.find("/sensor_", 1);
+  if (sensor == std::string_view::npos) return out;
+  const size_t rest_at = topic.find('/', sensor + 1);
+  if (rest_at == std::string_view::npos) return out;
+  const std::string_view rest = topic.substr(rest_at + 1);
+  if (rest.rfind("option/", 0) == 0) {
+    // Spaces in option names became '_' in newer SDKs; accept both.
+    if (rest == "option/Depth_Units/value" || rest == "option/Depth Units/value") out.role = Role::depth_units;
+    if (rest == "option/Stereo_Baseline/value" || rest == "option/Stereo Baseline/value") {
+      out.role = Role::stereo_baseline;
+    }
+    return out;
+  }
+  const size_t slash = rest.find('/');
+  if (slash == std::string_view::npos) return out;
+  out.stream = std::string(rest.substr(0, slash));
+  const std::string_view what = rest.substr(slash);
+  if (what == "/image/data") out.role = Role::image;
+  if (what == "/info/camera_info") out.role = Role::camera_info;
+  if (what.rfind("/tf/", 0) == 0) out.role = Role::tf;
+  if (out.role == Role::other) out.stream.clear();
+  return out;
+}
+
+std::string parse_image(Cursor c, ImageView& out) {
+  out.seq = c.get<uint32_t>();
+  const auto sec = c.get<uint32_t>();
+  const auto nsec = c.get<uint32_t>();
+  out.stamp_ns = static_cast<int64_t>(sec) * 1000000000LL + nsec;
+  const std::string_view frame_id = c.string();
+  out.height = c.get<uint32_t>();
+  out.width = c.get<uint32_t>();
+  out.encoding = c.string();
+  c.get<uint8_t>();  // is_bigendian: the SDK always writes 0
+  out.step = c.get<uint32_t>();
+  const auto bytes = c.get<uint32_t>();
+  if (!c.ok || bytes > c.size - c.pos) return "image message is cut off";
+  out.pixels = c.data + c.pos;
+  out.pixel_bytes = bytes;
+  c.pos += bytes;
+  // The SDK (>= 2.49) marks images with frame_id "1" and appends the frame's depth units.
+  out.depth_units_m = frame_id == "1" ? c.get<float>() : 0.0F;
+  if (!c.ok) return "image message lacks its depth units field";
+  if (out.width == 0 || out.height == 0 || out.width > kMaxSidePx || out.height > kMaxSidePx) {
+    return "image size " + std::to_string(out.width) + "x" + std::to_string(out.height) + " is implausible";
+  }
+  if (static_cast<uint64_t>(out.step) * out.height != bytes) {
+    return "image data holds " + std::to_string(bytes) + " bytes, step x height is " +
+           std::to_string(static_cast<uint64_t>(out.step) * out.height);
+  }
+  return {};
+}
+
+std::string parse_camera_info(Cursor c, Intrinsics& out) {
+  c.get<uint32_t>();  // header.seq
+  c.get<uint64_t>();  // header.stamp
+  c.string();         // header.frame_id
+  const auto height = c.get<uint32_t>();
+  const auto width = c.get<uint32_t>();
+  const std::string_view model = c.string();
+  const auto coefficients = c.get<uint32_t>();
+  Intrinsics in;
+  for (uint32_t i = 0; i < coefficients && c.ok; ++i) {
+    const auto value = c.get<double>();
+    if (i < in.coeffs.size()) in.coeffs[i] = static_cast<float>(value);
+  }
+  double k[9];
+  for (double& value : k) value = c.get<double>();
+  if (!c.ok) return "camera_info message is cut off";
+  if (width == 0 || height == 0 || width > kMaxSidePx || height > kMaxSidePx) return "camera_info size is implausible";
+  in.width = static_cast<int>(width);
+  in.height = static_cast<int>(height);
+  in.fx = static_cast<float>(k[0]);
+  in.ppx = static_cast<float>(k[2]);
+  in.fy = static_cast<float>(k[4]);
+  in.ppy = static_cast<float>(k[5]);
+  in.model = distortion_from_name(model).value_or(Distortion::none);
+  out = in;
+  return {};
+}
+
+std::string parse_transform(Cursor c, Pose& out) {
+  double v[7];  // translation x y z, rotation x y z w
+  for (double& value : v) value = c.get<double>();
+  if (!c.ok) return "transform message is cut off";
+  const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+  if (!(std::abs(q.norm() - 1.0) < 1e-3)) return "transform rotation is not a unit quaternion";
+  out = Pose::Identity();
+  out.linear() = q.normalized().toRotationMatrix();
+  out.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+  return {};
+}
+
+}  // namespace hrcsense::bag

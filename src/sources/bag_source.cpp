@@ -1,0 +1,277 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — a RealSense .bag as a Source: the depth stream with its calibration and units.
+#include "bag_messages.hpp"
+#include "bag_reader.hpp"
+
+#include "hrcsense/io.hpp"
+#include "hrcsense/recordings.hpp"
+
+#include <cstring>
+#include <map>
+
+namespace hrcsense {
+
+/// Depth units when neither the image nor an option says (the SDK's default).
+constexpr float kDefaultDepthUnitsM = 0.001F;
+
+/// Everything BagSource knows while it plays a bag.
+struct BagState {
+  explicit BagState(const std::string& path) : reader(path) {}
+
+  BagReader reader;
+  std::map<uint32_t, bag::TopicRole> roles;  ///< by connection id, filled on first sight
+  std::string depth_stream;                  ///< e.g. "Depth_0": the first depth stream seen
+  std::string color_stream;                  ///< e.g. "Color_0"
+  std::map<std::string, Intrinsics> intrinsics;  ///< by stream, from camera_info
+  std::map<std::string, Pose> tf;            ///< by stream: T_stream_reference
+  float depth_units_option_m = 0.0F;         ///< last Depth_Units option; 0 before any
+  float stereo_baseline_mm = 0.0F;
+  int file_version = 0;
+  // Counts over what has been read so far.
+  RecordingStream depth_info{"depth", "", {}, 0, 0, 0};
+  RecordingStream color_info{"color", "", {}, 0, 0, 0};
+  ColorImage color;                          ///< the latest decoded colour frame
+  bool have_color = false;
+  // Playback.
+  Frame pending;                             ///< the first frame, read while opening
+  bool has_pending = false;
+  int64_t played = 0;
+  int64_t lap_offset_ns = 0;                 ///< added to timestamps when looping
+  std::string error;
+
+  const bag::TopicRole& role_of(uint32_t conn) {
+    auto found = roles.find(conn);
+    if (found != roles.end()) return found->second;
+    const auto connection = reader.connections().find(conn);
+    bag::TopicRole role;
+    if (connection != reader.connections().end()) role = bag::classify_topic(connection->second.topic);
+    return roles.emplace(conn, role).first->second;
+  }
+};
+
+namespace {
+
+[[noreturn]] void message_error(const BagState& s, const BagMessage& m, const std::string& problem) {
+  const auto connection = s.reader.connections().find(m.conn);
+  const std::string topic = connection == s.reader.connections().end() ? "?" : connection->second.topic;
+  throw IoError(s.reader.path() + ": byte offset " + std::to_string(m.chunk_offset) + " (chunk): topic " + topic + ": " +
+                problem);
+}
+
+float read_float_message(const BagState& s, const BagMessage& m) {
+  bag::Cursor c{m.data, m.size};
+  const auto value = c.get<float>();
+  if (!c.ok) message_error(s, m, "Float32 message is cut off");
+  return value;
+}
+
+void note_stream(RecordingStream& stream, const bag::ImageView& image, int64_t stamp_ns) {
+  if (stream.frames == 0) stream.first_ns = stamp_ns;
+  stream.last_ns = stamp_ns;
+  stream.encoding = std::string(image.encoding);
+  ++stream.frames;
+}
+
+/// Converts an rgb8 / bgr8 / rgba8 / bgra8 image into `out` (RGB).
+void decode_color(const BagState& s, const BagMessage& m, const bag::ImageView& image, ColorImage& out) {
+  const std::string_view enc = image.encoding;
+  const size_t bpp = (enc == "rgb8" || enc == "bgr8") ? 3 : (enc == "rgba8" || enc == "bgra8") ? 4 : 0;
+  if (bpp == 0) message_error(s, m, "colour encoding '" + std::string(enc) + "' is not supported");
+  if (image.step < image.width * bpp) message_error(s, m, "colour step is smaller than a row");
+  const bool bgr = enc[0] == 'b';
+  out.width = static_cast<int>(image.width);
+  out.height = static_cast<int>(image.height);
+  out.rgb.resize(static_cast<size_t>(image.width) * image.height * 3);
+  uint8_t* dst = out.rgb.data();
+  for (uint32_t v = 0; v < image.height; ++v) {
+    const uint8_t* src = image.pixels + static_cast<size_t>(v) * image.step;
+    for (uint32_t u = 0; u < image.width; ++u, src += bpp, dst += 3) {
+      dst[0] = src[bgr ? 2 : 0];
+      dst[1] = src[1];
+      dst[2] = src[bgr ? 0 : 2];
+    }
+  }
+}
+
+/// Fills `out` from a depth image message. Throws IoError for anything inconsistent.
+void decode_depth(BagState& s, const BagMessage& m, const bag::ImageView& image, Frame& out) {
+  if (image.encoding != "mono16" && image.encoding != "16UC1" && image.encoding != "Z16") {
+    message_error(s, m, "depth encoding '" + std::string(image.encoding) + "' is not 16-bit");
+  }
+  if (image.step < image.width * 2) message_error(s, m, "depth step is smaller than a row");
+  const auto found = s.intrinsics.find(s.depth_stream);
+  if (found == s.intrinsics.end()) message_error(s, m, "depth frame before the depth stream's camera_info");
+  const Intrinsics& in = found->second;
+  if (static_cast<uint32_t>(in.width) != image.width || static_cast<uint32_t>(in.height) != image.height) {
+    message_error(s, m, "depth frame is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                            " but its camera_info says " + std::to_string(in.width) + "x" + std::to_string(in.height));
+  }
+  out.depth.resize(in.width, in.height);
+  for (uint32_t v = 0; v < image.height; ++v) {
+    std::memcpy(out.depth.pixels.data() + static_cast<size_t>(v) * image.width,
+                image.pixels + static_cast<size_t>(v) * image.step, static_cast<size_t>(image.width) * 2);
+  }
+  // Units: the image's own field, else the last Depth_Units option, else the SDK default.
+  float units_m = image.depth_units_m > 0.0F ? image.depth_units_m : s.depth_units_option_m;
+  out.depth.depth_scale_m = units_m > 0.0F ? units_m : kDefaultDepthUnitsM;
+  out.intrinsics = in;
+  out.stereo_baseline_mm = s.stereo_baseline_mm;
+  out.timestamp_ns = (image.stamp_ns != 0 ? image.stamp_ns : m.time_ns) + s.lap_offset_ns;
+  out.truth.reset();
+}
+
+/// Handles messages until one depth frame has been decoded into `out` (true) or the bag ends
+/// (false). Colour frames are decoded only when `with_color`. Throws IoError on damage.
+bool read_depth_frame(BagState& s, bool with_color, Frame& out) {
+  BagMessage m;
+  while (s.reader.next(m)) {
+    const bag::TopicRole& role = s.role_of(m.conn);
+    const bag::Cursor cursor{m.data, m.size};
+    std::string problem;
+    switch (role.role) {
+      case bag::Role::other:
+        break;
+      case bag::Role::file_version: {
+        bag::Cursor c = cursor;
+        s.file_version = static_cast<int>(c.get<uint32_t>());
+        break;
+      }
+      case bag::Role::depth_units:
+        s.depth_units_option_m = read_float_message(s, m);
+        break;
+      case bag::Role::stereo_baseline:
+        s.stereo_baseline_mm = read_float_message(s, m);
+        break;
+      case bag::Role::camera_info:
+        problem = bag::parse_camera_info(cursor, s.intrinsics[role.stream]);
+        break;
+      case bag::Role::tf:
+        problem = bag::parse_transform(cursor, s.tf[role.stream]);
+        break;
+      case bag::Role::image: {
+        bag::ImageView image;
+        problem = bag::parse_image(cursor, image);
+        if (!problem.empty()) break;
+        const int64_t stamp_ns = image.stamp_ns != 0 ? image.stamp_ns : m.time_ns;
+        if (s.depth_stream.empty() && role.stream.rfind("Depth_", 0) == 0) s.depth_stream = role.stream;
+        if (s.color_stream.empty() && role.stream.rfind("Color_", 0) == 0) s.color_stream = role.stream;
+        if (role.stream == s.depth_stream) {
+          decode_depth(s, m, image, out);
+          note_stream(s.depth_info, image, stamp_ns);
+          return true;
+        }
+        if (role.stream == s.color_stream) {
+          note_stream(s.color_info, image, stamp_ns);
+          if (with_color) {
+            decode_color(s, m, image, s.color);
+            s.have_color = true;
+          }
+        }
+        break;
+      }
+    }
+    if (!problem.empty()) message_error(s, m, problem);
+  }
+  return false;
+}
+
+}  // namespace
+
+BagSource::BagSource(RecordingParams params) : params_(std::move(params)), state_(std::make_unique<BagState>(params_.path)) {
+  // The first frame is read now so that info() can report the depth intrinsics.
+  if (!read_depth_frame(*state_, params_.with_color, state_->pending)) {
+    throw IoError(params_.path + ": no depth frames (topic /device_0/sensor_<s>/Depth_<i>/image/data)");
+  }
+  state_->has_pending = true;
+}
+
+BagSource::~BagSource() = default;
+
+SourceInfo BagSource::info() const {
+  const BagState& s = *state_;
+  SourceInfo info;
+  info.type = "bag";
+  info.description = params_.path + " (" + s.depth_stream + ", " +
+                     (s.reader.indexed() ? "indexed" : "not indexed: " + s.reader.index_problem()) + ")";
+  info.intrinsics = s.pending.intrinsics.width > 0 ? s.pending.intrinsics : s.intrinsics.at(s.depth_stream);
+  info.stereo_baseline_mm = s.stereo_baseline_mm > 0.0F ? s.stereo_baseline_mm : params_.stereo_baseline_mm;
+  info.nominal_fps = 30.0;
+  info.frame_count = -1;
+  if (s.reader.indexed() && !params_.loop) {
+    for (const auto& [id, connection] : s.reader.connections()) {
+      if (bag::classify_topic(connection.topic).stream == s.depth_stream &&
+          bag::classify_topic(connection.topic).role == bag::Role::image) {
+        const auto count = s.reader.indexed_counts().find(id);
+        info.frame_count = count == s.reader.indexed_counts().end() ? 0 : static_cast<int64_t>(count->second);
+      }
+    }
+  }
+  return info;
+}
+
+std::string BagSource::error() const { return state_->error; }
+
+Source::Status BagSource::next(Frame& out) {
+  BagState& s = *state_;
+  if (!s.error.empty()) return Status::error;
+  try {
+    if (s.has_pending) {
+      std::swap(out, s.pending);
+      s.has_pending = false;
+    } else if (!read_depth_frame(s, params_.with_color, out)) {
+      if (!params_.loop) return Status::end;
+      // Each lap starts one nominal period after the last frame of the previous one.
+      s.lap_offset_ns += s.depth_info.last_ns - s.depth_info.first_ns + 33333333;
+      s.reader.rewind();
+      if (!read_depth_frame(s, params_.with_color, out)) return Status::end;
+    }
+  } catch (const IoError& e) {
+    s.error = e.what();
+    return Status::error;
+  }
+  if (params_.stereo_baseline_mm > 0.0F && out.stereo_baseline_mm <= 0.0F) out.stereo_baseline_mm = params_.stereo_baseline_mm;
+  if (s.have_color) {
+    out.color = s.color;
+  } else {
+    out.color.reset();
+  }
+  out.index = s.played++;
+  return Status::frame;
+}
+
+/// Reads a whole bag for `summarize_recording`.
+RecordingSummary summarize_bag(const std::string& path) {
+  BagState s(path);
+  RecordingSummary summary;
+  summary.path = path;
+  summary.format = "bag";
+  Frame frame;
+  try {
+    while (read_depth_frame(s, false, frame)) {
+    }
+  } catch (const IoError& e) {
+    summary.damage = e.what();
+  }
+  if (s.depth_info.frames == 0 && summary.damage.empty()) throw IoError(path + ": no depth frames");
+  summary.compression = s.reader.compressions();
+  summary.indexed = s.reader.indexed();
+  summary.file_version = s.file_version;
+  summary.stereo_baseline_mm = s.stereo_baseline_mm;
+  summary.depth_units_m = s.depth_units_option_m > 0.0F ? s.depth_units_option_m : kDefaultDepthUnitsM;
+  if (s.depth_info.frames > 0) summary.depth_units_m = frame.depth.depth_scale_m;
+  s.depth_info.intrinsics = s.intrinsics[s.depth_stream];
+  summary.streams.push_back(s.depth_info);
+  if (!s.color_stream.empty()) {
+    s.color_info.intrinsics = s.intrinsics[s.color_stream];
+    summary.streams.push_back(s.color_info);
+    const auto depth_tf = s.tf.find(s.depth_stream);
+    const auto color_tf = s.tf.find(s.color_stream);
+    if (depth_tf != s.tf.end() && color_tf != s.tf.end()) {
+      // Both are given from the group's reference stream: E_depth→color = E_color ∘ E_depth⁻¹.
+      summary.T_color_depth = color_tf->second * depth_tf->second.inverse();
+    }
+  }
+  return summary;
+}
+
+}  // namespace hrcsense

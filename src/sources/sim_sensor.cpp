@@ -1,0 +1,290 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — the simulated D435's sensor model (specs/d435-sensor-model.md §3–4): visibility
+// from the right imager, minimum range, dropouts, flying pixels, disparity noise, quantisation.
+
+#include "sim_sensor.hpp"
+
+#include "sim_geometry.hpp"
+#include "sim_noise.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace hrcsense::sim_detail {
+namespace {
+
+constexpr uint64_t kGolden = 0x9E3779B97F4A7C15ULL;
+// Salts that give each random effect its own stream from the one seed.
+constexpr uint64_t kFixedSalt = 0x5DEECE66DULL;
+constexpr uint64_t kMaterialSalt = 0xC2B2AE3D27D4EB4FULL;
+constexpr uint64_t kSpeckleSalt = 0x165667B19E3779F9ULL;
+constexpr uint64_t kCorrelatedSalt = 0x27D4EB2F165667C5ULL;
+
+/// A uniform in [0, 1) from 24 bits of `bits` starting at `shift`.
+inline float unit24(uint64_t bits, int shift) {
+  return static_cast<float>((bits >> shift) & 0xFFFFFFU) * (1.0F / 16777216.0F);
+}
+
+/// Noise-free disparity d = fx·B / Z per pixel (0 where nothing was hit).
+void compute_disparity(const float* z_m, float fxb_px_m, size_t n, float* disparity_px) {
+  for (size_t i = 0; i < n; ++i) {
+    const float z = z_m[i];
+    disparity_px[i] = z < kNoHit && z > 0.0F ? fxb_px_m / z : 0.0F;
+  }
+}
+
+/// Marks pixels that have no depth for geometric reasons. The depth image is the left
+/// imager's; the right imager sits at +B along x, rows rectified, so a point at left column u
+/// with disparity d appears at right column x_r = u − d. It is outside the right image when
+/// x_r < −0.5 (the left band, first fx·B/Z columns). It is hidden from the right imager when a
+/// pixel further right in the same row lands at or left of x_r: that pixel's point is nearer
+/// and lies on the right camera's ray to this one. (Surfaces hidden in both views cast such a
+/// shadow through the surface that hides them, so scanning the visible pixels is exact.)
+void mark_hidden(const SimParams& p, float max_disparity_px, int width, int height, const float* disparity_px,
+                 uint8_t* hidden) {
+  // A step smaller than this is rounding, not occlusion: x_r grows by (1 − ∂d/∂u) per column,
+  // which is > 0 for every surface the right imager sees at more than grazing incidence.
+  constexpr float kEpsPx = 1e-3F;
+  for (int v = 0; v < height; ++v) {
+    const size_t row = static_cast<size_t>(v) * width;
+    float min_right_xr = std::numeric_limits<float>::infinity();
+    for (int u = width - 1; u >= 0; --u) {
+      const float d = disparity_px[row + u];
+      if (!(d > 0.0F)) {
+        hidden[row + u] = 0;
+        continue;
+      }
+      const float xr = static_cast<float>(u) - d;
+      const bool outside = p.left_band && xr < -0.5F;
+      const bool shadowed = p.occlusion_shadows && xr > min_right_xr + kEpsPx;
+      const bool too_near = d > max_disparity_px;
+      hidden[row + u] = (outside || shadowed || too_near) ? 1 : 0;
+      min_right_xr = std::min(min_right_xr, xr);
+    }
+  }
+}
+
+/// A smooth, zero-mean disparity error fixed per seed: Gaussian values on a grid of
+/// `correlated_cell_px`, bilinearly interpolated. Computed only when the key changes.
+void ensure_correlated(const SimParams& p, int width, int height, SimScratch& scratch) {
+  const size_t n = static_cast<size_t>(width) * height;
+  if (!(p.correlated_noise_px > 0.0F)) return;
+  const int cell = std::max(2, p.correlated_cell_px);
+  uint64_t key = mix64(p.seed ^ kCorrelatedSalt);
+  key = mix64(key ^ (static_cast<uint64_t>(cell) << 32) ^ static_cast<uint64_t>(width) * 65536U ^
+              static_cast<uint64_t>(height));
+  uint32_t sigma_bits = 0;
+  static_assert(sizeof sigma_bits == sizeof p.correlated_noise_px);
+  std::copy_n(reinterpret_cast<const char*>(&p.correlated_noise_px), 4, reinterpret_cast<char*>(&sigma_bits));
+  key = mix64(key ^ sigma_bits);
+  if (scratch.correlated_key == key && scratch.correlated_px.size() == n) return;
+  const int nodes_x = width / cell + 2;
+  const int nodes_y = height / cell + 2;
+  std::vector<float> nodes(static_cast<size_t>(nodes_x) * nodes_y);
+  NormalStream normal(mix64(p.seed ^ kCorrelatedSalt));
+  for (float& value : nodes) value = p.correlated_noise_px * normal.next();
+  // Bilinear interpolation lowers the variance between nodes; rescale so that σ holds on average
+  // (E[w²] summed over the four weights is (2/3)² per axis for uniform positions).
+  const float gain = 1.5F;
+  scratch.correlated_px.resize(n);
+  for (int v = 0; v < height; ++v) {
+    const float gy = static_cast<float>(v) / static_cast<float>(cell);
+    const int y0 = static_cast<int>(gy);
+    const float fy = gy - static_cast<float>(y0);
+    for (int u = 0; u < width; ++u) {
+      const float gx = static_cast<float>(u) / static_cast<float>(cell);
+      const int x0 = static_cast<int>(gx);
+      const float fx = gx - static_cast<float>(x0);
+      const float* r0 = &nodes[static_cast<size_t>(y0) * nodes_x + x0];
+      const float* r1 = r0 + nodes_x;
+      const float top = r0[0] + fx * (r0[1] - r0[0]);
+      const float bottom = r1[0] + fx * (r1[1] - r1[0]);
+      scratch.correlated_px[static_cast<size_t>(v) * width + u] = gain * (top + fy * (bottom - top));
+    }
+  }
+  scratch.correlated_key = key;
+}
+
+/// The 4-neighbour across the largest true-disparity step above `jump_px`, or -1: the pixel
+/// then lies on no depth edge.
+inline ptrdiff_t edge_neighbour(const float* d, int u, int v, int width, int height, size_t i, float jump_px) {
+  const float di = d[i];
+  float best = jump_px;
+  ptrdiff_t j = -1;
+  const auto consider = [&](ptrdiff_t k) {
+    const float step = std::abs(d[k] - di);
+    if (step > best) {
+      best = step;
+      j = k;
+    }
+  };
+  if (u > 0) consider(static_cast<ptrdiff_t>(i) - 1);
+  if (u + 1 < width) consider(static_cast<ptrdiff_t>(i) + 1);
+  if (v > 0) consider(static_cast<ptrdiff_t>(i) - width);
+  if (v + 1 < height) consider(static_cast<ptrdiff_t>(i) + width);
+  return j;
+}
+
+/// Whether a material patch drops this pixel (fixed per seed; patches of cell × cell pixels).
+inline bool material_drop(const SimParams& p, uint8_t material, int u, int v, int width, uint64_t seed) {
+  const int cell = std::max(1, p.material_cell_px);
+  const uint64_t cells_x = static_cast<uint64_t>((width + cell - 1) / cell);
+  const uint64_t c = static_cast<uint64_t>(v / cell) * cells_x + static_cast<uint64_t>(u / cell);
+  const uint64_t h = mix64(seed + c * kGolden);
+  return ((material & kDarkBit) != 0 && unit24(h, 0) < p.dark_dropout) ||
+         ((material & kShinyBit) != 0 && unit24(h, 20) < p.shiny_dropout) ||
+         ((material & kLowTextureBit) != 0 && unit24(h, 40) < p.low_texture_dropout);
+}
+
+/// Isolated random dropouts, new every frame: the gaps between them are geometric, so the
+/// cost is per dropout, not per pixel.
+class SpeckleStream {
+ public:
+  SpeckleStream(uint64_t seed, float rate) : state_(seed), rate_(rate) {
+    log_keep_ = rate > 0.0F && rate < 1.0F ? std::log1p(-static_cast<double>(rate)) : 0.0;
+  }
+  /// The first dropped pixel (max() when none).
+  size_t first() { return rate_ > 0.0F ? gap() : kNone; }
+  /// The dropped pixel after pixel i.
+  size_t after(size_t i) { return i + 1 + gap(); }
+
+ private:
+  static constexpr size_t kNone = std::numeric_limits<size_t>::max() / 2;
+  size_t gap() {
+    if (rate_ >= 1.0F) return 0;
+    state_ += kGolden;
+    const double u = (static_cast<double>(mix64(state_) >> 11) + 0.5) * 0x1.0p-53;
+    const double g = std::floor(std::log(u) / log_keep_);
+    return g < 1e15 ? static_cast<size_t>(g) : kNone;
+  }
+  uint64_t state_;
+  float rate_;
+  double log_keep_ = 0.0;
+};
+
+/// Noisy disparity → raw depth: add σ·g, quantise to the disparity step, Z = fx·B / d, round
+/// to the depth unit. 0 when the noisy disparity is not positive or the depth out of range.
+struct NoisyDepth {
+  float fxb;
+  float sigma_px;
+  float step_px;    ///< 0: no quantisation
+  float inv_step;   ///< 1 / step_px
+  float inv_scale;
+  uint16_t operator()(float d, float g) const {
+    d += sigma_px * g;
+    // Round to the nearest step. Truncation is floor for x ≥ 0, and for x < 0 both give a
+    // disparity ≤ 0, which has no depth either way; it avoids a libm call per pixel.
+    // |d| < 2^31 · step for any surface farther than a micrometre.
+    if (step_px > 0.0F) d = static_cast<float>(static_cast<int32_t>(d * inv_step + 0.5F)) * step_px;
+    const float r = fxb / d * inv_scale + 0.5F;
+    return d > 0.0F && r >= 1.0F && r < 65536.0F ? static_cast<uint16_t>(r) : 0;
+  }
+};
+
+/// Pixels beside a depth edge: a fixed share drops out, a fixed share of the far side flies
+/// (the matching window straddles the edge and takes in the nearer surface, whose texture
+/// dominates it, so the disparity lands between the two; the near side keeps its own).
+/// Fixed per pixel and seed, so that a still scene has still holes.
+void apply_edges(const SimParams& p, int width, int height, const float* d_true, const float* correlated,
+                 const float* g, const uint8_t* hidden, const NoisyDepth& to_raw, uint16_t* raw) {
+  const uint64_t fixed_seed = mix64(p.seed ^ kFixedSalt);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const size_t i = static_cast<size_t>(v) * width + u;
+      if (hidden[i] != 0 || !(d_true[i] > 0.0F)) continue;
+      const ptrdiff_t j = edge_neighbour(d_true, u, v, width, height, i, p.edge_jump_px);
+      if (j < 0) continue;
+      const uint64_t h = mix64(fixed_seed + i * kGolden);
+      if (unit24(h, 0) < p.edge_dropout) {
+        raw[i] = 0;
+      } else if (d_true[j] > d_true[i] && unit24(h, 24) < p.flying_pixels) {
+        const float d = d_true[i] + unit24(h, 40) * (d_true[j] - d_true[i]);
+        raw[i] = to_raw(d + (correlated != nullptr ? correlated[i] : 0.0F), g[i]);
+      }
+    }
+  }
+}
+
+/// Dark, shiny and low-texture surfaces drop out in patches, fixed per seed.
+void apply_materials(const SimParams& p, int width, int height, const uint16_t* ids, const uint8_t* material_of_id,
+                     uint16_t* raw) {
+  const uint64_t material_seed = mix64(p.seed ^ kMaterialSalt);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const size_t i = static_cast<size_t>(v) * width + u;
+      const uint8_t material = material_of_id[ids[i]];
+      if (material != 0 && raw[i] != 0 && material_drop(p, material, u, v, width, material_seed)) raw[i] = 0;
+    }
+  }
+}
+
+}  // namespace
+
+float sensor_min_range_m(const SimParams& p, float fx_px) {
+  if (p.min_range_m > 0.0F) return p.min_range_m;
+  if (!(p.max_disparity_px > 0.0F)) return 0.0F;
+  return fx_px * p.baseline_mm * 1e-3F / p.max_disparity_px;
+}
+
+void write_sensor_depth(const SimParams& p, float fx_px, int64_t index, const float* z_m, SimScratch& scratch,
+                        DepthImage& depth) {
+  const int width = depth.width;
+  const int height = depth.height;
+  const size_t n = static_cast<size_t>(width) * height;
+  const float fxb = fx_px * p.baseline_mm * 1e-3F;  // pixels · metres
+  scratch.disparity_px.resize(n);
+  scratch.hidden.resize(n);
+  const float min_range = sensor_min_range_m(p, fx_px);
+  const float max_disparity = min_range > 0.0F ? fxb / min_range : std::numeric_limits<float>::infinity();
+  compute_disparity(z_m, fxb, n, scratch.disparity_px.data());
+  mark_hidden(p, max_disparity, width, height, scratch.disparity_px.data(), scratch.hidden.data());
+
+  const float inv_scale = 1.0F / p.depth_scale_m;
+  const uint64_t frame_seed = mix64(mix64(p.seed) ^ (static_cast<uint64_t>(index) * kGolden));
+  uint16_t* raw = depth.pixels.data();
+  if (!p.noise) {
+    // Exact depth, rounded to the unit, where the stereo geometry gives any.
+    for (size_t i = 0; i < n; ++i) {
+      const float r = z_m[i] * inv_scale + 0.5F;
+      const bool ok = scratch.disparity_px[i] > 0.0F && scratch.hidden[i] == 0 && r >= 1.0F && r < 65536.0F;
+      raw[i] = ok ? static_cast<uint16_t>(r) : 0;
+    }
+    return;
+  }
+  // One draw per pixel, hit or not, so that a pixel's noise does not depend on the scene.
+  scratch.normal_draws.resize(n);
+  NormalStream normal(frame_seed);
+  for (size_t i = 0; i < n; ++i) scratch.normal_draws[i] = normal.next();
+  ensure_correlated(p, width, height, scratch);
+  const float* correlated = p.correlated_noise_px > 0.0F ? scratch.correlated_px.data() : nullptr;
+  const float step = p.disparity_step_px;
+  const NoisyDepth to_raw{fxb, p.disparity_noise_px, step, step > 0.0F ? 1.0F / step : 0.0F, inv_scale};
+  // Dense pass, branch-free so that it vectorises: every visible pixel gets its noisy depth.
+  const float* d_true = scratch.disparity_px.data();
+  const float* g = scratch.normal_draws.data();
+  const uint8_t* hidden = scratch.hidden.data();
+  if (correlated != nullptr || !(step > 0.0F)) {
+    for (size_t i = 0; i < n; ++i) {
+      const uint16_t r = to_raw(d_true[i] + (correlated != nullptr ? correlated[i] : 0.0F), g[i]);
+      raw[i] = d_true[i] > 0.0F && hidden[i] == 0 ? r : 0;
+    }
+  } else {
+    // The default: quantised, no correlated part. Written out so that it vectorises.
+    const float sigma = p.disparity_noise_px;
+    const float inv_step = 1.0F / step;
+    for (size_t i = 0; i < n; ++i) {
+      const float d = static_cast<float>(static_cast<int32_t>((d_true[i] + sigma * g[i]) * inv_step + 0.5F)) * step;
+      const float r = fxb / d * inv_scale + 0.5F;
+      const bool ok = d_true[i] > 0.0F && hidden[i] == 0 && d > 0.0F && r >= 1.0F && r < 65536.0F;
+      raw[i] = ok ? static_cast<uint16_t>(r) : 0;
+    }
+  }
+  // Sparse fix-ups. Flying pixels first (they re-compute a value); dropouts only ever zero one.
+  apply_edges(p, width, height, d_true, correlated, g, hidden, to_raw, raw);
+  apply_materials(p, width, height, scratch.object_ids.data(), scratch.material_of_id.data(), raw);
+  SpeckleStream speckle(mix64(frame_seed ^ kSpeckleSalt), p.speckle);
+  for (size_t i = speckle.first(); i < n; i = speckle.after(i)) raw[i] = 0;
+}
+
+}  // namespace hrcsense::sim_detail

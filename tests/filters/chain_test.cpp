@@ -1,0 +1,115 @@
+// SPDX-License-Identifier: Apache-2.0
+// The chain: block names, presets, order checks, the depth-domain fallback without a baseline,
+// decimated intrinsics, and repeatability after a reset.
+#include "hrcsense/filters.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace hrcsense {
+namespace {
+
+Frame noisy_frame(uint32_t seed, float baseline_mm) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.0F, 4.0F);
+  Frame f;
+  f.depth.resize(64, 48);
+  for (int v = 0; v < 48; ++v)
+    for (int u = 0; u < 64; ++u)
+      f.depth.pixels[static_cast<size_t>(v) * 64 + u] =
+          (u * 7 + v * 3) % 23 == 0 ? 0 : static_cast<uint16_t>((u < 32 ? 1000.0F : 1500.0F) + noise(rng));
+  f.intrinsics.width = 64;
+  f.intrinsics.height = 48;
+  f.intrinsics.fx = f.intrinsics.fy = 60.0F;
+  f.intrinsics.ppx = 32.0F;
+  f.intrinsics.ppy = 24.0F;
+  f.stereo_baseline_mm = baseline_mm;
+  return f;
+}
+
+TEST(FilterChain, NamesRoundTrip) {
+  for (const FilterBlock block : kFilterBlocks) EXPECT_EQ(filter_block_from_name(filter_block_name(block)), block);
+  EXPECT_FALSE(filter_block_from_name("median"));
+}
+
+TEST(FilterChain, Presets) {
+  EXPECT_TRUE(filter_preset("none")->order.empty());
+  const FilterChainParams sdk = *filter_preset("sdk");
+  EXPECT_EQ(sdk.order.size(), 6U);
+  EXPECT_EQ(sdk.decimation.magnitude, 2);
+  EXPECT_EQ(sdk.threshold.min_m, 0.1F);
+  const FilterChainParams thesis = *filter_preset("thesis");
+  EXPECT_EQ(thesis.spatial.alpha, 0.4F);
+  EXPECT_EQ(thesis.temporal.persistence, 3);
+  EXPECT_FALSE(filter_preset("fast"));
+  for (const char* name : {"none", "sdk", "thesis"}) EXPECT_EQ(check_filter_order(filter_preset(name)->order), "");
+}
+
+TEST(FilterChain, OrderChecks) {
+  using B = FilterBlock;
+  EXPECT_EQ(check_filter_order({B::spatial, B::spatial}), "spatial appears twice");
+  EXPECT_EQ(check_filter_order({B::to_depth}), "to_depth must follow to_disparity");
+  EXPECT_EQ(check_filter_order({B::to_disparity, B::spatial}), "to_disparity must be followed by to_depth");
+  EXPECT_NE(check_filter_order({B::to_disparity, B::decimation, B::to_depth}), "");
+  EXPECT_EQ(check_filter_order({B::to_disparity, B::hole_filling, B::to_depth, B::threshold}), "");
+}
+
+TEST(FilterChain, WithoutBaselineRunsInTheDepthDomain) {
+  FilterChain chain;
+  chain.params = *filter_preset("thesis");
+  Frame out;
+  chain.process(noisy_frame(1, 0.0F), out);
+  EXPECT_FALSE(chain.disparity_domain());
+  ASSERT_EQ(chain.block_count(), 2U);
+  EXPECT_EQ(chain.block(0), FilterBlock::spatial);
+  EXPECT_EQ(chain.block(1), FilterBlock::temporal);
+  // Same as running the two blocks by hand on depth.
+  Frame in = noisy_frame(1, 0.0F);
+  spatial_filter(chain.params.spatial, in.depth);
+  TemporalFilter temporal;
+  temporal.params = chain.params.temporal;
+  temporal.apply(in.depth);
+  EXPECT_EQ(out.depth.pixels, in.depth.pixels);
+  chain.process(noisy_frame(2, 50.0F), out);
+  EXPECT_TRUE(chain.disparity_domain());
+  EXPECT_EQ(chain.block_count(), 4U);
+}
+
+TEST(FilterChain, DecimationScalesTheFramesIntrinsics) {
+  FilterChain chain;
+  chain.params = *filter_preset("sdk");
+  Frame out;
+  chain.process(noisy_frame(3, 50.0F), out);
+  EXPECT_EQ(out.depth.width, 32);
+  EXPECT_EQ(out.depth.height, 24);
+  EXPECT_EQ(out.intrinsics.width, 32);
+  EXPECT_EQ(out.intrinsics.fx, 30.0F);
+  EXPECT_EQ(out.intrinsics.ppy, 12.0F);
+}
+
+TEST(FilterChain, ResetGivesIdenticalOutputAndNoFilterInvalidatesValidPixels) {
+  FilterChain chain;
+  chain.params = *filter_preset("thesis");
+  chain.params.order.push_back(FilterBlock::hole_filling);
+  std::vector<std::vector<uint16_t>> first;
+  Frame out;
+  for (uint32_t seed = 0; seed < 5; ++seed) {
+    const Frame in = noisy_frame(seed, 50.0F);
+    chain.process(in, out);
+    for (size_t i = 0; i < in.depth.pixels.size(); ++i) {
+      if (in.depth.pixels[i] != 0) {
+        ASSERT_NE(out.depth.pixels[i], 0) << i;
+      }
+    }
+    first.push_back(out.depth.pixels);
+  }
+  chain.reset();
+  for (uint32_t seed = 0; seed < 5; ++seed) {
+    chain.process(noisy_frame(seed, 50.0F), out);
+    EXPECT_EQ(out.depth.pixels, first[seed]);
+  }
+}
+
+}  // namespace
+}  // namespace hrcsense
