@@ -14,6 +14,18 @@ using test::expected_distance_m;
 using test::fake_params;
 using test::fill_frame;
 
+/// The background a pipeline learns from the empty fake scene.
+BackgroundModel learn_empty_background() {
+  Pipeline learner(fake_params());
+  Frame frame;
+  FrameResult result;
+  for (int i = 0; i < test::kLearnFrames; ++i) {
+    fill_frame(i, 0.0F, frame);
+    learner.process(frame, result);
+  }
+  return learner.background();
+}
+
 TEST(Pipeline, LearnsThenMeasuresTheObject) {
   Pipeline pipeline(fake_params());
   Frame frame;
@@ -99,16 +111,12 @@ TEST(Pipeline, CopiesTruthAndClearsItAgain) {
 
 TEST(Pipeline, PresetBackgroundSkipsLearning) {
   // Learn in one pipeline, hand the model to another: its first frame is already valid.
-  Pipeline learner(fake_params());
+  const BackgroundModel background = learn_empty_background();
   Frame frame;
   FrameResult result;
-  for (int i = 0; i < test::kLearnFrames; ++i) {
-    fill_frame(i, 0.0F, frame);
-    learner.process(frame, result);
-  }
   Pipeline pipeline(fake_params());
   EXPECT_FALSE(pipeline.background_ready());
-  pipeline.set_background(learner.background());
+  pipeline.set_background(background);
   EXPECT_TRUE(pipeline.background_ready());
   fill_frame(0, 0.3F, frame);
   pipeline.process(frame, result);
@@ -119,17 +127,13 @@ TEST(Pipeline, PresetBackgroundSkipsLearning) {
 
 // No robot to measure against must not read as "nothing near the robot".
 TEST(Pipeline, EmptyRobotModelIsStop) {
-  Pipeline learner(fake_params());
+  const BackgroundModel background = learn_empty_background();
   Frame frame;
   FrameResult result;
-  for (int i = 0; i < test::kLearnFrames; ++i) {
-    fill_frame(i, 0.0F, frame);
-    learner.process(frame, result);
-  }
   PipelineParams params = fake_params();
   params.robot.capsules.clear();
   Pipeline pipeline(params);
-  pipeline.set_background(learner.background());
+  pipeline.set_background(background);
   fill_frame(0, 0.0F, frame);  // an empty cell: without the rule this would be run
   pipeline.process(frame, result);
   EXPECT_FALSE(result.valid);
