@@ -11,6 +11,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <filesystem>
@@ -36,13 +37,15 @@ extern "C" void on_sigint(int /*signal*/) {
 }
 
 // Loads background.path when it exists. Returns false when there is nothing to load.
+// The background is at the filtered resolution (after decimation), not the source's.
 bool load_background_file(const Config& config, const SourceInfo& info, Pipeline& pipeline) {
   if (config.background_path.empty() || !std::filesystem::exists(config.background_path)) return false;
   BackgroundModel model = load_background(config.background_path);  // IoError: damaged file
-  if (model.width != info.intrinsics.width || model.height != info.intrinsics.height) {
+  const Intrinsics filtered = filtered_intrinsics(config.pipeline.filters, info.intrinsics);
+  if (model.width != filtered.width || model.height != filtered.height) {
     throw IoError(config.background_path + ": background is " + std::to_string(model.width) + "x" +
-                  std::to_string(model.height) + " but the source is " + std::to_string(info.intrinsics.width) +
-                  "x" + std::to_string(info.intrinsics.height));
+                  std::to_string(model.height) + " but the filtered source is " + std::to_string(filtered.width) +
+                  "x" + std::to_string(filtered.height) + " (filters.preset " + config.filters_preset + ")");
   }
   pipeline.set_background(std::move(model));
   return true;
@@ -58,6 +61,23 @@ void save_learnt_background(const Config& config, const Pipeline& pipeline) {
   if (!parent.empty()) std::filesystem::create_directories(parent);
   save_background(config.background_path, pipeline.background());
   spdlog::info("background saved to {}", config.background_path);
+}
+
+// What the JSON Lines header says about the filters; the note explains a depth-domain run of a
+// chain that asks for disparity.
+RunHeader::Filters describe_filters(const Config& config, const SourceInfo& info) {
+  RunHeader::Filters filters;
+  const FilterChainParams& chain = config.pipeline.filters;
+  filters.preset = config.filters_preset;
+  filters.domain = filter_domain(chain, info.stereo_baseline_mm);
+  const bool wants_disparity =
+      std::find(chain.order.begin(), chain.order.end(), FilterBlock::to_disparity) != chain.order.end();
+  if (wants_disparity && filters.domain == "depth") {
+    filters.note = "no stereo baseline: to_disparity/to_depth skipped, spatial and temporal run on depth "
+                   "(set source.stereo_baseline_mm)";
+  }
+  filters.intrinsics = filtered_intrinsics(chain, info.intrinsics);
+  return filters;
 }
 
 }  // namespace
@@ -89,6 +109,8 @@ int run_command(const CommandArgs& args) {
   header.commit = HRCSENSE_COMMIT;
   header.config_hash = config_hash(config);
   header.source = info;
+  header.filters = describe_filters(config, info);
+  if (!header.filters.note.empty()) spdlog::warn("filters: {}", header.filters.note);
 
   RunOptions options;
   options.pace = config.source.pace;

@@ -155,6 +155,15 @@ struct FilterChainParams {
 /// "thesis" (the 2020 thesis's settings). nullopt for an unknown name.
 std::optional<FilterChainParams> filter_preset(std::string_view name);
 
+/// The intrinsics of the chain's output for a source with intrinsics `source`: decimation
+/// scales them, the other blocks keep them. This is the resolution the pipeline learns its
+/// background at and the image that Contact::pixel indexes.
+Intrinsics filtered_intrinsics(const FilterChainParams& params, const Intrinsics& source);
+
+/// Where the chain's smoothing blocks run for a source with this stereo baseline: "none" (empty
+/// chain), "disparity", or "depth" (no to_disparity in the order, or no baseline to convert with).
+const char* filter_domain(const FilterChainParams& params, float stereo_baseline_mm);
+
 /// Why `order` cannot run, or empty when it can: a block twice, threshold or decimation
 /// inside the disparity domain, to_depth without to_disparity before it or the reverse.
 std::string check_filter_order(const std::vector<FilterBlock>& order);

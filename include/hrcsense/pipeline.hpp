@@ -58,6 +58,14 @@ struct RunHeader {
   std::string commit;
   std::string config_hash;
   SourceInfo source;
+  /// The depth filters as they run: `filters.preset`, the domain of filter_domain(), a note
+  /// when the domain is not the one the preset asks for, and the filtered resolution.
+  struct Filters {
+    std::string preset;    ///< empty: not written (no configuration, e.g. in tests)
+    std::string domain;    ///< "none", "disparity" or "depth"
+    std::string note;      ///< e.g. why there is no disparity domain; empty for none
+    Intrinsics intrinsics; ///< of the filtered image (background, Contact::pixel)
+  } filters;
 };
 
 /// Totals written once at the end.
@@ -160,7 +168,10 @@ struct PipelineParams {
   BackgroundParams background;
   ForegroundParams foreground;
   SafetyParams safety;
+  /// `proximity.backend`: brute, kdtree, octree or auto (depth_space later); the pipeline throws
+  /// std::invalid_argument for another name.
   std::string backend = "brute";
+  ProximityParams proximity;  ///< octree height, brute threads
 };
 
 /// The per-frame processing path, single-threaded: background → foreground → proximity →
@@ -188,6 +199,7 @@ class Pipeline {
   ForegroundExtractor extractor_;
   Foreground foreground_;
   FilterChain filters_;  ///< params_.filters; its temporal state spans frames
+  ProximitySearch proximity_;  ///< params_.backend with its reusable search buffers
   Frame filtered_;       ///< the filtered copy of the current frame (buffers reused)
 };
 

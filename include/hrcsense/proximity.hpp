@@ -1,8 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — proximity: the foreground point closest to the robot.
+// hrcsense — proximity: the foreground point closest to the robot's capsules (docs/PROXIMITY.md).
 #pragma once
 
 #include "hrcsense/types.hpp"
+
+#include <memory>
+#include <optional>
+#include <string_view>
 
 namespace hrcsense {
 
@@ -11,11 +15,60 @@ namespace hrcsense {
 float point_capsule_distance(const Eigen::Vector3f& p, const Capsule& capsule,
                              Eigen::Vector3f* closest_on_capsule = nullptr);
 
-/// Exact closest contact by brute force over every point and capsule.
-/// `points_base` in the base frame; `points_camera` (same order) fills Contact::closest_camera
-/// and may be empty. Ties: the lowest point index wins, then the lowest capsule index.
-/// Returns an invalid contact when the cloud or the robot is empty.
+/// Exact closest contact by brute force over every point and capsule, single-threaded, with
+/// no state kept between calls. `points_base` in the base frame; `points_camera` (same order)
+/// fills Contact::closest_camera and may be empty. Ties: the smallest float distance, then the
+/// lowest point index, then the lowest capsule index (the rule every backend follows).
+/// Returns an invalid contact when the cloud or the robot is empty or no point is finite.
 Contact closest_contact_brute(const PointCloud& points_base, const PointCloud& points_camera,
                               const RobotModel& robot);
+
+/// The search structures; all are exact and give the same contact (docs/PROXIMITY.md).
+enum class ProximityBackend {
+  brute,      ///< vectorised scan in blocks, pruned by block boxes; optionally two threads
+  kdtree,     ///< nanoflann's kd-tree, rebuilt per frame, with an exact capsule traversal
+  octree,     ///< hrcsense's own octree, rebuilt per frame into reused buffers
+  automatic,  ///< picks one by cloud size (config name "auto")
+};
+
+/// "brute", "kdtree", "octree" or "auto"; nullopt for anything else.
+std::optional<ProximityBackend> parse_proximity_backend(std::string_view name);
+/// The configuration name of a backend (static string).
+const char* proximity_backend_name(ProximityBackend backend);
+
+/// Tuning of the search; which backend is chosen separately (ProximitySearch's constructor).
+struct ProximityParams {
+  int octree_height = 8;  ///< octree depth, 1-10 (`proximity.octree.height`); leaves hold >= 1 point
+  int threads = 1;        ///< brute only: 1, or 2 for a second worker thread on large clouds
+};
+
+/// One backend with its reusable state: after the first frame of a given size no backend but
+/// kdtree allocates (nanoflann frees and re-allocates its tree nodes at every build).
+/// Not thread-safe; one instance per pipeline.
+class ProximitySearch {
+ public:
+  /// Throws std::invalid_argument for an octree height outside 1-10 or threads outside 1-2.
+  explicit ProximitySearch(ProximityBackend backend = ProximityBackend::brute, ProximityParams params = {});
+  ~ProximitySearch();
+  ProximitySearch(ProximitySearch&&) noexcept;
+  ProximitySearch& operator=(ProximitySearch&&) noexcept;
+  ProximitySearch(const ProximitySearch&) = delete;
+  ProximitySearch& operator=(const ProximitySearch&) = delete;
+
+  /// The exact closest contact; arguments and result as closest_contact_brute. The cloud is
+  /// new every frame: trees are rebuilt at every call.
+  Contact closest(const PointCloud& points_base, const PointCloud& points_camera, const RobotModel& robot);
+
+  /// The backend the last call used (for `auto`, the one it picked); the configured one before.
+  ProximityBackend last_backend() const { return last_backend_; }
+  ProximityBackend backend() const { return backend_; }
+
+ private:
+  struct State;
+  ProximityBackend backend_;
+  ProximityBackend last_backend_;
+  ProximityParams params_;
+  std::unique_ptr<State> state_;
+};
 
 }  // namespace hrcsense

@@ -50,7 +50,7 @@ struct RecordingParams {
   std::string path;                 ///< folder or .bag file
   bool loop = false;                ///< start over at the end (indices and timestamps keep rising)
   float stereo_baseline_mm = 0.0F;  ///< used when the recording does not carry a baseline
-  bool with_color = false;          ///< bag: also decode colour frames into Frame::color
+  bool with_color = false;          ///< also decode colour frames into Frame::color (bag, folder)
 };
 
 /// A folder of depth PNGs. Two layouts:
@@ -61,6 +61,10 @@ struct RecordingParams {
 /// `intrinsics.json` is either hrcsense's own format (io.hpp) or {"width", "height",
 /// "depth_K": 3x3, "depth_units_m", "pixel_convention"}; a 1-based pixel convention is turned
 /// into hrcsense's 0-based one (ppx, ppy minus 1).
+/// Colour (decoded only with `with_color`): .png or .jpg/.jpeg images named in the third column
+/// of frames.txt, else `rgb/<depth file stem>.*`; TUM: `rgb.txt`, the image nearest in time
+/// (within 20 ms). The datasets' optional `rgb_K`, `depth_to_rgb_R` and `depth_to_rgb_T_m` give
+/// Frame::color_intrinsics and Frame::depth_to_color.
 class FolderSource : public Source {
  public:
   /// Lists the frames and reads the intrinsics; throws IoError naming the file when the folder,
@@ -68,7 +72,8 @@ class FolderSource : public Source {
   explicit FolderSource(RecordingParams params);
   SourceInfo info() const override;
   /// A PNG that cannot be read, or whose size or bit depth differs from the intrinsics, is an
-  /// error naming the file and frame; every later call repeats it.
+  /// error naming the file and frame; every later call repeats it. So is a damaged colour image
+  /// (when decoded), or a JPEG in a build without libturbojpeg.
   Status next(Frame& out) override;
   std::string error() const override { return error_; }
 
@@ -78,6 +83,8 @@ class FolderSource : public Source {
   const std::vector<std::string>& depth_files() const { return files_; }
   /// Recorded timestamps (ns), one per file; empty when the folder has none.
   const std::vector<int64_t>& timestamps_ns() const { return stamps_ns_; }
+  /// The colour image of each depth file ("" where there is none); empty when the folder has no colour.
+  const std::vector<std::string>& color_files() const { return color_files_; }
 
  private:
   RecordingParams params_;
@@ -86,6 +93,9 @@ class FolderSource : public Source {
   float depth_scale_m_ = 0.001F;
   std::vector<std::string> files_;
   std::vector<int64_t> stamps_ns_;
+  std::vector<std::string> color_files_;
+  Intrinsics color_intrinsics_;                 ///< width 0 until an image gives the size; fx 0: unknown
+  std::optional<Extrinsics> depth_to_color_;
   int64_t played_ = 0;
   std::string error_;
 };

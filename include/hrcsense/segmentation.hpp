@@ -11,23 +11,51 @@
 
 namespace hrcsense {
 
-/// What the background model learns per pixel from the first frames.
+/// What the background model learns per pixel from the first frames. A pixel is "reliable"
+/// when it was valid in at least BackgroundParams::min_valid_ratio of the learning frames.
 struct BackgroundModel {
   int width = 0;
   int height = 0;
-  std::vector<float> mean_m;       ///< mean depth over the valid samples; 0 if never valid
-  std::vector<float> spread_m;     ///< standard deviation over the valid samples
+  /// Background depth the foreground test compares with: a reliable pixel's mean over its valid
+  /// samples; for an unreliable pixel the smallest mean among the reliable pixels closest to it
+  /// in the image, within fill_radius_px (its own few samples are never used); 0 (unknown) when
+  /// there is none, and where the pixel was never valid in a long batch (unseen_min_frames).
+  std::vector<float> mean_m;
+  /// Depth noise: a reliable pixel's standard deviation over its valid samples, raised to the
+  /// learnt noise floor where the camera has no stereo noise model; for an unreliable pixel the
+  /// spread of the pixel its mean came from.
+  std::vector<float> spread_m;
   std::vector<float> valid_ratio;  ///< share of learning frames with a valid sample, 0..1
 };
 
 struct BackgroundParams {
   int frames = 100;                  ///< frames to learn from
-  /// A pixel "moves" while learning when its spread exceeds
-  /// max(moving_k_sigma · σ_model(z), moving_min_spread_m).
+  /// A reliable pixel "moves" while learning when its spread exceeds
+  /// max(moving_k_sigma · σ_noise(z), moving_min_spread_m); σ_noise is the stereo model with a
+  /// baseline, else the noise floor learnt from the batch (BackgroundLearner).
   float moving_k_sigma = 6.0F;
   float moving_min_spread_m = 0.03F;  ///< metres
-  /// Learning refuses to finish while more than this share of valid pixels moves.
+  /// Learning refuses to finish while more than this share of reliable pixels moves.
   float max_moving_share = 0.002F;
+  /// Motion must be at least this wide (px, odd): moving pixels count only when every pixel of
+  /// the square around them moved too, so that flickering depth edges and single noisy pixels
+  /// are not motion. 1 counts every moving pixel.
+  int motion_min_width_px = 3;
+  /// Pixels valid in fewer than this share of the learning frames are unreliable: they are
+  /// neither motion nor background of their own (0..1).
+  float min_valid_ratio = 0.5F;
+  /// An unreliable pixel takes the background of the reliable pixels closest to it when they
+  /// are at most this many pixels away (8-connected steps); beyond, its background stays unknown.
+  int fill_radius_px = 16;
+  /// A pixel never valid in a batch of at least this many frames cannot be measured there (a
+  /// shiny or dark surface, out of range): its background stays unknown, so that anything
+  /// measured there later counts (ForegroundParams::workspace_base). In shorter batches "never
+  /// valid" is weak evidence (a pixel valid a third of the time misses 3 frames in 30 % of
+  /// batches), and such pixels are filled like the other unreliable ones.
+  int unseen_min_frames = 10;
+  /// Upper bound of the learnt noise σ / z² (1/m): 1 cm at 1 m, 25 cm at 5 m, above any depth
+  /// camera's; a larger median spread means that most of the view moved, not noise.
+  float max_noise_per_z2 = 0.01F;
   /// Stereo noise model used for σ_model(z) (subpixel RMS in px; baseline from the frame).
   float subpixel_rms_px = 0.08F;
 };
@@ -48,14 +76,24 @@ struct BackgroundLearner {
   /// Why learning last restarted; empty if it never did.
   const std::string& message() const { return message_; }
   int frames_seen() const { return count_; }
+  /// The depth noise σ / z² (1/m) the last completed batch was judged with: the stereo model's
+  /// with a baseline, else learnt from the batch; 0 before the first batch.
+  double noise_per_z2() const { return noise_per_z2_; }
 
  private:
   std::vector<double> sum_, sum_sq_;
   std::vector<uint32_t> valid_count_;
   int count_ = 0;
   bool ready_ = false;
+  double noise_per_z2_ = 0.0;
   BackgroundModel model_;
   std::string message_;
+  // Scratch of the batch summary, sized with the image: spread / mean² samples for the noise
+  // median, the moving mask and its erosion, and the fill's queue and distance per pixel.
+  std::vector<float> ratios_;
+  std::vector<uint8_t> moving_, eroded_;
+  std::vector<int32_t> fill_queue_;
+  std::vector<uint16_t> fill_layer_;
 };
 
 /// Axis-aligned box in the base frame.

@@ -1,12 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — a simulated D435: a scene of planes, boxes, spheres and capsules, ray-cast into a
-// 16-bit depth image with the D435's stereo artefacts (docs/SIMULATOR.md), plus ground truth.
+// 16-bit depth image with the D435's stereo artefacts (docs/SIMULATOR.md), a flat-shaded rgb8
+// image from the D435's colour camera, plus ground truth.
 #pragma once
 
 #include "hrcsense/camera.hpp"
 #include "hrcsense/types.hpp"
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,7 +53,15 @@ struct SceneObject {
   int64_t last_frame = -1;        ///< last frame in which it exists; -1: until the end
   std::vector<Waypoint> path;     ///< empty: never moves; else linear interpolation, held at the ends
   Material material;              ///< default: a well-textured matte surface
+  /// Flat colour in the colour image, 8-bit RGB; unset: kSimPalette[object index % size].
+  std::optional<std::array<uint8_t, 3>> color_rgb;
 };
+
+/// Colours of objects that set none, by object index: distinct, so that every object stands out.
+inline constexpr std::array<std::array<uint8_t, 3>, 8> kSimPalette{{
+    {178, 178, 170}, {120, 144, 160}, {196, 170, 120}, {90, 110, 90},
+    {220, 80, 60}, {60, 120, 220}, {230, 190, 40}, {150, 80, 170},
+}};
 
 /// The simulated camera and its D435 effects. Defaults are the D435's and are pinned in
 /// docs/SIMULATOR.md. `noise` switches every random effect at once (disparity noise and its
@@ -81,6 +92,12 @@ struct SimParams {
   float speckle = 0.002F;            ///< share of pixels dropped at random, new every frame
   float correlated_noise_px = 0.0F;  ///< σ of a smooth disparity error fixed per seed; 0: off
   int correlated_cell_px = 32;       ///< correlation length of that error, pixels (≥ 2)
+  bool color = true;                 ///< also render the colour camera (Frame::color)
+  int color_width = 0;               ///< colour resolution; 0: the depth resolution
+  int color_height = 0;
+  /// Depth → colour translation, metres (the colour camera's extrinsics, rotation identity).
+  /// Default: the test D435i of specs/d435-sensor-model.md §2.
+  Eigen::Vector3f color_translation_m{0.01508F, 0.0000046F, 0.00017F};
 };
 
 /// A scene: objects plus the camera's pose in the base frame.
@@ -88,22 +105,31 @@ struct Scene {
   std::vector<SceneObject> objects;
 };
 
+/// Per-pixel rays of a camera at unit depth (x/z, y/z), recomputed when its intrinsics change.
+struct SimRays {
+  Intrinsics intrinsics;           ///< what the rays were computed for; width 0: not yet
+  std::vector<float> x;            ///< per pixel: x/z of the pixel's ray, camera frame
+  std::vector<float> y;            ///< per pixel: y/z of the pixel's ray, camera frame
+};
+
 /// Buffers a Simulator reuses between frames so that rendering does not allocate after the
 /// first frame. Derived data only: never part of the scene, safe to copy or to leave empty.
 struct SimScratch {
-  int width = 0;                   ///< size the rays were computed for; 0: not yet
-  int height = 0;
-  std::vector<float> ray_x;        ///< per pixel: x/z of the pixel's ray, camera frame
-  std::vector<float> ray_y;        ///< per pixel: y/z of the pixel's ray, camera frame
+  SimRays rays;                    ///< the depth camera's
+  SimRays color_rays;              ///< the colour camera's
+  std::vector<float> color_z_m;    ///< colour camera z-buffer
+  std::vector<uint16_t> color_ids; ///< per colour pixel: 1 + index of the object hit, 0: nothing
   std::vector<Shape> shapes_base;  ///< this frame's existing shapes, moved along their paths
   std::vector<uint16_t> shape_labels;  ///< label of each entry of shapes_base
   std::vector<uint16_t> shape_ids;     ///< 1 + scene object index of each entry of shapes_base
   std::vector<uint16_t> object_ids;    ///< per pixel: 1 + index of the object hit, 0: nothing
   std::vector<uint16_t> label_of_id;   ///< label per object id (index 0: nothing hit)
   std::vector<uint8_t> material_of_id; ///< Material as bits (1 dark, 2 shiny, 4 low texture) per id
+  std::vector<std::array<uint8_t, 3>> color_of_id;  ///< RGB per object id (index 0: nothing hit, black)
   std::vector<float> disparity_px;     ///< per pixel: noise-free disparity fx·B/Z, 0: nothing hit
   std::vector<uint8_t> hidden;         ///< per pixel: 1 where the stereo geometry gives no depth
   std::vector<float> normal_draws;     ///< this frame's N(0, 1) draw per pixel
+  std::vector<uint8_t> row_steps;      ///< per pixel of a row: a large step to a neighbour
   std::vector<float> correlated_px;    ///< fixed correlated disparity error (empty when off)
   uint64_t correlated_key = 0;         ///< what correlated_px was computed for
   PointCloud points_base;          ///< noise-free non-static pixels, base frame (truth contact)
@@ -123,10 +149,23 @@ struct Simulator {
   /// The depth intrinsics used (D435i for the configured resolution).
   /// Throws std::invalid_argument for a resolution the D435 does not offer.
   Intrinsics intrinsics() const;
-  /// Renders frame `index` into `out` (depth, intrinsics, timestamp, baseline, ground truth).
+  /// The colour intrinsics used (d435_color_intrinsics of the colour resolution).
+  /// Throws std::invalid_argument for a resolution it does not know.
+  Intrinsics color_intrinsics() const;
+  /// Depth → colour extrinsics (SDK layout): identity rotation, params.color_translation_m.
+  Extrinsics depth_to_color() const;
+  /// Renders frame `index` into `out` (depth, intrinsics, timestamp, baseline, ground truth,
+  /// and with params.color the colour image, its intrinsics and the depth → colour extrinsics).
   /// Reuses out's buffers, so rendering into the same Frame does not allocate.
   void render(int64_t index, Frame& out) const;
 };
+
+/// A D435i colour camera's intrinsics (Inverse Brown-Conrady, zero coefficients, as the
+/// camera reports) for a colour resolution: the calibrated 1280x720 and 640x480 rows of
+/// specs/d435-sensor-model.md §2, other 16:9 modes (1920x1080, 960x540, 848x480, 640x360,
+/// 480x270, 424x240) scaled from 1280x720 by height and cropped about the centre as the
+/// sensor does, 320x240 halved from 640x480. nullopt for other sizes.
+std::optional<Intrinsics> d435_color_intrinsics(int width, int height);
 
 /// Fill rate as the Depth Quality Tool defines it: valid pixels / pixels in the image, over
 /// frames first .. first+count-1 of the simulator. count ≥ 1.

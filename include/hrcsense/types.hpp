@@ -38,6 +38,14 @@ struct Intrinsics {
 /// A rigid transform. `T_a_b` maps points given in frame b into frame a.
 using Pose = Eigen::Isometry3d;
 
+/// A rigid transform between two sensors, laid out as the SDK's rs2_extrinsics.
+/// "From A to B": P_B = R * P_A + t, with the rotation stored column-major as the SDK does:
+/// element (row i, column j) is rotation[3 * j + i].
+struct Extrinsics {
+  std::array<float, 9> rotation{1.0F, 0.0F, 0.0F, 0.0F, 1.0F, 0.0F, 0.0F, 0.0F, 1.0F};
+  std::array<float, 3> translation_m{};  ///< metres
+};
+
 /// A 16-bit depth image; raw 0 means "no data".
 struct DepthImage {
   int width = 0;
@@ -68,6 +76,7 @@ inline constexpr uint16_t kStaticLabel = 0;
 struct Contact {
   bool valid = false;                              ///< false when there was no foreground
   float distance_m = 0.0F;                         ///< >= 0; 0 when a point is inside a capsule
+  bool inside = false;                             ///< the point is inside or on a capsule (distance 0)
   Eigen::Vector3f closest_base = Eigen::Vector3f::Zero();        ///< foreground point, base frame
   Eigen::Vector3f closest_camera = Eigen::Vector3f::Zero();      ///< same point, camera frame
   Eigen::Vector3f closest_robot_base = Eigen::Vector3f::Zero();  ///< point on the robot, base frame
@@ -93,6 +102,8 @@ struct Frame {
   Intrinsics intrinsics;             ///< of the depth image
   float stereo_baseline_mm = 0.0F;   ///< 0 when the source does not know it
   std::optional<ColorImage> color;
+  Intrinsics color_intrinsics;       ///< of the colour image; width 0 when there is none
+  std::optional<Extrinsics> depth_to_color;  ///< depth sensor -> colour sensor, when known
   std::optional<GroundTruth> truth;  ///< simulated sources only
 };
 
@@ -168,6 +179,9 @@ struct FrameResult {
   std::vector<StageTiming> timings;
   std::optional<Contact> truth;  ///< simulated sources: ground-truth contact
   double latency_us = 0.0;       ///< from the frame entering processing to the result
+  /// The proximity backend that searched this frame (static name, e.g. "octree" when `auto`
+  /// picked it); null when no search ran.
+  const char* backend = nullptr;
 };
 
 }  // namespace hrcsense

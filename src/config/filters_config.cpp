@@ -78,6 +78,8 @@ void read_options(KeyReader& r, FilterChainParams& f) {
 }  // namespace
 
 void read_filters(KeyReader& r, Config& c) {
+  // Without filters.preset the default of Config::filters_preset stands: "sdk", the chain a
+  // RealSense Viewer user runs, so that settings tuned there carry over unchanged.
   r.choice("filters.preset", c.filters_preset, {"none", "sdk", "thesis"});
   FilterChainParams& f = c.pipeline.filters;
   f = *filter_preset(c.filters_preset);

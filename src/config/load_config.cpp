@@ -2,6 +2,7 @@
 // hrcsense config — load_config: the YAML file, then --set overrides, then one typed read
 // per key into the stages' parameter structs (the table is read_all below).
 #include "key_reader.hpp"
+#include "robot_config.hpp"
 
 #include "hrcsense/camera.hpp"
 
@@ -96,28 +97,13 @@ void read_segmentation(KeyReader& r, Config& c) {
 }
 
 void read_robot_and_safety(KeyReader& r, Config& c) {
-  r.choice("robot.model", c.robot_model, {"points", "ur5", "ur5e", "ur10e"});
-  if (c.robot_model != "points") not_implemented(r, "robot.model", c.robot_model, "points");
-  // Default: the 2020 thesis's robot point (-0.5, 0.5, 0.5) m, given there with y up.
-  std::vector<Eigen::Vector3f> points_base{Eigen::Vector3f(-0.5F, -0.5F, 0.5F)};
-  float padding_m = 0.0F;
-  r.vec3_list("robot.points_base", points_base);
-  // Without a robot every distance would be "infinite" and every verdict run: refuse.
-  if (c.robot_model == "points" && points_base.empty()) {
-    r.fail("robot.points_base", "expected at least one point [x, y, z] for robot.model points");
-  }
-  r.number("robot.padding_m", padding_m, Bound::non_negative);
-  r.number_list("robot.joints_rad", c.robot_joints_rad, 6);
-  r.choice("robot.base_frame", c.robot_base_frame, {"base", "base_link"});
-  c.pipeline.robot.capsules.clear();
-  for (size_t i = 0; i < points_base.size(); ++i) {
-    // A robot point is a capsule of length 0; padding makes it a sphere.
-    c.pipeline.robot.capsules.push_back(Capsule{points_base[i], points_base[i], padding_m, static_cast<int>(i)});
-  }
+  config_detail::read_robot(r, c);  // src/config/robot_config.cpp
 
   r.choice("proximity.backend", c.pipeline.backend, {"brute", "kdtree", "octree", "depth_space", "auto"});
-  if (c.pipeline.backend != "brute") not_implemented(r, "proximity.backend", c.pipeline.backend, "brute");
+  if (c.pipeline.backend == "depth_space") not_implemented(r, "proximity.backend", c.pipeline.backend, "brute");
   r.integer("proximity.octree.height", c.proximity_octree_height, 1, 10);
+  c.pipeline.proximity.octree_height = c.proximity_octree_height;
+  r.integer("proximity.threads", c.pipeline.proximity.threads, 1, 2);
 
   SafetyParams& safety = c.pipeline.safety;
   r.number("safety.slow_distance_m", safety.slow_distance_m, Bound::non_negative);

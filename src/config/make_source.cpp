@@ -15,6 +15,8 @@ Simulator make_simulator(const Config& config) {
   simulator.scene = config.scene;
   simulator.T_base_camera = config.pipeline.T_base_camera;
   simulator.robot = config.pipeline.robot;
+  // The arm is part of the static scene: rendered, learnt as background, never foreground.
+  if (auto arm = robot_scene_object(config)) simulator.scene.objects.push_back(*arm);
   return simulator;
 }
 

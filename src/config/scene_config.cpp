@@ -2,7 +2,11 @@
 // hrcsense config — `scene.objects`: simulated objects made of planes, boxes, spheres, capsules.
 #include "key_reader.hpp"
 
+#include "hrcsense/sim.hpp"
+
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -145,8 +149,22 @@ struct SceneReader {
     return out;
   }
 
+  /// `color: [r, g, b]`, integers 0..255.
+  std::array<uint8_t, 3> color(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsSequence() || node.size() != 3) fail(key, "expected [r, g, b] with integers 0..255");
+    std::array<uint8_t, 3> out{};
+    for (size_t i = 0; i < 3; ++i) {
+      int value = -1;
+      if (!node[i].IsScalar() || !YAML::convert<int>::decode(node[i], value) || value < 0 || value > 255) {
+        fail(key, "expected [r, g, b] with integers 0..255");
+      }
+      out[i] = static_cast<uint8_t>(value);
+    }
+    return out;
+  }
+
   SceneObject object(const YAML::Node& node, const std::string& key, size_t index) const {
-    only_keys(node, key, {"name", "static", "first_frame", "last_frame", "path", "material", "shapes"});
+    only_keys(node, key, {"name", "static", "first_frame", "last_frame", "path", "material", "color", "shapes"});
     SceneObject out;
     const YAML::Node& map = node;
     out.name = "object" + std::to_string(index);
@@ -167,6 +185,7 @@ struct SceneReader {
     if (map["material"].IsDefined() && !map["material"].IsNull()) {
       out.material = material(map["material"], key + ".material");
     }
+    if (map["color"].IsDefined() && !map["color"].IsNull()) out.color_rgb = color(map["color"], key + ".color");
     const YAML::Node shapes = required(map, key, "shapes");
     if (!shapes.IsSequence() || shapes.size() == 0) fail(key + ".shapes", "expected a non-empty list of shapes");
     for (size_t i = 0; i < shapes.size(); ++i) {
@@ -240,6 +259,12 @@ YAML::Node scene_objects_node(const Scene& scene) {
     if (object.material.shiny) material.push_back("shiny");
     if (object.material.low_texture) material.push_back("low_texture");
     node["material"] = material;
+    if (object.color_rgb) {
+      YAML::Node color(YAML::NodeType::Sequence);
+      color.SetStyle(YAML::EmitterStyle::Flow);
+      for (const uint8_t c : *object.color_rgb) color.push_back(static_cast<int>(c));
+      node["color"] = color;
+    }
     YAML::Node shapes(YAML::NodeType::Sequence);
     for (const Shape& shape : object.shapes) shapes.push_back(shape_node(shape));
     node["shapes"] = shapes;
@@ -268,6 +293,17 @@ void read_sim_effects(KeyReader& r, SimParams& sim) {
   share("sim.speckle", sim.speckle);
   r.number("sim.correlated_noise_px", sim.correlated_noise_px, Bound::non_negative);
   r.integer("sim.correlated_cell_px", sim.correlated_cell_px, 2, 4096);
+  r.flag("sim.color", sim.color);
+  r.integer("sim.color_width", sim.color_width, 0, 65535);
+  r.integer("sim.color_height", sim.color_height, 0, 65535);
+  const int width = sim.color_width > 0 ? sim.color_width : sim.width;
+  const int height = sim.color_height > 0 ? sim.color_height : sim.height;
+  if (sim.color && !d435_color_intrinsics(width, height)) {
+    r.fail("sim.color_width", std::to_string(width) + "x" + std::to_string(height) +
+                                  " is not a D435 colour resolution; expected 1920x1080, 1280x720, 960x540, "
+                                  "848x480, 640x480, 640x360, 480x270, 424x240 or 320x240 (0x0: the depth's)");
+  }
+  r.vec3("sim.color_translation_m", sim.color_translation_m);
 }
 
 Scene read_scene_objects(const YAML::Node& objects, const std::string& where, const std::string& key) {

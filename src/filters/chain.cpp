@@ -49,6 +49,26 @@ std::optional<FilterChainParams> filter_preset(std::string_view name) {
   return std::nullopt;
 }
 
+Intrinsics filtered_intrinsics(const FilterChainParams& params, const Intrinsics& source) {
+  if (std::find(params.order.begin(), params.order.end(), FilterBlock::decimation) == params.order.end()) {
+    return source;
+  }
+  // Decimating an empty image of the source's size keeps one definition of the output size
+  // (padding included); called once per run, so the allocation does not matter.
+  DepthImage in, out;
+  in.resize(source.width, source.height);
+  Intrinsics result;
+  decimate(params.decimation, in, source, out, result);
+  return result;
+}
+
+const char* filter_domain(const FilterChainParams& params, float stereo_baseline_mm) {
+  if (params.order.empty()) return "none";
+  const bool wants_disparity =
+      std::find(params.order.begin(), params.order.end(), FilterBlock::to_disparity) != params.order.end();
+  return wants_disparity && stereo_baseline_mm > 0.0F ? "disparity" : "depth";
+}
+
 std::string check_filter_order(const std::vector<FilterBlock>& order) {
   bool seen[kFilterBlocks.size()] = {};
   bool in_disparity = false;

@@ -2,7 +2,13 @@
 // hrcsense filters — per-pixel blocks: threshold and the depth↔disparity transforms (spec §2, §3).
 #include "hrcsense/filters.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace hrcsense {
 namespace {
@@ -17,15 +23,44 @@ uint16_t to_u16_like_sdk(float value) {
 }  // namespace
 
 // The SDK multiplies raw by the depth units in float32 and compares inclusively, so the
-// float rounding of min/max decides the boundaries (max 1.5 m drops 1500 mm).
+// float rounding of min/max decides the boundaries (max 1.5 m drops 1500 mm). raw · scale
+// rounds monotonically for a finite positive scale, so the raw values kept form one interval
+// [lo, hi], found by bisection; the per-pixel test is then an integer comparison.
 void apply_threshold(const ThresholdParams& params, DepthImage& depth) {
   const float scale = depth.depth_scale_m;
   const float min_m = params.min_m;
   const float max_m = params.max_m;
-  for (uint16_t& raw : depth.pixels) {
+  const auto keeps = [&](uint32_t raw) {
     const float z_m = static_cast<float>(raw) * scale;
-    raw = (z_m >= min_m && z_m <= max_m) ? raw : uint16_t{0};
+    return z_m >= min_m && z_m <= max_m;
+  };
+  if (!(scale > 0.0F && scale < std::numeric_limits<float>::infinity())) {
+    for (uint16_t& raw : depth.pixels) raw = keeps(raw) ? raw : uint16_t{0};
+    return;
   }
+  // lo: the first raw with z >= min (65536: none); hi + 1: the first raw with z > max.
+  const auto first_true = [](auto predicate) {
+    uint32_t low = 0, high = 65536;
+    while (low < high) {
+      const uint32_t middle = (low + high) / 2;
+      if (predicate(middle)) {
+        high = middle;
+      } else {
+        low = middle + 1;
+      }
+    }
+    return low;
+  };
+  const uint32_t lo = first_true([&](uint32_t raw) { return static_cast<float>(raw) * scale >= min_m; });
+  const uint32_t end = first_true([&](uint32_t raw) { return !(static_cast<float>(raw) * scale <= max_m); });
+  if (lo >= end) {
+    std::fill(depth.pixels.begin(), depth.pixels.end(), uint16_t{0});
+    return;
+  }
+  // raw - lo wraps for raw < lo, so one unsigned comparison tests both ends.
+  const auto low = static_cast<uint16_t>(lo);
+  const auto span = static_cast<uint16_t>(end - 1 - lo);
+  for (uint16_t& raw : depth.pixels) raw = static_cast<uint16_t>(raw - low) <= span ? raw : uint16_t{0};
 }
 
 // Evaluated left to right in float32, as the SDK: ((B_mm · 0.001) · fx · 32) / units.
@@ -39,7 +74,25 @@ void depth_to_disparity(const DepthImage& in, float factor, DisparityImage& out)
   const size_t n = in.pixels.size();
   const uint16_t* src = in.pixels.data();
   float* dst = out.pixels.data();
-  for (size_t i = 0; i < n; ++i) {
+  size_t i = 0;
+#if defined(__SSE2__)
+  // Holes divide by 1 instead of 0 (no branch, no division by zero) and are then masked to 0.
+  const __m128 f = _mm_set1_ps(factor);
+  const __m128 one = _mm_set1_ps(1.0F);
+  const __m128i zero = _mm_setzero_si128();
+  const auto convert = [&](__m128i raw32) {
+    const __m128 hole = _mm_castsi128_ps(_mm_cmpeq_epi32(raw32, zero));
+    const __m128 raw = _mm_cvtepi32_ps(raw32);
+    const __m128 quotient = _mm_div_ps(f, _mm_or_ps(_mm_andnot_ps(hole, raw), _mm_and_ps(hole, one)));
+    return _mm_andnot_ps(hole, quotient);
+  };
+  for (; i + 8 <= n; i += 8) {
+    const __m128i raw = _mm_loadu_si128(reinterpret_cast<const __m128i*>(src + i));
+    _mm_storeu_ps(dst + i, convert(_mm_unpacklo_epi16(raw, zero)));
+    _mm_storeu_ps(dst + i + 4, convert(_mm_unpackhi_epi16(raw, zero)));
+  }
+#endif
+  for (; i < n; ++i) {
     // Every non-zero uint16 is a normal float; 0 stays "no data".
     dst[i] = src[i] != 0 ? factor / static_cast<float>(src[i]) : 0.0F;
   }
@@ -50,7 +103,31 @@ void disparity_to_depth(const DisparityImage& in, float factor, DepthImage& out)
   const size_t n = in.pixels.size();
   const float* src = in.pixels.data();
   uint16_t* dst = out.pixels.data();
-  for (size_t i = 0; i < n; ++i) {
+  size_t i = 0;
+#if defined(__SSE2__)
+  // cvttps2dq is the SDK's conversion: out of range and NaN give INT32_MIN, whose low 16 bits
+  // are 0. Only normal floats (exponent neither 0 nor 255) are converted.
+  const __m128 f = _mm_set1_ps(factor);
+  const __m128 half = _mm_set1_ps(0.5F);
+  const __m128 one = _mm_set1_ps(1.0F);
+  const __m128i exponent = _mm_set1_epi32(0x7f800000);
+  const __m128i zero = _mm_setzero_si128();
+  const auto convert = [&](const float* p) {
+    const __m128 d = _mm_loadu_ps(p);
+    const __m128i e = _mm_and_si128(_mm_castps_si128(d), exponent);
+    const __m128i normal = _mm_andnot_si128(_mm_or_si128(_mm_cmpeq_epi32(e, zero), _mm_cmpeq_epi32(e, exponent)),
+                                            _mm_set1_epi32(-1));
+    const __m128 safe = _mm_or_ps(_mm_and_ps(_mm_castsi128_ps(normal), d), _mm_andnot_ps(_mm_castsi128_ps(normal), one));
+    const __m128i raw = _mm_cvttps_epi32(_mm_add_ps(_mm_div_ps(f, safe), half));
+    // Keep the low 16 bits, sign-extended so that the signed saturating pack passes them on.
+    return _mm_and_si128(normal, _mm_srai_epi32(_mm_slli_epi32(raw, 16), 16));
+  };
+  for (; i + 8 <= n; i += 8) {
+    const __m128i packed = _mm_packs_epi32(convert(src + i), convert(src + i + 4));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + i), packed);
+  }
+#endif
+  for (; i < n; ++i) {
     // The SDK converts only normal floats (not 0, denormals, inf or NaN).
     dst[i] = std::isnormal(src[i]) ? to_u16_like_sdk(factor / src[i] + 0.5F) : uint16_t{0};
   }

@@ -6,7 +6,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <type_traits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace hrcsense {
 namespace {
@@ -44,6 +49,104 @@ inline uint16_t abs_difference(uint16_t a, uint16_t b) {
 }
 inline float abs_difference(float a, float b) { return std::fabs(a - b); }
 
+#if defined(__SSE2__)
+// The persistence rule without the table, as lane operations: m = the history bits of the N
+// frames before the current phase (`window`); "M of N" is then m != 0 (M 1), m has two bits
+// set (m & (m − 1) != 0, M 2) or m is all N bits (M 8). Mode 0 never fills, mode 8 always.
+struct PersistenceRule {
+  int window = 0;
+  int min_valid = 0;  // 0: never, 9: always
+};
+
+PersistenceRule persistence_rule(int persistence, int phase) {
+  if (persistence <= 0) return {0, 0};
+  if (persistence >= 8) return {0, 9};
+  PersistenceRule rule{0, kMinValid[persistence]};
+  for (int back = 1; back <= kWindow[persistence]; ++back) rule.window |= 1 << ((phase - back + 8) % 8);
+  return rule;
+}
+
+inline __m128i persistence_allows(__m128i history, const PersistenceRule& rule) {
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i all = _mm_set1_epi32(-1);
+  const __m128i w = _mm_set1_epi32(rule.window);
+  const __m128i m = _mm_and_si128(history, w);
+  switch (rule.min_valid) {
+    case 0: return zero;
+    case 1: return _mm_xor_si128(_mm_cmpeq_epi32(m, zero), all);
+    case 2: return _mm_xor_si128(_mm_cmpeq_epi32(_mm_and_si128(m, _mm_sub_epi32(m, _mm_set1_epi32(1))), zero), all);
+    case 8: return _mm_cmpeq_epi32(m, w);
+    default: return all;
+  }
+}
+
+inline __m128i select(__m128i mask, __m128i a, __m128i b) {
+  return _mm_or_si128(_mm_and_si128(mask, a), _mm_andnot_si128(mask, b));
+}
+
+// Four pixels as 32-bit lanes: float bits, or uint16 widened.
+inline __m128i load4(const float* p) { return _mm_castps_si128(_mm_loadu_ps(p)); }
+inline __m128i load4(const uint16_t* p) {
+  return _mm_unpacklo_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)), _mm_setzero_si128());
+}
+inline void store4(float* p, __m128i v) { _mm_storeu_ps(p, _mm_castsi128_ps(v)); }
+inline void store4(uint16_t* p, __m128i v) {
+  // Sign-extend the low 16 bits so that the signed saturating pack passes them on unchanged.
+  const __m128i packed = _mm_packs_epi32(_mm_srai_epi32(_mm_slli_epi32(v, 16), 16), _mm_setzero_si128());
+  _mm_storel_epi64(reinterpret_cast<__m128i*>(p), packed);
+}
+
+// The per-pixel rules of apply_to() on four pixels at a time; returns how many it did.
+template <typename T>
+size_t temporal_sse2(T* pixels, T* last, uint8_t* history, size_t n, int phase, const TemporalParams& params) {
+  constexpr bool kFloat = std::is_same_v<T, float>;
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i all = _mm_set1_epi32(-1);
+  const __m128i mask = _mm_set1_epi32(1 << phase);
+  const __m128 alpha = _mm_set1_ps(params.alpha);
+  const __m128 one_minus_alpha = _mm_set1_ps(1.0F - params.alpha);
+  const __m128 delta_f = _mm_set1_ps(static_cast<float>(params.delta));
+  const __m128i delta_i = _mm_set1_epi32(params.delta);
+  const PersistenceRule rule = persistence_rule(params.persistence, phase);
+  size_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    const __m128i current = load4(pixels + i);
+    const __m128i previous = load4(last + i);
+    int32_t bytes = 0;
+    std::memcpy(&bytes, history + i, sizeof bytes);
+    const __m128i old_history = _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(bytes), zero), zero);
+    __m128i current_valid, previous_valid, close, blended;
+    if constexpr (kFloat) {
+      const __m128 c = _mm_castsi128_ps(current);
+      const __m128 p = _mm_castsi128_ps(previous);
+      current_valid = _mm_castps_si128(_mm_cmpneq_ps(c, _mm_setzero_ps()));  // NaN counts, −0 does not
+      previous_valid = _mm_castps_si128(_mm_cmpneq_ps(p, _mm_setzero_ps()));
+      close = _mm_castps_si128(_mm_cmplt_ps(_mm_andnot_ps(_mm_set1_ps(-0.0F), _mm_sub_ps(c, p)), delta_f));
+      blended = _mm_castps_si128(_mm_add_ps(_mm_mul_ps(alpha, c), _mm_mul_ps(one_minus_alpha, p)));
+    } else {
+      current_valid = _mm_xor_si128(_mm_cmpeq_epi32(current, zero), all);
+      previous_valid = _mm_xor_si128(_mm_cmpeq_epi32(previous, zero), all);
+      const __m128i difference = _mm_sub_epi32(current, previous);
+      const __m128i sign = _mm_srai_epi32(difference, 31);
+      close = _mm_cmplt_epi32(_mm_sub_epi32(_mm_xor_si128(difference, sign), sign), delta_i);
+      const __m128 f = _mm_add_ps(_mm_mul_ps(alpha, _mm_cvtepi32_ps(current)),
+                                  _mm_mul_ps(one_minus_alpha, _mm_cvtepi32_ps(previous)));
+      blended = _mm_cvttps_epi32(f);  // truncated, as the SDK
+    }
+    const __m128i agree = _mm_and_si128(_mm_and_si128(current_valid, previous_valid), close);
+    const __m128i updated = select(agree, blended, current);
+    const __m128i fill = _mm_and_si128(previous_valid, persistence_allows(old_history, rule));
+    store4(pixels + i, select(current_valid, updated, select(fill, previous, current)));
+    store4(last + i, select(current_valid, updated, previous));
+    const __m128i new_history =
+        select(current_valid, select(agree, _mm_or_si128(old_history, mask), mask), _mm_andnot_si128(mask, old_history));
+    bytes = _mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(new_history, zero), zero));
+    std::memcpy(history + i, &bytes, sizeof bytes);
+  }
+  return i;
+}
+#endif
+
 }  // namespace
 
 void TemporalFilter::reset() { has_state_ = false; }
@@ -75,7 +178,11 @@ void TemporalFilter::apply_to(T* pixels, int width, int height, bool disparity) 
   const auto mask = static_cast<uint8_t>(1U << phase_);
   T* last = last_vector.data();
   uint8_t* history = history_.data();
-  for (size_t i = 0; i < n; ++i) {
+  size_t i = 0;
+#if defined(__SSE2__)
+  i = temporal_sse2(pixels, last, history, n, phase_, params);
+#endif
+  for (; i < n; ++i) {
     const T current = pixels[i];
     const T previous = last[i];
     if (current != T{0}) {

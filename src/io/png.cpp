@@ -195,29 +195,63 @@ void write_png(const std::string& path, const WriteRequest& request) {
   }
 }
 
-}  // namespace
+/// Any 8-bit or 16-bit PNG as 8-bit RGB: palettes expanded, grey replicated, alpha dropped.
+bool read_png_rows_rgb8(png_structp png, png_infop info, uint8_t* rgb, png_uint_32 width, png_uint_32 height) {
+  if (setjmp(png_jmpbuf(png))) {
+    return false;
+  }
+  png_set_expand(png);
+  png_set_strip_16(png);
+  png_set_strip_alpha(png);
+  png_set_gray_to_rgb(png);
+  const int passes = png_set_interlace_handling(png);
+  png_read_update_info(png, info);
+  if (png_get_rowbytes(png, info) != static_cast<size_t>(width) * 3) {
+    png_error(png, "unexpected row size after transforms");  // guards the buffer we write into
+  }
+  for (int pass = 0; pass < passes; ++pass) {
+    for (png_uint_32 y = 0; y < height; ++y) {
+      png_read_row(png, rgb + static_cast<size_t>(y) * width * 3, nullptr);
+    }
+  }
+  png_read_end(png, nullptr);
+  return true;
+}
 
-void read_depth_png(const std::string& path, DepthImage& out) {
-  FilePtr file(std::fopen(path.c_str(), "rb"));
-  if (!file) {
-    fail(path, std::string("cannot open: ") + std::strerror(errno));
-  }
-  png_byte signature[8] = {};
-  if (std::fread(signature, 1, sizeof(signature), file.get()) != sizeof(signature) ||
-      png_sig_cmp(signature, 0, sizeof(signature)) != 0) {
-    fail(path, "not a PNG file (bad signature)");
-  }
+/// An open PNG file whose header has been read; throws IoError naming the file otherwise.
+struct PngReader {
+  FilePtr file;
   PngErrorState error;
   PngReadStructs structs;
-  structs.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &error, on_png_error, on_png_warning);
-  structs.info = structs.png ? png_create_info_struct(structs.png) : nullptr;
-  if (!structs.info) {
-    fail(path, "libpng could not allocate its read structures");
-  }
   PngHeader header;
-  if (!read_png_header(structs.png, structs.info, file.get(), &header)) {
-    fail(path, "unreadable PNG header: " + describe(error));
+
+  explicit PngReader(const std::string& path) : file(std::fopen(path.c_str(), "rb")) {
+    if (!file) {
+      fail(path, std::string("cannot open: ") + std::strerror(errno));
+    }
+    png_byte signature[8] = {};
+    if (std::fread(signature, 1, sizeof(signature), file.get()) != sizeof(signature) ||
+        png_sig_cmp(signature, 0, sizeof(signature)) != 0) {
+      fail(path, "not a PNG file (bad signature)");
+    }
+    structs.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &error, on_png_error, on_png_warning);
+    structs.info = structs.png ? png_create_info_struct(structs.png) : nullptr;
+    if (!structs.info) {
+      fail(path, "libpng could not allocate its read structures");
+    }
+    if (!read_png_header(structs.png, structs.info, file.get(), &header)) {
+      fail(path, "unreadable PNG header: " + describe(error));
+    }
   }
+};
+
+}  // namespace
+
+void read_depth_png(const std::string& path, DepthImage& out) { read_depth_png(path, out, 0, 0); }
+
+void read_depth_png(const std::string& path, DepthImage& out, int expected_width, int expected_height) {
+  PngReader reader(path);
+  const PngHeader& header = reader.header;
   if (header.bit_depth != 16 || header.color_type != PNG_COLOR_TYPE_GRAY) {
     fail(path, "expected a 16-bit grayscale depth PNG, found " + std::to_string(header.bit_depth) + "-bit " +
                    color_type_name(header.color_type));
@@ -225,10 +259,31 @@ void read_depth_png(const std::string& path, DepthImage& out) {
   if (header.width == 0 || header.height == 0) {
     fail(path, "empty image");  // libpng rejects this already; kept as the invariant we rely on
   }
+  if (expected_width > 0 && (header.width != static_cast<png_uint_32>(expected_width) ||
+                             header.height != static_cast<png_uint_32>(expected_height))) {
+    fail(path, "image is " + std::to_string(header.width) + "x" + std::to_string(header.height) + ", expected " +
+                   std::to_string(expected_width) + "x" + std::to_string(expected_height) + " (wrong size)");
+  }
   // Sizes are bounded by kMaxSidePx through png_set_user_limits, so this cannot overflow.
   out.resize(static_cast<int>(header.width), static_cast<int>(header.height));
-  if (!read_png_rows16(structs.png, structs.info, out.pixels.data(), header.width, header.height)) {
-    fail(path, "damaged or truncated PNG data: " + describe(error));
+  if (!read_png_rows16(reader.structs.png, reader.structs.info, out.pixels.data(), header.width, header.height)) {
+    fail(path, "damaged or truncated PNG data: " + describe(reader.error));
+  }
+}
+
+void read_color_png(const std::string& path, ColorImage& out) {
+  PngReader reader(path);
+  const PngHeader& header = reader.header;
+  if (header.width == 0 || header.height == 0 ||
+      static_cast<long long>(header.width) * header.height > kMaxColorPixels) {
+    fail(path, "colour image of " + std::to_string(header.width) + "x" + std::to_string(header.height) +
+                   " pixels is empty or too large");
+  }
+  out.width = static_cast<int>(header.width);
+  out.height = static_cast<int>(header.height);
+  out.rgb.resize(static_cast<size_t>(header.width) * header.height * 3);
+  if (!read_png_rows_rgb8(reader.structs.png, reader.structs.info, out.rgb.data(), header.width, header.height)) {
+    fail(path, "damaged or truncated PNG data: " + describe(reader.error));
   }
 }
 

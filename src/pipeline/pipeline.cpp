@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <optional>
+#include <stdexcept>
 #include <utility>
 
 namespace hrcsense {
@@ -56,6 +58,7 @@ void begin_result(const Frame& frame, FrameResult& result) {
   result.timestamp_ns = frame.timestamp_ns;
   result.valid = false;
   result.contact = Contact{};
+  result.backend = nullptr;
   result.foreground_points = 0;
   result.invalid_pixels = 0;
   result.timings.clear();  // keeps its capacity: four stages after the first frame
@@ -116,9 +119,17 @@ void finish_stop(FrameResult& result, const char* reason, Clock::time_point star
   finish(result, start);
 }
 
+// The configured backend; config validates the name first, so a bad one here is a caller's bug.
+ProximitySearch make_proximity_search(const PipelineParams& params) {
+  const std::optional<ProximityBackend> backend = parse_proximity_backend(params.backend);
+  if (!backend) throw std::invalid_argument("proximity.backend '" + params.backend + "' is not a backend");
+  return ProximitySearch(*backend, params.proximity);
+}
+
 }  // namespace
 
-Pipeline::Pipeline(PipelineParams params) : params_(std::move(params)) {
+Pipeline::Pipeline(PipelineParams params)
+    : params_(std::move(params)), proximity_(make_proximity_search(params_)) {
   learner_.params = params_.background;
   extractor_.params = params_.foreground;
   filters_.params = params_.filters;
@@ -153,7 +164,8 @@ void Pipeline::process(const Frame& source_frame, FrameResult& result) {
   });
   if (!extracted) return finish_stop(result, "foreground extraction failed", start);
   timed(result, "proximity", [&] {
-    result.contact = closest_contact_brute(foreground_.points_base, foreground_.points_camera, params_.robot);
+    result.contact = proximity_.closest(foreground_.points_base, foreground_.points_camera, params_.robot);
+    result.backend = proximity_backend_name(proximity_.last_backend());
   });
   timed(result, "safety", [&] { result.verdict = verdict_for_contact(params_.safety, result.contact); });
   result.foreground_points = foreground_.points_base.size();

@@ -1,98 +1,171 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — exact closest contact between a foreground cloud and robot capsules, brute force.
+// hrcsense — exact closest contact by brute force: a vectorised scan over blocks of the SoA
+// cloud, skipping (block, capsule) pairs whose box lower bound cannot reach the best so far.
+
+#include "brute.hpp"
 
 #include "hrcsense/proximity.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <cstddef>
-#include <limits>
 
 namespace hrcsense {
+namespace proximity_detail {
 namespace {
 
-// A capsule's segment reduced to what the inner loop needs. The reciprocal of |ab|² is 0 for a
-// degenerate segment (a == b), which pins t to 0 and so makes the capsule a sphere around a.
-struct Segment {
-  float ax, ay, az;
-  float abx, aby, abz;
-  float inv_len2;
-  float radius_m;
+// Points per block: small enough that a block's coordinates stay in L1 across the capsules
+// and its box is tight (a block of a depth image's foreground spans one or two image rows),
+// large enough that the per-block box and bound cost little per point.
+constexpr size_t kBlock = 512;
+// Clouds from this size on are split between two threads when params.threads is 2: below it
+// the hand-over costs more than the half scan saves.
+constexpr size_t kTwoThreadMinPoints = 32768;
+
+struct Cloud {
+  const float* x;
+  const float* y;
+  const float* z;
+  size_t n;
 };
 
-Segment make_segment(const Capsule& capsule) {
-  const Eigen::Vector3f ab = capsule.b - capsule.a;
-  const float len2 = ab.squaredNorm();
-  return {capsule.a.x(), capsule.a.y(), capsule.a.z(), ab.x(), ab.y(), ab.z(),
-          len2 > 0.0F ? 1.0F / len2 : 0.0F, capsule.radius_m};
-}
-
-// Squared distance from (px, py, pz) to the capsule's segment (its axis). The vectorised and
-// the scalar pass both evaluate this expression and must agree bit for bit: no fast-math and
-// no FMA contraction (see the proximity target's compile options).
-inline float axis_distance_sq(const Segment& s, float px, float py, float pz) {
-  const float apx = px - s.ax;
-  const float apy = py - s.ay;
-  const float apz = pz - s.az;
-  float t = (apx * s.abx + apy * s.aby + apz * s.abz) * s.inv_len2;
-  // Clamp t to [0, 1] with arithmetic instead of selects: GCC turns the selects into long
-  // blend chains (or keeps the loop scalar) unless fast-math drops NaN handling. max(t, 0) is
-  // exact; min(., 1) may move t by one float step near 0, which shifts the closest point
-  // along the segment and changes d2 only to second order.
-  t = 0.5F * (t + std::fabs(t));
-  t = 1.0F - 0.5F * ((1.0F - t) + std::fabs(1.0F - t));
-  const float dx = apx - t * s.abx;
-  const float dy = apy - t * s.aby;
-  const float dz = apz - t * s.abz;
-  return dx * dx + dy * dy + dz * dz;
-}
-
-// Surface distance from the squared axis distance: 0 inside. Monotone in d2 (sqrt is
-// correctly rounded), so the minimum of d2 gives the minimum surface distance exactly.
-inline float surface_distance(const Segment& s, float d2) {
-  const float d = std::sqrt(d2) - s.radius_m;
-  return d > 0.0F ? d : 0.0F;
-}
-
-// Smallest squared axis distance of any point. The loop has no sqrt (which would keep it
-// scalar because of errno) and no fast-math: points with NaN coordinates never compare less
-// and are ignored. +inf when there is no finite point.
-float min_axis_distance_sq(const Segment& s, const float* x, const float* y, const float* z,
-                           size_t n) {
-  float best = std::numeric_limits<float>::infinity();
-#pragma omp simd reduction(min : best)
-  for (size_t i = 0; i < n; ++i) {
-    const float d2 = axis_distance_sq(s, x[i], y[i], z[i]);
-    best = d2 < best ? d2 : best;
+// A true upper bound on the minimum: the best distance of a sparse sample of actual points.
+// Seeding the scan with it lets the box bounds prune from the first block on.
+float sampled_upper_bound_m(const Cloud& cloud, const std::vector<CapsuleBound>& capsules) {
+  constexpr size_t kSamples = 256;
+  const size_t stride = std::max<size_t>(1, cloud.n / kSamples);
+  float best = kInf;
+  for (size_t i = 0; i < cloud.n; i += stride) {
+    for (const CapsuleBound& c : capsules) {
+      const float d = surface_distance(c.segment, axis_distance_sq(c.segment, cloud.x[i], cloud.y[i], cloud.z[i]));
+      best = d < best ? d : best;
+    }
   }
   return best;
 }
 
-// Lowest point index whose surface distance equals `target_m` exactly; n when none does.
-// Several points can share the reported (float) distance, e.g. all points inside the capsule
-// at 0. Blocks whose smallest d2 is clearly beyond the target (by a slack far above float
-// rounding) are skipped with the vectorised loop; only the block with the hit is scanned.
-size_t first_index_at(const Segment& s, const float* x, const float* y, const float* z, size_t n,
-                      float target_m) {
-  constexpr size_t kBlock = 256;
-  const float reach_m = target_m + s.radius_m;
-  const float bound_sq = reach_m * reach_m * 1.0001F + 1e-12F;
-  for (size_t begin = 0; begin < n; begin += kBlock) {
-    const size_t end = std::min(n, begin + kBlock);
-    if (!(min_axis_distance_sq(s, x + begin, y + begin, z + begin, end - begin) <= bound_sq)) continue;
-    for (size_t i = begin; i < end; ++i) {
-      const float d2 = axis_distance_sq(s, x[i], y[i], z[i]);
-      if (d2 <= bound_sq && surface_distance(s, d2) == target_m) return i;
+}  // namespace
+
+BlockResult scan_blocks(const float* x, const float* y, const float* z, size_t n,
+                        const std::vector<CapsuleBound>& capsules, size_t first_block, size_t last_block,
+                        float upper_bound_m) {
+  BlockResult result{upper_bound_m, kNoBlock};
+  const bool prune = capsules.size() > 1;
+  for (size_t b = first_block; b < last_block; ++b) {
+    const size_t begin = b * kBlock;
+    const size_t count = std::min(n, begin + kBlock) - begin;
+    const float* bx = x + begin;
+    const float* by = y + begin;
+    const float* bz = z + begin;
+    Box box;
+    if (prune) box = bounding_box(bx, by, bz, count);
+    for (const CapsuleBound& c : capsules) {
+      if (prune && prunable(lower_bound_m(c, box), result.distance_m, c.segment.radius_m)) continue;
+      const float d2 = min_axis_distance_sq(c.segment, bx, by, bz, count);
+      if (!(d2 < kInf)) continue;  // no finite point
+      const float m = surface_distance(c.segment, d2);
+      // The first block reaching the final minimum holds its lowest point index.
+      if (m < result.distance_m || (m == result.distance_m && result.block == kNoBlock)) {
+        result = {m, b};
+      }
     }
   }
-  return n;
+  return result;
 }
 
-}  // namespace
+size_t block_count(size_t n) { return (n + kBlock - 1) / kBlock; }
+
+Best resolve_block(const float* x, const float* y, const float* z, size_t n,
+                   const std::vector<CapsuleBound>& capsules, const BlockResult& block) {
+  Best best;
+  const size_t begin = block.block * kBlock;
+  const size_t end = std::min(n, begin + kBlock);
+  for (size_t i = begin; i < end && !best.found(); ++i) {
+    for (size_t c = 0; c < capsules.size(); ++c) {
+      const Segment& s = capsules[c].segment;
+      const float d = surface_distance(s, axis_distance_sq(s, x[i], y[i], z[i]));
+      if (d == block.distance_m) {
+        best = {d, i, c};
+        break;
+      }
+    }
+  }
+  return best;
+}
+
+void prepare_bounds(const RobotModel& robot, std::vector<CapsuleBound>& out) {
+  out.clear();
+  for (const Capsule& capsule : robot.capsules) out.push_back(make_bound(capsule));
+}
+
+Best brute_search(const PointCloud& points_base, const std::vector<CapsuleBound>& capsules, Worker* worker) {
+  const Cloud cloud{points_base.x.data(), points_base.y.data(), points_base.z.data(), points_base.size()};
+  if (cloud.n == 0 || capsules.empty()) return {};
+  const size_t blocks = block_count(cloud.n);
+  const float upper_bound_m = capsules.size() > 1 && blocks > 8 ? sampled_upper_bound_m(cloud, capsules) : kInf;
+  BlockResult result;
+  if (worker != nullptr && cloud.n >= kTwoThreadMinPoints) {
+    // The second thread takes the upper half of the blocks; on equal minima the lower half
+    // wins, which keeps the lowest-index rule.
+    const size_t half = blocks / 2;
+    BlockResult upper;
+    auto upper_half = [&] { upper = scan_blocks(cloud.x, cloud.y, cloud.z, cloud.n, capsules, half, blocks, upper_bound_m); };
+    worker->run(upper_half);
+    const BlockResult lower = scan_blocks(cloud.x, cloud.y, cloud.z, cloud.n, capsules, 0, half, upper_bound_m);
+    worker->wait();
+    const bool lower_wins = lower.block != kNoBlock &&
+                            (upper.block == kNoBlock || lower.distance_m <= upper.distance_m);
+    result = lower_wins ? lower : upper;
+  } else {
+    result = scan_blocks(cloud.x, cloud.y, cloud.z, cloud.n, capsules, 0, blocks, upper_bound_m);
+  }
+  if (result.block == kNoBlock) return {};  // no finite point
+  return resolve_block(cloud.x, cloud.y, cloud.z, cloud.n, capsules, result);
+}
+
+Worker::Worker() : thread_([this] { loop(); }) {}
+
+Worker::~Worker() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    quit_ = true;
+  }
+  wake_.notify_one();
+  thread_.join();
+}
+
+void Worker::run_raw(void (*job)(void*), void* context) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    job_ = job;
+    context_ = context;
+    pending_ = true;
+  }
+  wake_.notify_one();
+}
+
+void Worker::wait() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  done_.wait(lock, [this] { return !pending_; });
+}
+
+void Worker::loop() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    wake_.wait(lock, [this] { return pending_ || quit_; });
+    if (quit_) return;
+    lock.unlock();
+    job_(context_);
+    lock.lock();
+    pending_ = false;
+    done_.notify_one();
+  }
+}
+
+}  // namespace proximity_detail
 
 float point_capsule_distance(const Eigen::Vector3f& p, const Capsule& capsule,
                              Eigen::Vector3f* closest_on_capsule) {
+  using namespace proximity_detail;
   const Segment s = make_segment(capsule);
   const float distance_m = surface_distance(s, axis_distance_sq(s, p.x(), p.y(), p.z()));
   if (closest_on_capsule != nullptr) {
@@ -114,53 +187,10 @@ float point_capsule_distance(const Eigen::Vector3f& p, const Capsule& capsule,
 
 Contact closest_contact_brute(const PointCloud& points_base, const PointCloud& points_camera,
                               const RobotModel& robot) {
-  Contact contact;
-  const size_t n = points_base.size();
-  if (n == 0 || robot.capsules.empty()) return contact;
-  const float* x = points_base.x.data();
-  const float* y = points_base.y.data();
-  const float* z = points_base.z.data();
-
-  // Pass 1, vectorised: the minimum over all points for each capsule, then over capsules.
-  // The first kMaxRemembered capsule minima are kept so that pass 2 skips capsules that do
-  // not reach the overall minimum; a fixed array, so that the search never allocates.
-  constexpr size_t kMaxRemembered = 64;
-  std::array<float, kMaxRemembered> capsule_min_m{};
-  const float inf = std::numeric_limits<float>::infinity();
-  float best_m = inf;
-  for (size_t c = 0; c < robot.capsules.size(); ++c) {
-    const Segment s = make_segment(robot.capsules[c]);
-    const float d2 = min_axis_distance_sq(s, x, y, z, n);
-    const float m = d2 < inf ? surface_distance(s, d2) : inf;
-    if (c < kMaxRemembered) capsule_min_m[c] = m;
-    best_m = std::min(best_m, m);
-  }
-  if (!(best_m < std::numeric_limits<float>::infinity())) return contact;  // no finite point
-
-  // Pass 2, the arg-min: lowest point index attaining the minimum, then lowest capsule index.
-  // Only capsules whose minimum equals best_m are searched again, each up to its first hit.
-  size_t best_point = n;
-  size_t best_capsule = 0;
-  for (size_t c = 0; c < robot.capsules.size(); ++c) {
-    if (c < kMaxRemembered && capsule_min_m[c] != best_m) continue;
-    const Segment s = make_segment(robot.capsules[c]);
-    const size_t i = first_index_at(s, x, y, z, std::min(n, best_point + 1), best_m);
-    if (i < best_point) {
-      best_point = i;
-      best_capsule = c;
-    }
-  }
-  if (best_point == n) return contact;  // unreachable: pass 1 found this value
-
-  const Capsule& capsule = robot.capsules[best_capsule];
-  contact.valid = true;
-  contact.distance_m = best_m;
-  contact.closest_base = points_base.point(best_point);
-  point_capsule_distance(contact.closest_base, capsule, &contact.closest_robot_base);
-  contact.robot_link = capsule.link;
-  if (points_camera.size() == n) contact.closest_camera = points_camera.point(best_point);
-  if (points_base.pixel.size() == n) contact.pixel = static_cast<int>(points_base.pixel[best_point]);
-  return contact;
+  std::vector<proximity_detail::CapsuleBound> capsules;
+  proximity_detail::prepare_bounds(robot, capsules);
+  const proximity_detail::Best best = proximity_detail::brute_search(points_base, capsules, nullptr);
+  return proximity_detail::make_contact(best, points_base, points_camera, robot);
 }
 
 }  // namespace hrcsense

@@ -1,5 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — background learning: per-pixel mean, spread and valid ratio over a still batch.
+// hrcsense — background learning: per-pixel mean, spread and valid ratio over a still batch, a
+// noise floor learnt from the batch when the camera has no noise model, and a background for
+// the pixels the camera measures too rarely to learn one of their own.
+//
+// Why it is built this way: a structured-light camera at 2–9 m (../shared/data/
+// ist_piv_lab_people) loses and regains about 12 % of its pixels between frames of an empty
+// room and quantises depth in steps of ~0.003·z² (7 cm at 5 m). Counting every flickering or
+// one-step pixel as motion makes learning restart forever; so flicker makes a pixel unreliable,
+// not moving, noise is judged against a floor learnt from the whole image, and motion has to
+// cover an area (a person does, a flickering depth edge does not).
 
 #include "hrcsense/camera.hpp"
 #include "hrcsense/segmentation.hpp"
@@ -10,10 +19,6 @@
 
 namespace hrcsense {
 namespace {
-
-// A pixel valid in only part of the batch with a usable mean had something come and go.
-constexpr double kFlickerMinRatio = 0.2;
-constexpr double kFlickerMaxRatio = 0.8;
 
 std::string size_changed_message(int old_w, int old_h, int new_w, int new_h) {
   char text[160];
@@ -41,24 +46,10 @@ struct BatchSums {
   int frames;
 };
 
-/// Writes mean, spread and valid ratio of a complete batch into `model` and returns the share
-/// of valid pixels that moved during it (0..1).
-double summarise_batch(const BatchSums& sums, const Frame& frame, const BackgroundParams& params,
-                       BackgroundModel& model) {
-  const size_t n = sums.pixels;
-  const double scale_m = frame.depth.depth_scale_m;
+/// Writes mean and spread over the valid samples and the valid ratio of every pixel.
+void write_statistics(const BatchSums& sums, double scale_m, BackgroundModel& model) {
   const double frames = sums.frames;
-  // σ_model(z) = z² · c; without a baseline there is no noise model, only the absolute floor.
-  const bool have_model = frame.stereo_baseline_mm > 0.0F && frame.intrinsics.fx > 0.0F;
-  const double c = have_model ? stereo_depth_sigma_m(1.0, frame.intrinsics.fx, frame.stereo_baseline_mm,
-                                                     params.subpixel_rms_px)
-                              : 0.0;
-  const double k_sigma = params.moving_k_sigma;
-  const double min_spread_m = params.moving_min_spread_m;
-
-  size_t valid_pixels = 0;
-  size_t moving_pixels = 0;
-  for (size_t i = 0; i < n; ++i) {
+  for (size_t i = 0; i < sums.pixels; ++i) {
     const uint32_t valid = sums.valid_count[i];
     if (valid == 0) {
       model.mean_m[i] = 0.0F;
@@ -68,19 +59,162 @@ double summarise_batch(const BatchSums& sums, const Frame& frame, const Backgrou
     }
     const double mean_raw = sums.sum[i] / valid;
     const double variance_raw = std::max(0.0, sums.sum_sq[i] / valid - mean_raw * mean_raw);
-    const double mean_m = mean_raw * scale_m;
-    const double spread_m = std::sqrt(variance_raw) * scale_m;
-    const double ratio = valid / frames;
-    model.mean_m[i] = static_cast<float>(mean_m);
-    model.spread_m[i] = static_cast<float>(spread_m);
-    model.valid_ratio[i] = static_cast<float>(ratio);
-
-    const double limit_m = std::max(k_sigma * c * mean_m * mean_m, min_spread_m);
-    const bool came_and_went = ratio >= kFlickerMinRatio && ratio <= kFlickerMaxRatio;
-    ++valid_pixels;
-    moving_pixels += (spread_m > limit_m || came_and_went) ? 1U : 0U;
+    model.mean_m[i] = static_cast<float>(mean_raw * scale_m);
+    model.spread_m[i] = static_cast<float>(std::sqrt(variance_raw) * scale_m);
+    model.valid_ratio[i] = static_cast<float>(valid / frames);
   }
-  return valid_pixels == 0 ? 0.0 : static_cast<double>(moving_pixels) / static_cast<double>(valid_pixels);
+}
+
+bool is_reliable(const BackgroundModel& model, size_t i, float min_valid_ratio) {
+  return model.valid_ratio[i] > 0.0F && model.valid_ratio[i] >= min_valid_ratio;
+}
+
+/// How much smaller the median spread of n Gaussian samples (population formula) is than σ:
+/// sqrt(median(χ²ₙ₋₁) / n), with the Wilson–Hilferty approximation of the χ² median
+/// (k · (1 − 2 / 9k)³, within 1 % for k ≥ 1). 0.68 for 3 samples, 0.91 for 10.
+double median_spread_per_sigma(uint32_t samples) {
+  const double k = samples - 1.0;
+  const double c = 1.0 - 2.0 / (9.0 * k);
+  return std::sqrt(k * c * c * c / samples);
+}
+
+/// The depth noise σ / z² (1/m) of a batch without a stereo noise model: the median over the
+/// reliable pixels with at least two samples of spread / mean², each spread corrected for its
+/// sample count (a spread over a few samples is mostly smaller than σ). The median, because up
+/// to half of the pixels may move or flicker without moving it, while any higher quantile would
+/// let a person covering a fifth of the view raise the floor above their own motion. A noise-free
+/// camera gives 0.
+double learnt_noise_per_z2(const BatchSums& sums, const BackgroundModel& model, float min_valid_ratio,
+                           std::vector<float>& ratios) {
+  ratios.clear();  // keeps its capacity: no allocation after the first batch of a size
+  for (size_t i = 0; i < sums.pixels; ++i) {
+    const uint32_t samples = sums.valid_count[i];
+    if (samples < 2 || !is_reliable(model, i, min_valid_ratio)) continue;
+    const double mean_m = model.mean_m[i];
+    ratios.push_back(static_cast<float>(model.spread_m[i] / (mean_m * mean_m * median_spread_per_sigma(samples))));
+  }
+  if (ratios.empty()) return 0.0;
+  const auto middle = ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2);
+  std::nth_element(ratios.begin(), middle, ratios.end());
+  return *middle;
+}
+
+/// Marks (1) the reliable pixels whose spread exceeds max(k · noise_per_z2 · mean², min_spread_m)
+/// and returns how many pixels are reliable.
+size_t mark_moving(const BackgroundModel& model, const BackgroundParams& params, double noise_per_z2,
+                   uint8_t* moving) {
+  const size_t n = model.mean_m.size();
+  const double k_noise = params.moving_k_sigma * noise_per_z2;
+  size_t reliable = 0;
+  for (size_t i = 0; i < n; ++i) {
+    moving[i] = 0;
+    if (!is_reliable(model, i, params.min_valid_ratio)) continue;
+    ++reliable;
+    const double mean_m = model.mean_m[i];
+    const double limit_m = std::max(k_noise * mean_m * mean_m, static_cast<double>(params.moving_min_spread_m));
+    moving[i] = model.spread_m[i] > limit_m ? 1 : 0;
+  }
+  return reliable;
+}
+
+/// Moving pixels whose whole width_px × width_px square (clipped to the image, so that motion at
+/// the border counts) moved too: a binary erosion, separable into a row and a column pass.
+size_t count_wide_motion(const uint8_t* moving, int width, int height, int width_px, uint8_t* rows_ok) {
+  const int r = std::max(width_px, 1) / 2;
+  for (int v = 0; v < height; ++v) {
+    const uint8_t* row = moving + static_cast<size_t>(v) * width;
+    for (int u = 0; u < width; ++u) {
+      uint8_t all = 1;
+      for (int k = std::max(u - r, 0); k <= std::min(u + r, width - 1); ++k) all &= row[k];
+      rows_ok[static_cast<size_t>(v) * width + u] = all;
+    }
+  }
+  size_t count = 0;
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      uint8_t all = 1;
+      for (int k = std::max(v - r, 0); k <= std::min(v + r, height - 1); ++k) {
+        all &= rows_ok[static_cast<size_t>(k) * width + u];
+      }
+      count += all;
+    }
+  }
+  return count;
+}
+
+/// A few frames cannot measure one pixel's noise (three samples of a quantising camera are
+/// often equal): raise each reliable pixel's spread to the batch's noise at its depth.
+void apply_noise_floor(BackgroundModel& model, double noise_per_z2, float min_valid_ratio) {
+  for (size_t i = 0; i < model.mean_m.size(); ++i) {
+    if (!is_reliable(model, i, min_valid_ratio)) continue;
+    const double mean_m = model.mean_m[i];
+    model.spread_m[i] = std::max(model.spread_m[i], static_cast<float>(noise_per_z2 * mean_m * mean_m));
+  }
+}
+
+/// Gives every unreliable pixel the background of the reliable pixels closest to it in the image:
+/// a breadth-first search from the reliable pixels over 8-neighbours, in which a pixel at
+/// distance k takes the smallest mean (with its spread) among its neighbours at distance k − 1,
+/// up to `radius_px`; farther pixels stay unknown (0). Closest in the image, so that a slanted
+/// surface or an object a few pixels away does not lend its depth; the smallest mean among
+/// equally close ones, so that a pixel in a thin invalid band at a depth edge (where a camera
+/// rarely measures) is foreground only when nearer than both sides. Its own samples are not
+/// used: a single valid reading may be a person passing or a glint. With `keep_unseen`, pixels
+/// never valid stay unknown and the search does not cross them.
+void fill_unreliable(BackgroundModel& model, float min_valid_ratio, int radius_px, bool keep_unseen,
+                     std::vector<int32_t>& queue, std::vector<uint16_t>& layer) {
+  const int width = model.width;
+  const int height = model.height;
+  const size_t n = model.mean_m.size();
+  constexpr uint16_t kUnset = 0xFFFF;
+  constexpr uint16_t kUnseen = 0xFFFE;  // never assigned, never crossed
+  const int radius = std::clamp(radius_px, 0, kUnseen - 1);
+  size_t tail = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const bool unseen = keep_unseen && model.valid_ratio[i] == 0.0F;
+    layer[i] = is_reliable(model, i, min_valid_ratio) ? 0 : unseen ? kUnseen : kUnset;
+    if (layer[i] == 0) continue;
+    model.mean_m[i] = 0.0F;
+    model.spread_m[i] = 0.0F;
+  }
+  // Layer 0: the reliable pixels next to an unreliable one.
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const size_t i = static_cast<size_t>(v) * width + u;
+      if (layer[i] != 0) continue;
+      bool border = false;
+      for (int nv = std::max(v - 1, 0); nv <= std::min(v + 1, height - 1) && !border; ++nv) {
+        for (int nu = std::max(u - 1, 0); nu <= std::min(u + 1, width - 1); ++nu) {
+          border = border || layer[static_cast<size_t>(nv) * width + nu] == kUnset;
+        }
+      }
+      if (border) queue[tail++] = static_cast<int32_t>(i);
+    }
+  }
+  // Layer k occupies queue[begin, end); its pixels' means are final before layer k + 1 reads them.
+  size_t begin = 0;
+  for (int k = 1; k <= radius && begin < tail; ++k) {
+    const size_t end = tail;
+    for (size_t q = begin; q < end; ++q) {
+      const size_t i = static_cast<size_t>(queue[q]);
+      const int u = static_cast<int>(i % static_cast<size_t>(width));
+      const int v = static_cast<int>(i / static_cast<size_t>(width));
+      for (int nv = std::max(v - 1, 0); nv <= std::min(v + 1, height - 1); ++nv) {
+        for (int nu = std::max(u - 1, 0); nu <= std::min(u + 1, width - 1); ++nu) {
+          const size_t j = static_cast<size_t>(nv) * width + nu;
+          if (layer[j] == kUnset) {
+            layer[j] = static_cast<uint16_t>(k);
+            queue[tail++] = static_cast<int32_t>(j);
+          } else if (layer[j] != k || model.mean_m[i] >= model.mean_m[j]) {
+            continue;
+          }
+          model.mean_m[j] = model.mean_m[i];
+          model.spread_m[j] = model.spread_m[i];
+        }
+      }
+    }
+    begin = end;
+  }
 }
 
 }  // namespace
@@ -98,7 +232,7 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame) {
       message_ = size_changed_message(model_.width, model_.height, depth.width, depth.height);
       status = Status::restarted;
     }
-    // The only allocation: the first frame of a size.
+    // The only allocations: the first frame of a size.
     sum_.assign(n, 0.0);
     sum_sq_.assign(n, 0.0);
     valid_count_.assign(n, 0U);
@@ -107,6 +241,12 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame) {
     model_.mean_m.assign(n, 0.0F);
     model_.spread_m.assign(n, 0.0F);
     model_.valid_ratio.assign(n, 0.0F);
+    ratios_.clear();
+    ratios_.reserve(n);
+    moving_.assign(n, 0);
+    eroded_.assign(n, 0);
+    fill_queue_.assign(n, 0);
+    fill_layer_.assign(n, 0);
     count_ = 0;
   } else if (count_ == 0) {
     std::fill(sum_.begin(), sum_.end(), 0.0);
@@ -126,13 +266,27 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame) {
   if (count_ < std::max(params.frames, 1)) return status;
 
   const BatchSums sums{sum_.data(), sum_sq_.data(), valid_count_.data(), n, count_};
-  const double moving_share = summarise_batch(sums, frame, params, model_);
   const int batch_frames = count_;
   count_ = 0;
+  write_statistics(sums, depth.depth_scale_m, model_);
+  // σ_noise(z) = noise_per_z2 · z²: the stereo model with a baseline, else learnt.
+  const bool have_model = frame.stereo_baseline_mm > 0.0F && frame.intrinsics.fx > 0.0F;
+  noise_per_z2_ = have_model
+                      ? stereo_depth_sigma_m(1.0, frame.intrinsics.fx, frame.stereo_baseline_mm, params.subpixel_rms_px)
+                      : std::min(learnt_noise_per_z2(sums, model_, params.min_valid_ratio, ratios_),
+                                 static_cast<double>(params.max_noise_per_z2));
+  const size_t reliable = mark_moving(model_, params, noise_per_z2_, moving_.data());
+  const size_t moving = count_wide_motion(moving_.data(), depth.width, depth.height, params.motion_min_width_px,
+                                          eroded_.data());
+  const double moving_share = reliable == 0 ? 0.0 : static_cast<double>(moving) / static_cast<double>(reliable);
   if (moving_share > static_cast<double>(params.max_moving_share)) {
     message_ = motion_message(moving_share, batch_frames, params.max_moving_share);
     return Status::restarted;
   }
+  // With a baseline the foreground test adds the stereo model itself.
+  if (!have_model) apply_noise_floor(model_, noise_per_z2_, params.min_valid_ratio);
+  const bool keep_unseen = batch_frames >= params.unseen_min_frames;
+  fill_unreliable(model_, params.min_valid_ratio, params.fill_radius_px, keep_unseen, fill_queue_, fill_layer_);
   ready_ = true;
   return Status::ready;
 }

@@ -119,6 +119,35 @@ void put_truth(std::string& line, const Contact& truth) {
   line += '}';
 }
 
+// The filters as they run; the filtered resolution is the one contact pixels and the learnt
+// background refer to. Left out when no configuration said (preset empty).
+void put_filters(std::string& line, const RunHeader::Filters& filters) {
+  if (filters.preset.empty()) return;
+  put_key(line, "filters");
+  line += '{';
+  put_key(line, "preset");
+  put_string(line, filters.preset);
+  put_key(line, "domain");
+  put_string(line, filters.domain);
+  if (!filters.note.empty()) {
+    put_key(line, "note");
+    put_string(line, filters.note);
+  }
+  put_key(line, "width");
+  put_int(line, filters.intrinsics.width);
+  put_key(line, "height");
+  put_int(line, filters.intrinsics.height);
+  put_key(line, "fx");
+  put_float(line, filters.intrinsics.fx);
+  put_key(line, "fy");
+  put_float(line, filters.intrinsics.fy);
+  put_key(line, "ppx");
+  put_float(line, filters.intrinsics.ppx);
+  put_key(line, "ppy");
+  put_float(line, filters.intrinsics.ppy);
+  line += '}';
+}
+
 }  // namespace
 
 void JsonLinesSink::header(const RunHeader& header) {
@@ -171,7 +200,9 @@ void JsonLinesSink::header(const RunHeader& header) {
     if (i > 0) line += ',';
     put_float(line, in.coeffs[i]);
   }
-  line += "]}}\n";
+  line += "]}";
+  put_filters(line, header.filters);
+  line += "}\n";
   out_ << line;
 }
 
@@ -221,8 +252,10 @@ void JsonLinesSink::frame(const FrameResult& result) {
     line += "null";
   }
 
-  put_key(line, "backend");
-  put_string(line, backend_);
+  put_key(line, "inside");  // a foreground point inside (or on) a capsule: distance 0
+  line += contact.valid ? (contact.inside ? "true" : "false") : "null";
+  put_key(line, "backend");  // the one that searched (auto's pick), else the configured one
+  put_string(line, result.backend != nullptr ? result.backend : backend_.c_str());
   put_key(line, "foreground_points");
   put_int(line, static_cast<int64_t>(result.foreground_points));
   put_key(line, "invalid_pixels");

@@ -130,6 +130,7 @@ BagReader::BagReader(std::string path, BagLimits limits) : path_(std::move(path)
       connections_.clear();
       indexed_counts_.clear();
       chunk_positions_.clear();
+      chunk_connections_.clear();
     }
   }
 }
@@ -204,8 +205,13 @@ void BagReader::read_index(uint64_t index_pos, uint32_t conn_count, uint32_t chu
     if (chunk_pos < data_start_ || chunk_pos >= index_pos) fail(pos, "chunk position outside the chunk area");
     if (!chunk_positions_.empty() && chunk_pos <= chunk_positions_.back()) fail(pos, "chunk positions out of order");
     if (packed_.size() != static_cast<size_t>(record.fields.count) * 8) fail(pos, "chunk info size mismatch");
-    for (size_t k = 0; k < packed_.size(); k += 8) indexed_counts_[le32(&packed_[k])] += le32(&packed_[k + 4]);
+    std::vector<uint32_t> in_chunk;
+    for (size_t k = 0; k < packed_.size(); k += 8) {
+      indexed_counts_[le32(&packed_[k])] += le32(&packed_[k + 4]);
+      in_chunk.push_back(le32(&packed_[k]));
+    }
     chunk_positions_.push_back(chunk_pos);
+    chunk_connections_.push_back(std::move(in_chunk));
     pos = record.end;
   }
 }
@@ -248,7 +254,9 @@ void BagReader::load_chunk(uint64_t offset, const Record& record) {
   size_t in = 0, out = 0;
   for (;;) {
     size_t in_n = packed_.size() - in, out_n = chunk_.size() - out;
-    const size_t hint = LZ4F_decompress(lz4_.get(), chunk_.data() + out, &out_n, packed_.data() + in, &in_n, nullptr);
+    LZ4F_decompressOptions_t options{};
+    options.stableDst = 1;  // chunk_ stays put while one chunk is decompressed: no internal copies
+    const size_t hint = LZ4F_decompress(lz4_.get(), chunk_.data() + out, &out_n, packed_.data() + in, &in_n, &options);
     if (LZ4F_isError(hint)) fail(offset, std::string("lz4 chunk is corrupt: ") + LZ4F_getErrorName(hint));
     in += in_n;
     out += out_n;
@@ -294,7 +302,9 @@ bool BagReader::next(BagMessage& out) {
     }
     if (indexed_) {
       if (next_chunk_ >= chunk_positions_.size()) return false;
-      const uint64_t offset = chunk_positions_[next_chunk_++];
+      const size_t chunk = next_chunk_++;
+      if (!chunk_wanted(chunk)) continue;
+      const uint64_t offset = chunk_positions_[chunk];
       if (!read_record(offset, record, false) || record.fields.op != kOpChunk) fail(offset, "index points to a non-chunk");
       load_chunk(offset, record);
       continue;
@@ -312,6 +322,15 @@ bool BagReader::next(BagMessage& out) {
       fail(offset, "unexpected record (op " + std::to_string(op) + ")");
     }
   }
+}
+
+bool BagReader::chunk_wanted(size_t chunk) const {
+  if (!wanted_) return true;
+  for (const uint32_t conn : chunk_connections_[chunk]) {
+    const auto found = connections_.find(conn);
+    if (found == connections_.end() || wanted_(found->second)) return true;  // unknown: read it
+  }
+  return false;
 }
 
 void BagReader::rewind() {

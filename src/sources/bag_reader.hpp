@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -54,6 +55,10 @@ class BagReader {
   bool next(BagMessage& out);
   /// Starts over at the first chunk (connections stay known).
   void rewind();
+  /// Indexed bags only: chunks whose messages all belong to connections for which `wanted`
+  /// returns false are skipped without being read or decompressed (e.g. colour nobody asked
+  /// for). Their messages are then never returned. Unindexed bags are read whole.
+  void set_wanted(std::function<bool(const BagConnection&)> wanted) { wanted_ = std::move(wanted); }
 
   const std::string& path() const { return path_; }
   bool indexed() const { return indexed_; }
@@ -71,6 +76,7 @@ class BagReader {
   bool read_record(uint64_t offset, Record& record, bool whole_data);
   void read_index(uint64_t index_pos, uint32_t conn_count, uint32_t chunk_count);
   void load_chunk(uint64_t offset, const Record& record);
+  bool chunk_wanted(size_t chunk) const;
   void add_connection(const Record& record, uint64_t offset);
   [[noreturn]] void fail(uint64_t offset, const std::string& problem) const;
 
@@ -89,6 +95,8 @@ class BagReader {
   bool indexed_ = false;
   std::string index_problem_;
   std::vector<uint64_t> chunk_positions_;  ///< from the index
+  std::vector<std::vector<uint32_t>> chunk_connections_;  ///< from the index: connections per chunk
+  std::function<bool(const BagConnection&)> wanted_;
   size_t next_chunk_ = 0;           ///< indexed: next entry of chunk_positions_
   uint64_t scan_pos_ = 0;           ///< not indexed: next record in the file
   std::map<uint32_t, BagConnection> connections_;

@@ -175,9 +175,36 @@ bool read_depth_frame(BagState& s, bool with_color, Frame& out) {
   return false;
 }
 
+/// The colour stream's intrinsics and the depth → colour extrinsics, as far as the bag has them.
+void set_color_calibration(const BagState& s, Frame& out) {
+  const auto color_in = s.intrinsics.find(s.color_stream);
+  out.color_intrinsics = color_in == s.intrinsics.end() ? Intrinsics{} : color_in->second;
+  const auto depth_tf = s.tf.find(s.depth_stream);
+  const auto color_tf = s.tf.find(s.color_stream);
+  if (depth_tf == s.tf.end() || color_tf == s.tf.end()) {
+    out.depth_to_color.reset();
+    return;
+  }
+  // Both tfs are given from the group's reference stream: E_depth→color = E_color ∘ E_depth⁻¹.
+  const Pose T_color_depth = color_tf->second * depth_tf->second.inverse();
+  Extrinsics e;
+  for (int i = 0; i < 3; ++i) {
+    e.translation_m[static_cast<size_t>(i)] = static_cast<float>(T_color_depth.translation()(i));
+    for (int j = 0; j < 3; ++j) e.rotation[static_cast<size_t>(3 * j + i)] = static_cast<float>(T_color_depth.linear()(i, j));
+  }
+  out.depth_to_color = e;
+}
+
 }  // namespace
 
 BagSource::BagSource(RecordingParams params) : params_(std::move(params)), state_(std::make_unique<BagState>(params_.path)) {
+  // Chunks holding only images nobody asked for (colour without with_color, infrared) are not
+  // even decompressed: the SDK writes one chunk per large frame, so this halves the work.
+  state_->reader.set_wanted([with_color = params_.with_color](const BagConnection& connection) {
+    const bag::TopicRole role = bag::classify_topic(connection.topic);
+    if (role.role != bag::Role::image) return true;
+    return role.stream.rfind("Depth_", 0) == 0 || (with_color && role.stream.rfind("Color_", 0) == 0);
+  });
   // The first frame is read now so that info() can report the depth intrinsics.
   if (!read_depth_frame(*state_, params_.with_color, state_->pending)) {
     throw IoError(params_.path + ": no depth frames (topic /device_0/sensor_<s>/Depth_<i>/image/data)");
@@ -232,8 +259,11 @@ Source::Status BagSource::next(Frame& out) {
   if (params_.stereo_baseline_mm > 0.0F && out.stereo_baseline_mm <= 0.0F) out.stereo_baseline_mm = params_.stereo_baseline_mm;
   if (s.have_color) {
     out.color = s.color;
+    set_color_calibration(s, out);
   } else {
     out.color.reset();
+    out.color_intrinsics = Intrinsics{};
+    out.depth_to_color.reset();
   }
   out.index = s.played++;
   return Status::frame;

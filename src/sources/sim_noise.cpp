@@ -3,6 +3,8 @@
 
 #include "sim_noise.hpp"
 
+#include <vector>
+
 namespace hrcsense::sim_detail {
 
 const NormalStream::Tables& NormalStream::tables() {
@@ -56,6 +58,50 @@ float NormalStream::slow(int32_t value, unsigned layer) {
     layer = static_cast<unsigned>((bits >> 32) & 127U);
     if (static_cast<uint32_t>(std::abs(static_cast<int64_t>(value))) < t.k[layer]) {
       return static_cast<float>(value * t.w[layer]);
+    }
+  }
+}
+
+namespace {
+
+constexpr size_t kTableSize = size_t{1} << 18;
+
+const std::vector<float>& normal_table() {
+  static const std::vector<float> kTable = [] {
+    std::vector<float> t(kTableSize);
+    NormalStream normal(0x6A09E667F3BCC908ULL);  // any fixed seed
+    double sum = 0.0;
+    for (float& x : t) {
+      x = normal.next();
+      sum += x;
+    }
+    const double mean = sum / static_cast<double>(kTableSize);
+    double sq = 0.0;
+    for (const float x : t) sq += (x - mean) * (x - mean);
+    const double scale = 1.0 / std::sqrt(sq / static_cast<double>(kTableSize));
+    for (float& x : t) x = static_cast<float>((x - mean) * scale);
+    return t;
+  }();
+  return kTable;
+}
+
+}  // namespace
+
+void fill_normal_rows(uint64_t frame_seed, int width, int height, float* out) {
+  const std::vector<float>& table = normal_table();
+  const size_t w = static_cast<size_t>(width);
+  // Rows wider than the table (none of the D435's) wrap around it.
+  const size_t span = w < kTableSize ? kTableSize - w + 1 : 1;
+  for (int v = 0; v < height; ++v) {
+    const uint64_t h = mix64(frame_seed + static_cast<uint64_t>(v + 1) * 0x9E3779B97F4A7C15ULL);
+    const size_t offset = static_cast<size_t>(h >> 40) % span;
+    const float sign = (h & 1U) != 0 ? -1.0F : 1.0F;
+    float* row = out + static_cast<size_t>(v) * w;
+    if (offset + w <= kTableSize) {
+      const float* window = table.data() + offset;
+      for (size_t u = 0; u < w; ++u) row[u] = sign * window[u];
+    } else {
+      for (size_t u = 0; u < w; ++u) row[u] = sign * table[(offset + u) % kTableSize];
     }
   }
 }

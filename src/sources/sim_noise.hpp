@@ -59,4 +59,12 @@ class NormalStream {
   uint64_t state_;
 };
 
+/// Fills a width × height image with N(0, 1) draws for the frame whose seed is `frame_seed`.
+/// Each row is a window of a fixed table of 2^18 ziggurat draws (normalised to mean 0, σ 1),
+/// at an offset and with a sign drawn per row and frame, so a frame costs a copy instead of a
+/// draw per pixel. Neighbouring pixels get independent table entries and a pixel gets an
+/// independent entry each frame (unless two frames pick the same offset, 1 in 2^18); what
+/// is given up is that, within a frame, two rows may share a stretch of values, shifted.
+void fill_normal_rows(uint64_t frame_seed, int width, int height, float* out);
+
 }  // namespace hrcsense::sim_detail

@@ -29,8 +29,9 @@ inline float unit24(uint64_t bits, int shift) {
 /// Noise-free disparity d = fx·B / Z per pixel (0 where nothing was hit).
 void compute_disparity(const float* z_m, float fxb_px_m, size_t n, float* disparity_px) {
   for (size_t i = 0; i < n; ++i) {
-    const float z = z_m[i];
-    disparity_px[i] = z < kNoHit && z > 0.0F ? fxb_px_m / z : 0.0F;
+    // Hits have z > 0 and misses +inf, which gives 0. No select: GCC keeps float selects
+    // as branches (trapping math), and this loop should vectorise.
+    disparity_px[i] = fxb_px_m / std::max(std::numeric_limits<float>::min(), z_m[i]);
   }
 }
 
@@ -46,21 +47,28 @@ void mark_hidden(const SimParams& p, float max_disparity_px, int width, int heig
   // A step smaller than this is rounding, not occlusion: x_r grows by (1 − ∂d/∂u) per column,
   // which is > 0 for every surface the right imager sees at more than grazing incidence.
   constexpr float kEpsPx = 1e-3F;
-  for (int v = 0; v < height; ++v) {
-    const size_t row = static_cast<size_t>(v) * width;
-    float min_right_xr = std::numeric_limits<float>::infinity();
+  // Branch-free, and several rows at once so that their running minima (a serial chain per
+  // row) overlap in the pipeline.
+  constexpr int kRows = 4;
+  const float band_limit = p.left_band ? -0.5F : -std::numeric_limits<float>::infinity();
+  const float shadow_eps = p.occlusion_shadows ? kEpsPx : std::numeric_limits<float>::infinity();
+  for (int v0 = 0; v0 < height; v0 += kRows) {
+    const int rows = std::min(kRows, height - v0);
+    float min_right_xr[kRows];
+    for (float& m : min_right_xr) m = std::numeric_limits<float>::infinity();
     for (int u = width - 1; u >= 0; --u) {
-      const float d = disparity_px[row + u];
-      if (!(d > 0.0F)) {
-        hidden[row + u] = 0;
-        continue;
+      for (int k = 0; k < rows; ++k) {
+        const size_t i = static_cast<size_t>(v0 + k) * width + u;
+        const float d = disparity_px[i];
+        const bool hit = d > 0.0F;
+        const float xr = static_cast<float>(u) - d;
+        const bool outside = xr < band_limit;
+        const bool shadowed = xr > min_right_xr[k] + shadow_eps;
+        const bool too_near = d > max_disparity_px;
+        hidden[i] = hit && (outside || shadowed || too_near) ? 1 : 0;
+        const float m = xr < min_right_xr[k] ? xr : min_right_xr[k];
+        min_right_xr[k] = hit ? m : min_right_xr[k];
       }
-      const float xr = static_cast<float>(u) - d;
-      const bool outside = p.left_band && xr < -0.5F;
-      const bool shadowed = p.occlusion_shadows && xr > min_right_xr + kEpsPx;
-      const bool too_near = d > max_disparity_px;
-      hidden[row + u] = (outside || shadowed || too_near) ? 1 : 0;
-      min_right_xr = std::min(min_right_xr, xr);
     }
   }
 }
@@ -187,11 +195,34 @@ struct NoisyDepth {
 /// dominates it, so the disparity lands between the two; the near side keeps its own).
 /// Fixed per pixel and seed, so that a still scene has still holes.
 void apply_edges(const SimParams& p, int width, int height, const float* d_true, const float* correlated,
-                 const float* g, const uint8_t* hidden, const NoisyDepth& to_raw, uint16_t* raw) {
+                 const float* g, const uint8_t* hidden, const NoisyDepth& to_raw, uint16_t* raw,
+                 std::vector<uint8_t>& row_steps) {
   const uint64_t fixed_seed = mix64(p.seed ^ kFixedSalt);
+  row_steps.resize(static_cast<size_t>(width));
+  uint8_t* steps = row_steps.data();
   for (int v = 0; v < height; ++v) {
+    // Most pixels lie on no edge: screen the interior of the row branch-free (it vectorises),
+    // then look closer only at pixels with a large step to some neighbour. Border rows and
+    // columns skip the screen.
+    const size_t row = static_cast<size_t>(v) * width;
+    const bool border_row = v == 0 || v + 1 == height;
+    if (!border_row) {
+      for (int u = 1; u + 1 < width; ++u) {
+        const size_t i = row + u;
+        const float di = d_true[i];
+        const float left = std::abs(d_true[i - 1] - di);
+        const float right = std::abs(d_true[i + 1] - di);
+        const float up = std::abs(d_true[i - width] - di);
+        const float down = std::abs(d_true[i + width] - di);
+        // The comparison stored as is: a `? 1 : 0` would stay a branch and stop vectorisation.
+        steps[u] = static_cast<uint8_t>(std::max(std::max(left, right), std::max(up, down)) > p.edge_jump_px);
+      }
+      steps[0] = 1;
+      steps[width - 1] = 1;
+    }
     for (int u = 0; u < width; ++u) {
-      const size_t i = static_cast<size_t>(v) * width + u;
+      const size_t i = row + u;
+      if (!border_row && steps[u] == 0) continue;
       if (hidden[i] != 0 || !(d_true[i] > 0.0F)) continue;
       const ptrdiff_t j = edge_neighbour(d_true, u, v, width, height, i, p.edge_jump_px);
       if (j < 0) continue;
@@ -254,8 +285,7 @@ void write_sensor_depth(const SimParams& p, float fx_px, int64_t index, const fl
   }
   // One draw per pixel, hit or not, so that a pixel's noise does not depend on the scene.
   scratch.normal_draws.resize(n);
-  NormalStream normal(frame_seed);
-  for (size_t i = 0; i < n; ++i) scratch.normal_draws[i] = normal.next();
+  fill_normal_rows(frame_seed, width, height, scratch.normal_draws.data());
   ensure_correlated(p, width, height, scratch);
   const float* correlated = p.correlated_noise_px > 0.0F ? scratch.correlated_px.data() : nullptr;
   const float step = p.disparity_step_px;
@@ -275,13 +305,16 @@ void write_sensor_depth(const SimParams& p, float fx_px, int64_t index, const fl
     const float inv_step = 1.0F / step;
     for (size_t i = 0; i < n; ++i) {
       const float d = static_cast<float>(static_cast<int32_t>((d_true[i] + sigma * g[i]) * inv_step + 0.5F)) * step;
-      const float r = fxb / d * inv_scale + 0.5F;
-      const bool ok = d_true[i] > 0.0F && hidden[i] == 0 && d > 0.0F && r >= 1.0F && r < 65536.0F;
-      raw[i] = ok ? static_cast<uint16_t>(r) : 0;
+      const float r = fxb / std::max(std::numeric_limits<float>::min(), d) * inv_scale + 0.5F;
+      // Bitwise & and integer masks instead of selects, a clamped conversion: branch-free, so
+      // that it vectorises (GCC keeps float selects as branches under trapping math).
+      const int ok = (d_true[i] > 0.0F) & (hidden[i] == 0) & (d > 0.0F) & (r >= 1.0F) & (r < 65536.0F);
+      const auto value = static_cast<int32_t>(std::min(r, 65535.0F));
+      raw[i] = static_cast<uint16_t>(value & -ok);
     }
   }
   // Sparse fix-ups. Flying pixels first (they re-compute a value); dropouts only ever zero one.
-  apply_edges(p, width, height, d_true, correlated, g, hidden, to_raw, raw);
+  apply_edges(p, width, height, d_true, correlated, g, hidden, to_raw, raw, scratch.row_steps);
   apply_materials(p, width, height, scratch.object_ids.data(), scratch.material_of_id.data(), raw);
   SpeckleStream speckle(mix64(frame_seed ^ kSpeckleSalt), p.speckle);
   for (size_t i = speckle.first(); i < n; i = speckle.after(i)) raw[i] = 0;

@@ -67,8 +67,8 @@ TEST(ConfigErrors, IllTypedValuesNameFileKeyAndExpectation) {
 
 TEST(ConfigErrors, NotYetImplementedChoicesSaySo) {
   // The filters are built now: their keys are tested in tests/filters/filters_config_test.cpp.
-  expect_config_error("", {"robot.model=ur5e"}, {"robot.model 'ur5e'", "not implemented yet"});
-  expect_config_error("", {"proximity.backend=kdtree"}, {"proximity.backend 'kdtree'", "not implemented yet"});
+  // The arm models are built now: their keys are tested in tests/config/robot_config_test.cpp.
+  expect_config_error("", {"proximity.backend=depth_space"}, {"proximity.backend 'depth_space'", "not implemented yet"});
   const Config live = load_config("", {"source.type=realsense"});
   try {
     (void)make_source(live);

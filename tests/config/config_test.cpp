@@ -27,7 +27,8 @@ TEST(Config, DefaultsWithoutFileMatchTheStructDefaults) {
   EXPECT_DOUBLE_EQ(config.sim.fps, sim.fps);
   EXPECT_FLOAT_EQ(config.sim.disparity_noise_px, sim.disparity_noise_px);
   EXPECT_TRUE(config.scene.objects.empty());
-  EXPECT_EQ(config.filters_preset, "none");
+  EXPECT_EQ(config.filters_preset, "sdk");  // the RealSense Viewer's defaults (issue 4)
+  EXPECT_EQ(config.pipeline.filters.order, filter_preset("sdk")->order);
   EXPECT_EQ(config.pipeline.background.frames, 100);
   EXPECT_FLOAT_EQ(config.pipeline.foreground.k_sigma, pipeline.foreground.k_sigma);
   EXPECT_FLOAT_EQ(config.pipeline.safety.slow_distance_m, pipeline.safety.slow_distance_m);

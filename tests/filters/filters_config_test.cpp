@@ -31,9 +31,18 @@ void expect_error(const std::vector<std::string>& sets, const std::vector<std::s
 }
 
 TEST(FiltersConfig, Presets) {
-  EXPECT_TRUE(order_of({}).empty());
-  EXPECT_EQ(order_of({"filters.preset=sdk"}),
-            (std::vector<FilterBlock>{B::threshold, B::decimation, B::to_disparity, B::spatial, B::temporal, B::to_depth}));
+  EXPECT_TRUE(order_of({"filters.preset=none"}).empty());
+  const std::vector<FilterBlock> sdk{B::threshold, B::decimation, B::to_disparity, B::spatial, B::temporal, B::to_depth};
+  EXPECT_EQ(order_of({"filters.preset=sdk"}), sdk);
+  // No preset named: the RealSense Viewer's defaults (issue 4), with the SDK's option defaults.
+  const Config defaults = load_config("", {});
+  EXPECT_EQ(defaults.filters_preset, "sdk");
+  EXPECT_EQ(defaults.pipeline.filters.order, sdk);
+  EXPECT_EQ(defaults.pipeline.filters.decimation.magnitude, 2);
+  EXPECT_EQ(defaults.pipeline.filters.threshold.min_m, 0.1F);
+  EXPECT_EQ(defaults.pipeline.filters.threshold.max_m, 4.0F);
+  EXPECT_EQ(defaults.pipeline.filters.spatial.alpha, 0.5F);
+  EXPECT_EQ(defaults.pipeline.filters.temporal.persistence, 3);
   const Config thesis = load_config("", {"filters.preset=thesis"});
   EXPECT_EQ(thesis.pipeline.filters.order, (std::vector<FilterBlock>{B::to_disparity, B::spatial, B::temporal, B::to_depth}));
   EXPECT_EQ(thesis.pipeline.filters.spatial.alpha, 0.4F);
@@ -45,7 +54,8 @@ TEST(FiltersConfig, OrderAndEnabled) {
   EXPECT_EQ(order_of({"filters.order=[spatial, threshold]"}), (std::vector<FilterBlock>{B::spatial, B::threshold}));
   EXPECT_EQ(order_of({"filters.preset=sdk", "filters.decimation.enabled=false"}),
             (std::vector<FilterBlock>{B::threshold, B::to_disparity, B::spatial, B::temporal, B::to_depth}));
-  EXPECT_EQ(order_of({"filters.hole_filling.enabled=true"}), (std::vector<FilterBlock>{B::hole_filling}));
+  EXPECT_EQ(order_of({"filters.preset=none", "filters.hole_filling.enabled=true"}),
+            (std::vector<FilterBlock>{B::hole_filling}));
   EXPECT_EQ(order_of({"filters.order=[threshold, spatial]", "filters.spatial.enabled=false"}),
             (std::vector<FilterBlock>{B::threshold}));
   expect_error({"filters.order=[threshold]", "filters.spatial.enabled=true"}, {"filters.spatial.enabled", "filters.order"});

@@ -5,6 +5,7 @@
 
 #include "hrcsense/filters.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -172,5 +173,90 @@ struct Temporal {
     }
   }
 };
+
+
+// §3: keep raw when min <= raw · units <= max, in float32.
+inline DepthImage threshold(const ThresholdParams& q, DepthImage img) {
+  for (uint16_t& raw : img.pixels) {
+    const float z = float(raw) * img.depth_scale_m;
+    if (!(z >= q.min_m && z <= q.max_m)) raw = 0;
+  }
+  return img;
+}
+
+// §2: disparity = F / raw for raw != 0.
+inline DisparityImage to_disparity(const DepthImage& in, float factor) {
+  DisparityImage out;
+  out.resize(in.width, in.height);
+  for (size_t i = 0; i < in.pixels.size(); ++i) out.pixels[i] = in.pixels[i] != 0 ? factor / float(in.pixels[i]) : 0.0F;
+  return out;
+}
+
+// §2: raw = F / d + 0.5 truncated, for normal d; through a 32-bit integer as the SDK's x86 build
+// (whose conversion gives INT32_MIN out of range).
+inline DepthImage to_depth(const DisparityImage& in, float factor) {
+  DepthImage out;
+  out.resize(in.width, in.height);
+  for (size_t i = 0; i < in.pixels.size(); ++i) {
+    if (!std::isnormal(in.pixels[i])) continue;
+    const float x = factor / in.pixels[i] + 0.5F;
+    const int32_t truncated = (x > -2147483648.0F && x < 2147483648.0F) ? int32_t(x) : INT32_MIN;
+    out.pixels[i] = uint16_t(uint32_t(truncated));
+  }
+  return out;
+}
+
+// §4: lower median (s 2–3) or truncated mean (otherwise) of each block's non-zero values,
+// padded to multiples of 4.
+inline DepthImage decimate(int s, const DepthImage& in) {
+  DepthImage out;
+  const int rw = in.width / s, rh = in.height / s;
+  out.resize((rw + 3) / 4 * 4, (rh + 3) / 4 * 4);
+  for (int j = 0; j < rh; ++j) {
+    for (int i = 0; i < rw; ++i) {
+      std::vector<uint16_t> values;
+      for (int y = j * s; y < j * s + s; ++y)
+        for (int x = i * s; x < i * s + s; ++x)
+          if (in.pixels[size_t(y) * in.width + x] != 0) values.push_back(in.pixels[size_t(y) * in.width + x]);
+      uint16_t result = 0;
+      if (!values.empty()) {
+        std::sort(values.begin(), values.end());
+        uint32_t sum = 0;
+        for (const uint16_t v : values) sum += v;
+        result = (s == 2 || s == 3) ? values[(values.size() - 1) / 2] : uint16_t(sum / values.size());
+      }
+      out.pixels[size_t(j) * out.width + i] = result;
+    }
+  }
+  return out;
+}
+
+// §7, in place in raster order: mode 0 copies the left pixel; 1 takes the largest of up-left,
+// up, left, down-left, down; 2 the smallest non-empty one, starting from up even when empty.
+template <typename Image>
+Image fill_holes(int mode, Image img) {
+  using T = typename decltype(img.pixels)::value_type;
+  const auto empty = [](T x) {
+    if constexpr (std::is_same_v<T, float>) return plus_zero(x);
+    else return x == 0;
+  };
+  const int w = img.width, h = img.height;
+  auto at = [&](int u, int v) -> T& { return img.pixels[size_t(v) * w + u]; };
+  for (int v = 0; v < h; ++v) {
+    for (int u = 1; u < w; ++u) {
+      if (!empty(at(u, v))) continue;
+      if (mode == 0) {
+        at(u, v) = at(u - 1, v);
+      } else if (v >= 1 && v + 1 < h) {
+        T best = at(u, v - 1);
+        for (const T x : {at(u - 1, v - 1), at(u - 1, v), at(u - 1, v + 1), at(u, v + 1)}) {
+          if (mode == 1 ? x > best : (!empty(x) && x < best)) best = x;
+        }
+        at(u, v) = best;
+      }
+    }
+  }
+  return img;
+}
 
 }  // namespace hrcsense::reference

@@ -1,32 +1,73 @@
 // SPDX-License-Identifier: Apache-2.0
 // Acceptance (issue C1): the whole pipeline on a real depth camera's recording of people
-// walking through a room (../shared/data/ist_piv_lab_people, frames seconds apart).
+// walking through a room (../shared/data/ist_piv_lab_people, frames seconds apart), without
+// depth filters and with the default (SDK) preset.
 #include "recordings_test_util.hpp"
 
 #include "hrcsense/config.hpp"
+#include "hrcsense/io.hpp"
 #include "hrcsense/recordings.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
 namespace hrcsense {
 namespace {
 
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
 struct FrameStats {
   double foreground_share = 0.0;  ///< foreground pixels / all pixels
   bool contact = false;
   bool valid = false;             ///< processed with a ready background
   std::string reason;             ///< the verdict's reason
-  double closest_depth_m = 0.0;
+  double closest_depth_m = kNaN;
   double closest_blob_share = 0.0;  ///< size of the foreground blob holding the closest pixel
+  /// How far the closest point is in front of the empty room: the nearest valid depth of the
+  /// recording's frames 0-2 (unfiltered) at its pixel or, where they have none (about 20 % of
+  /// the room: windows, dark screens), within the first of 8, 16, 32 source pixels around it
+  /// that has one, minus its depth; NaN when there is none.
+  double closest_gap_m = kNaN;
+};
+
+/// The empty room of frames 0-2: per source pixel the nearest valid depth (m), 0 where none.
+struct EmptyRoom {
+  int width = 0;
+  std::vector<float> nearest_m;
+  void add(const DepthImage& depth) {
+    width = depth.width;
+    nearest_m.resize(depth.pixels.size(), 0.0F);
+    for (size_t i = 0; i < depth.pixels.size(); ++i) {
+      const float z_m = depth.pixels[i] * depth.depth_scale_m;
+      if (depth.pixels[i] != 0 && (nearest_m[i] == 0.0F || z_m < nearest_m[i])) nearest_m[i] = z_m;
+    }
+  }
+  /// The nearest depth over the source pixels that pixel `i` of an image `image_width` wide
+  /// covers (decimation: a block of source pixels), widened by `margin_px` source pixels.
+  float nearest_at(int i, int image_width, int margin_px) const {
+    const int scale = width / image_width;
+    const int height = static_cast<int>(nearest_m.size()) / width;
+    const int u0 = (i % image_width) * scale, v0 = (i / image_width) * scale;
+    float nearest = 0.0F;
+    for (int v = std::max(v0 - margin_px, 0); v < std::min(v0 + scale + margin_px, height); ++v) {
+      for (int u = std::max(u0 - margin_px, 0); u < std::min(u0 + scale + margin_px, width); ++u) {
+        const float z_m = nearest_m[static_cast<size_t>(v) * width + u];
+        if (z_m > 0.0F && (nearest == 0.0F || z_m < nearest)) nearest = z_m;
+      }
+    }
+    return nearest;
+  }
 };
 
 /// Pixels of the 4-connected foreground region containing `seed` (0 when seed is not in it).
 size_t blob_size(const std::vector<uint8_t>& mask, int width, int height, int seed) {
-  if (seed < 0 || mask[static_cast<size_t>(seed)] == 0) return 0;
+  if (seed < 0 || static_cast<size_t>(seed) >= mask.size() || mask[static_cast<size_t>(seed)] == 0) return 0;
   std::vector<uint8_t> seen(mask.size(), 0);
   std::vector<int> stack{seed};
   seen[static_cast<size_t>(seed)] = 1;
@@ -47,68 +88,194 @@ size_t blob_size(const std::vector<uint8_t>& mask, int width, int height, int se
   return count;
 }
 
-std::vector<FrameStats> run_people(const std::string& path, const std::vector<std::string>& extra) {
+FrameStats frame_stats(const Pipeline& pipeline, const Frame& processed, const FrameResult& result,
+                       const EmptyRoom& room) {
+  const std::vector<uint8_t>& mask = pipeline.foreground().mask;
+  FrameStats s;
+  s.foreground_share = mask.empty() ? 0.0
+                                    : static_cast<double>(std::count(mask.begin(), mask.end(), uint8_t{1})) /
+                                          static_cast<double>(mask.size());
+  s.contact = result.contact.valid;
+  s.valid = result.valid;
+  s.reason = result.verdict.reason;
+  if (!s.contact) return s;
+  const int pixel = result.contact.pixel;
+  s.closest_depth_m = result.contact.closest_camera.z();
+  s.closest_blob_share = static_cast<double>(blob_size(mask, processed.depth.width, processed.depth.height, pixel)) /
+                         static_cast<double>(mask.size());
+  float room_m = 0.0F;
+  for (int margin_px = 0; margin_px <= 32 && room_m == 0.0F; margin_px = std::max(2 * margin_px, 8)) {
+    room_m = room.nearest_at(pixel, processed.depth.width, margin_px);
+  }
+  if (room_m > 0.0F) s.closest_gap_m = room_m - s.closest_depth_m;
+  return s;
+}
+
+/// Runs the pipeline over the recording; calls `visit(frame_index, pipeline, depth, result)` for
+/// every frame with the depth image the foreground was computed from (after the filters).
+template <typename Visit>
+std::vector<FrameStats> run_people(const std::string& path, const std::vector<std::string>& extra, Visit visit) {
   std::vector<std::string> sets{"source.type=folder", "source.path=" + path, "background.frames=3"};
   sets.insert(sets.end(), extra.begin(), extra.end());
   const Config config = load_config("", sets);
   std::unique_ptr<Source> source = make_source(config);
   Pipeline pipeline(config.pipeline);
+  // The filters' output is not exposed by the pipeline: a second chain with the same
+  // parameters (deterministic) gives the image the foreground was computed from.
+  FilterChain chain;
+  chain.params = config.pipeline.filters;
   Frame frame;
+  Frame filtered;
   FrameResult result;
+  EmptyRoom room;
   std::vector<FrameStats> stats;
   while (source->next(frame) == Source::Status::frame) {
+    if (stats.size() < 3) room.add(frame.depth);
     pipeline.process(frame, result);
-    const std::vector<uint8_t>& mask = pipeline.foreground().mask;
-    FrameStats s;
-    size_t on = 0;
-    for (uint8_t m : mask) on += m != 0 ? 1 : 0;
-    s.foreground_share = mask.empty() ? 0.0 : static_cast<double>(on) / static_cast<double>(mask.size());
-    s.contact = result.contact.valid;
-    s.valid = result.valid;
-    s.reason = result.verdict.reason;
-    if (s.contact) {
-      s.closest_depth_m = result.contact.closest_camera.z();
-      s.closest_blob_share = static_cast<double>(blob_size(mask, frame.depth.width, frame.depth.height,
-                                                           result.contact.pixel)) /
-                             static_cast<double>(mask.size());
+    const Frame* processed = &frame;
+    if (!chain.params.order.empty()) {
+      chain.start(frame, filtered);
+      for (size_t i = 0; i < chain.block_count(); ++i) chain.run_block(i, filtered);
+      processed = &filtered;
     }
-    stats.push_back(s);
+    stats.push_back(frame_stats(pipeline, *processed, result, room));
+    visit(stats.size() - 1, pipeline, processed->depth, result);
   }
   return stats;
 }
 
+std::vector<FrameStats> run_people(const std::string& path, const std::vector<std::string>& extra) {
+  return run_people(path, extra, [](size_t, const Pipeline&, const DepthImage&, const FrameResult&) {});
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values.empty() ? kNaN : values[values.size() / 2];
+}
+
+/// One line per frame range for docs/RECORDINGS.md: min / median / max foreground share, and the
+/// closest point's depth (min / median) where there is one.
+void print_summary(const std::vector<FrameStats>& stats, const char* label) {
+  const size_t ranges[][2] = {{3, 7}, {8, 25}, {26, 29}, {30, 99}, {100, 107}};
+  for (const auto& range : ranges) {
+    std::vector<double> share, depth;
+    for (size_t i = range[0]; i <= range[1] && i < stats.size(); ++i) {
+      share.push_back(100.0 * stats[i].foreground_share);
+      if (stats[i].contact) depth.push_back(stats[i].closest_depth_m);
+    }
+    std::printf("[people %s] frames %zu-%zu: foreground min %.2f %% median %.2f %% max %.2f %%; closest z min %.2f m "
+                "median %.2f m (%zu frames with contact)\n",
+                label, range[0], range[1], *std::min_element(share.begin(), share.end()), median(share),
+                *std::max_element(share.begin(), share.end()),
+                depth.empty() ? kNaN : *std::min_element(depth.begin(), depth.end()), median(depth), depth.size());
+  }
+  double min_gap_m = kNaN, min_blob = kNaN;
+  for (size_t i = 30; i <= 99 && i < stats.size(); ++i) {
+    min_gap_m = std::fmin(min_gap_m, stats[i].closest_gap_m);
+    min_blob = std::fmin(min_blob, 100.0 * stats[i].closest_blob_share);
+  }
+  std::printf("[people %s] frames 30-99: the closest point stands >= %.2f m in front of the empty room, in blobs of "
+              ">= %.2f %%\n",
+              label, min_gap_m, min_blob);
+}
+
 void check_acceptance(const std::vector<FrameStats>& stats, const char* label) {
   ASSERT_EQ(stats.size(), 108U);
+  // Three learning frames (the empty room), then every frame is processed.
+  for (size_t i = 0; i < stats.size(); ++i) EXPECT_EQ(stats[i].valid, i >= 3) << label << ": frame " << i;
   for (size_t i = 8; i <= 25; ++i) {
     EXPECT_LE(stats[i].foreground_share, 0.005) << label << ": empty frame " << i;
   }
   for (size_t i = 30; i <= 99; ++i) {
     EXPECT_GE(stats[i].foreground_share, 0.02) << label << ": frame " << i << " with people";
     EXPECT_TRUE(stats[i].contact) << label << ": frame " << i;
-    // On a person: the closest pixel lies in a person-sized foreground blob (>= 0.5 % of the
-    // image, ~1500 pixels) at a depth where the README says people are (0.8-2.6 m, some slack).
-    EXPECT_GE(stats[i].closest_blob_share, 0.005) << label << ": frame " << i;
+    // On a person: the closest point lies in a foreground blob of at least 0.25 % of the image
+    // (noise blobs in the empty frames stay below 0.15 %; a person half out of the image, as in
+    // frame 83, is 0.46 %), stands at least 0.25 m in front of everything the recording showed
+    // there in the empty frames 0-2 (the dataset README's criterion for people, checked on the
+    // unfiltered data, independently of the learnt model), and at a depth where the README
+    // finds people (0.8-2.6 m, with some slack).
+    EXPECT_GE(stats[i].closest_blob_share, 0.0025) << label << ": frame " << i;
+    EXPECT_GE(stats[i].closest_gap_m, 0.25) << label << ": frame " << i;  // NaN (no data) fails
     EXPECT_GT(stats[i].closest_depth_m, 0.6) << label << ": frame " << i;
     EXPECT_LT(stats[i].closest_depth_m, 4.0) << label << ": frame " << i;
   }
+  print_summary(stats, label);
   if (::testing::Test::HasFailure()) {
     for (size_t i = 0; i < stats.size(); ++i) {
-      std::printf("%s frame %zu: valid %d, foreground %.2f %%, closest z %.3f m in a blob of %.2f %% (%s)\n", label,
-                  i, stats[i].valid ? 1 : 0, 100.0 * stats[i].foreground_share, stats[i].closest_depth_m,
-                  100.0 * stats[i].closest_blob_share, stats[i].reason.c_str());
+      std::printf("%s frame %zu: valid %d, foreground %.2f %%, closest z %.3f m (%.3f m before the empty room) in a "
+                  "blob of %.2f %% (%s)\n",
+                  label, i, stats[i].valid ? 1 : 0, 100.0 * stats[i].foreground_share, stats[i].closest_depth_m,
+                  stats[i].closest_gap_m, 100.0 * stats[i].closest_blob_share, stats[i].reason.c_str());
     }
   }
 }
 
-// Disabled until background learning copes with a structured-light camera: in the empty
-// frames 0-2, 12.0 % of the valid pixels come and go and 41 % spread by more than 3 cm (8.6 %
-// by more than 10 cm), so BackgroundLearner (limit: 0.2 % moving pixels) restarts every batch
-// and never finishes (34-53 % "moving" without a baseline, 12-13 % with an assumed 75 mm one).
-// Run it with --gtest_also_run_disabled_tests.
-TEST(PeopleAcceptance, DISABLED_NoFiltersForegroundIsPeopleAndEmptyFramesStayEmpty) {
+TEST(PeopleAcceptance, NoFiltersForegroundIsPeopleAndEmptyFramesStayEmpty) {
   const std::string path = test::shared_data("ist_piv_lab_people");
   if (path.empty()) GTEST_SKIP() << "../shared/data/ist_piv_lab_people is absent";
   check_acceptance(run_people(path, {"filters.preset=none"}), "none");
+}
+
+// The default preset: without a stereo baseline the chain runs in the depth domain, and its
+// decimation halves the resolution (320x240).
+TEST(PeopleAcceptance, SdkFiltersForegroundIsPeopleAndEmptyFramesStayEmpty) {
+  const std::string path = test::shared_data("ist_piv_lab_people");
+  if (path.empty()) GTEST_SKIP() << "../shared/data/ist_piv_lab_people is absent";
+  check_acceptance(run_people(path, {"filters.preset=sdk"}), "sdk");
+}
+
+/// The picture for docs/RECORDINGS.md: depth in grey (near is bright, no data black), the
+/// foreground tinted orange, the closest point as a red disc with a white ring. Images smaller
+/// than 640 px wide (decimated) are enlarged by pixel repetition.
+ColorImage people_picture(const DepthImage& depth, const std::vector<uint8_t>& mask, int closest_pixel) {
+  const int scale = std::max(1, 640 / depth.width);
+  ColorImage image;
+  image.width = depth.width * scale;
+  image.height = depth.height * scale;
+  image.rgb.assign(static_cast<size_t>(image.width) * image.height * 3, 0);
+  const int cu = closest_pixel >= 0 ? closest_pixel % depth.width : -100;
+  const int cv = closest_pixel >= 0 ? closest_pixel / depth.width : -100;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const size_t i = static_cast<size_t>(y / scale) * depth.width + static_cast<size_t>(x / scale);
+      const double z_m = depth.pixels[i] * static_cast<double>(depth.depth_scale_m);
+      // 0.5 m -> 255, 9 m -> 40.
+      const double grey = depth.pixels[i] == 0 ? 0.0 : std::clamp(255.0 - (z_m - 0.5) * (215.0 / 8.5), 40.0, 255.0);
+      double rgb[3] = {grey, grey, grey};
+      if (mask[i] != 0) {
+        const double tint[3] = {255.0, 140.0, 0.0};
+        for (int c = 0; c < 3; ++c) rgb[c] = 0.35 * grey + 0.65 * tint[c];
+      }
+      const double d = std::hypot((x + 0.5) / scale - (cu + 0.5), (y + 0.5) / scale - (cv + 0.5)) * scale;
+      if (d <= 7.0) rgb[0] = 255.0, rgb[1] = 0.0, rgb[2] = 0.0;
+      else if (d <= 10.0) rgb[0] = rgb[1] = rgb[2] = 255.0;
+      uint8_t* out = &image.rgb[(static_cast<size_t>(y) * image.width + x) * 3];
+      for (int c = 0; c < 3; ++c) out[c] = static_cast<uint8_t>(std::lround(rgb[c]));
+    }
+  }
+  return image;
+}
+
+// Writes docs/images/people_frame_<N>_<preset>.png; run on purpose only:
+//   test_recordings --gtest_also_run_disabled_tests --gtest_filter=PeopleAcceptance.DISABLED_WritePictures
+TEST(PeopleAcceptance, DISABLED_WritePictures) {
+  const std::string path = test::shared_data("ist_piv_lab_people");
+  if (path.empty()) GTEST_SKIP() << "../shared/data/ist_piv_lab_people is absent";
+  constexpr size_t kFrame = 61;
+  for (const char* preset : {"none", "sdk"}) {
+    bool written = false;
+    run_people(path, {std::string("filters.preset=") + preset},
+               [&](size_t index, const Pipeline& pipeline, const DepthImage& depth, const FrameResult& result) {
+                 if (index != kFrame) return;
+                 char name[96];
+                 std::snprintf(name, sizeof name, "/docs/images/people_frame_%zu_%s.png", kFrame, preset);
+                 write_color_png(std::string(HRCSENSE_SOURCE_DIR) + name,
+                                 people_picture(depth, pipeline.foreground().mask, result.contact.pixel));
+                 written = true;
+               });
+    EXPECT_TRUE(written) << preset;
+  }
 }
 
 }  // namespace

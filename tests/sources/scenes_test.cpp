@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace hrcsense {
 namespace {
@@ -106,6 +107,80 @@ TEST(Scenes, ThesisBoxContactIsTheFrontTopLeftVertex) {
   }
 }
 
+constexpr const char* kAllScenes[] = {"walk.yaml", "thesis-box.yaml", "thesis-box-human.yaml", "cell-ur5.yaml",
+                                      "clutter.yaml"};
+
+/// Pixels of non-static objects in frame i (labels do not depend on the noise).
+size_t moving_pixels(const Simulator& sim, int64_t i, Frame& f) {
+  sim.render(i, f);
+  return static_cast<size_t>(
+      std::count_if(f.truth->labels.begin(), f.truth->labels.end(), [](uint16_t l) { return l != kStaticLabel; }));
+}
+
+// Every scene learns an empty cell: no person or object enters during the background frames,
+// and afterwards every non-static object of the scene is seen.
+TEST(Scenes, EmptyWhileLearningThenPeopleEnter) {
+  for (const char* name : kAllScenes) {
+    const Config config = load_config(scene_path(name), {"sim.noise=false", "sim.color=false"});
+    const Simulator sim = make_simulator(config);
+    const int64_t learn = config.pipeline.background.frames;
+    ASSERT_GE(learn, 30) << name;
+    ASSERT_GT(sim.params.frames, learn + 100) << name;
+    Frame f;
+    for (int64_t i = 0; i < learn; i += (i + 1 < learn ? 7 * kStep : 1)) {
+      EXPECT_EQ(moving_pixels(sim, i, f), 0U) << name << " frame " << i;
+    }
+    EXPECT_EQ(moving_pixels(sim, learn - 1, f), 0U) << name << " last learning frame";
+    size_t moving_objects = 0;
+    for (const SceneObject& o : sim.scene.objects) moving_objects += o.is_static ? 0 : 1;
+    std::vector<bool> seen(moving_objects + 1, false);
+    for (int64_t i = learn; i < sim.params.frames; i += 10 * kStep) {
+      sim.render(i, f);
+      for (const uint16_t l : f.truth->labels) seen[l] = true;
+    }
+    for (size_t label = 1; label <= moving_objects; ++label) {
+      EXPECT_TRUE(seen[label]) << name << ": non-static object " << label << " never in view";
+    }
+  }
+}
+
+// thesis-box-human: the person stands at least 0.15 m farther from the robot point than the
+// box, so the true closest point is the box's front top left vertex in every frame.
+TEST(Scenes, ThesisBoxHumanContactIsOnTheBoxInEveryFrame) {
+  const Config config = load_config(scene_path("thesis-box-human.yaml"), {"sim.noise=false", "sim.color=false"});
+  EXPECT_EQ(config.filters_preset, "thesis");
+  const Simulator sim = make_simulator(config);
+  Simulator person_only = sim;  // the same scene without the box: the person's own distance
+  const auto box_it = std::find_if(person_only.scene.objects.begin(), person_only.scene.objects.end(),
+                                   [](const SceneObject& o) { return o.name == "box"; });
+  ASSERT_NE(box_it, person_only.scene.objects.end());
+  person_only.scene.objects.erase(box_it);
+  const Eigen::Vector3f vertex(0.5F, 0.0F, 1.0F);
+  const float box_m = (vertex - Eigen::Vector3f(-0.5F, -0.5F, 0.5F)).norm();  // 1.2247 m
+  constexpr uint16_t kBoxLabel = 1;  // the first non-static object
+  Frame f;
+  Frame g;
+  size_t person_frames = 0;
+  float person_min_m = INFINITY;
+  for (int64_t i = 100; i < sim.params.frames; i += kStep) {
+    sim.render(i, f);
+    const GroundTruth& truth = *f.truth;
+    ASSERT_TRUE(truth.contact.valid) << "frame " << i;
+    ASSERT_GE(truth.contact.pixel, 0) << "frame " << i;
+    EXPECT_EQ(truth.labels[static_cast<size_t>(truth.contact.pixel)], kBoxLabel) << "frame " << i;
+    EXPECT_LT((truth.contact.closest_base - vertex).norm(), 0.003F) << "frame " << i;
+    EXPECT_LT((truth.analytic_contact.closest_base - vertex).norm(), 1e-5F) << "frame " << i;
+    person_only.render(i, g);
+    if (!g.truth->analytic_contact.valid) continue;
+    ++person_frames;
+    person_min_m = std::min(person_min_m, g.truth->analytic_contact.distance_m);
+    EXPECT_GE(g.truth->analytic_contact.distance_m, box_m + 0.15F) << "frame " << i;
+  }
+  std::printf("thesis-box-human: person in view %zu frames, nearest %.3f m (box %.4f m)\n", person_frames,
+              person_min_m, box_m);
+  EXPECT_GT(person_frames * static_cast<size_t>(kStep), 200U) << "the person is in view from about frame 110";
+}
+
 TEST(Scenes, InfoPrintsTheFillRate) {
   const std::string command = std::string(HRCSENSE_CLI) + " info --config " + scene_path("walk.yaml") + " 2>&1";
   std::FILE* pipe = popen(command.c_str(), "r");
@@ -165,7 +240,7 @@ double real_fill_rate(const std::string& file) {
 // The shipped scenes lose depth like a real D435 does: between 70 % and 98 % valid over the
 // first frames (docs/SIMULATOR.md reports the figures beside the real frame's).
 TEST(Scenes, FillRateOfTheShippedScenesIsD435Like) {
-  for (const char* name : {"walk.yaml", "thesis-box.yaml"}) {
+  for (const char* name : kAllScenes) {
     const Simulator sim = make_simulator(load_config(scene_path(name), {}));
     const double fill = sim_fill_rate(sim, 0, 3);
     std::printf("%s: fill rate %.1f %%\n", name, 100.0 * fill);

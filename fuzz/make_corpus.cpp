@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: Apache-2.0
+// Writes the fuzzers' seed corpus: tiny valid inputs (a few hundred bytes to a few KB each).
+// Usage: hrcsense-fuzz-corpus <fuzz/corpus>. The files are committed; rerun after a format change.
+#include "../tests/support/bag_writer.hpp"
+#include "fuzz_entries.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+namespace {
+
+using namespace hrcsense;
+
+Frame tiny_frame(int64_t index) {
+  Frame frame;
+  frame.index = index;
+  frame.timestamp_ns = 1'000'000'123LL + index * 33'333'333LL;
+  frame.depth.resize(8, 6);
+  for (size_t i = 0; i < frame.depth.pixels.size(); ++i) {
+    frame.depth.pixels[i] = static_cast<uint16_t>(700 + 3 * i + static_cast<size_t>(index));
+  }
+  frame.intrinsics = Intrinsics{8, 6, 6.5F, 6.25F, 3.5F, 2.5F, Distortion::brown_conrady, {0.1F, -0.05F, 0, 0, 0.01F}};
+  return frame;
+}
+
+void write_bag(const std::string& path, const test::BagWriterParams& params, bool color) {
+  test::BagWriter writer(path, params);
+  for (int64_t i = 0; i < 2; ++i) {
+    const Frame frame = tiny_frame(i);
+    writer.add_depth(frame);
+    if (color && i == 0) {
+      ColorImage rgb{4, 3, std::vector<uint8_t>(4 * 3 * 3, 0x80)};
+      Pose T = Pose::Identity();
+      T.translation() = Eigen::Vector3d(0.015, 0, 0);
+      writer.add_color(frame.timestamp_ns + 5, rgb, Intrinsics{4, 3, 3.0F, 3.0F, 1.5F, 1.0F}, T);
+    }
+  }
+  writer.close();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: %s <corpus folder>\n", argv[0]);
+    return 2;
+  }
+  const std::filesystem::path root(argv[1]);
+  std::filesystem::create_directories(root / "bag");
+  std::filesystem::create_directories(root / "folder");
+  test::BagWriterParams lz4;
+  lz4.stereo_baseline_mm = 50.0F;
+  write_bag((root / "bag/lz4_indexed_color.bag").string(), lz4, true);
+  test::BagWriterParams none;
+  none.compression = test::BagCompression::none;
+  none.write_index = false;
+  write_bag((root / "bag/none_unindexed.bag").string(), none, false);
+  test::BagWriterParams old_sdk;
+  old_sdk.trailing_depth_units = false;
+  old_sdk.depth_units_option_m = 0.0001F;
+  old_sdk.file_version = 3;
+  write_bag((root / "bag/lz4_units_option.bag").string(), old_sdk, false);
+  const char* names[fuzz::kFolderTargets] = {"depth_png", "dataset_json", "frames_txt", "color_png",
+                                             "color_jpeg", "depth_txt", "rgb_txt", "hrcsense_json"};
+  for (int t = 0; t < fuzz::kFolderTargets; ++t) {
+    std::ofstream file(root / "folder" / names[t], std::ios::binary | std::ios::trunc);
+    file << fuzz::folder_seed(static_cast<fuzz::FolderTarget>(t));
+  }
+  return 0;
+}

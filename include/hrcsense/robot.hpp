@@ -1,0 +1,115 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — the robot arm as a kinematic capsule model: a 6-joint standard-DH description
+// (UR5, UR5e, UR10e built in, others from YAML), forward kinematics, and the capsules the
+// proximity search uses for a joint state. See docs/ROBOT.md for the frames and numbers.
+#pragma once
+
+#include "hrcsense/types.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace hrcsense {
+
+/// Number of joints of the arms hrcsense describes (6R, standard DH).
+inline constexpr int kJointCount = 6;
+/// Links 0..6: 0 the fixed base (DH frame 0), i the body moved by joint i (DH frame i);
+/// link 6 is wrist 3, whose frame is the tool flange.
+inline constexpr int kArmLinkCount = 7;
+/// Capsule::link of the tool's capsules (given in the flange frame, DH frame 6).
+inline constexpr int kToolLink = 7;
+
+/// Joint angles in radians, joint 1 (base) first, as on the UR pendant and in ROS.
+using JointAngles = std::array<double, kJointCount>;
+
+/// One row of a standard Denavit-Hartenberg table, as Universal Robots publish them:
+/// T_{i-1,i} = Rz(θ_i) · Tz(d) · Tx(a) · Rx(α).
+struct DhRow {
+  double d_m = 0.0;        ///< offset along the previous z
+  double a_m = 0.0;        ///< length along the new x (UR: negative for the upper arm and forearm)
+  double alpha_rad = 0.0;  ///< twist about the new x
+};
+
+/// Allowed range of one joint, radians, inclusive.
+struct JointLimit {
+  double min_rad = -2.0 * 3.14159265358979323846;
+  double max_rad = 2.0 * 3.14159265358979323846;
+};
+
+/// A capsule fixed to a link: segment ends in that link's DH frame (the flange frame for the
+/// tool), metres, and the radius of the real body around the segment.
+struct LinkCapsule {
+  Eigen::Vector3d a_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d b_m = Eigen::Vector3d::Zero();
+  double radius_m = 0.0;  ///< covers the real link; the search adds the padding
+};
+
+/// A 6-joint arm: kinematics and the capsules that cover its links.
+struct RobotDescription {
+  std::string name;                                    ///< e.g. "ur5"
+  std::array<DhRow, kJointCount> dh{};                 ///< joint 1 first
+  std::array<JointLimit, kJointCount> limits{};        ///< joint 1 first
+  std::array<std::vector<LinkCapsule>, kArmLinkCount> links;  ///< capsules per link, link frame
+  std::vector<LinkCapsule> tool;                       ///< in the flange frame; may be empty
+  double padding_m = 0.0;  ///< default of robot.padding_m for this arm (added to every radius)
+};
+
+/// Which frame robot capsules, camera.T_base_camera and all base-frame outputs refer to.
+enum class BaseFrame {
+  base,       ///< as on the UR pendant and ROS's `base`: base_link rotated π about z
+  base_link,  ///< UR's DH frame 0 (ROS's `base_link`)
+};
+
+/// Pose of every link's DH frame in base_link: frames[0] is the identity (the fixed base),
+/// frames[i] the frame after joint i; frames[6] is the tool flange.
+struct LinkFrames {
+  std::array<Pose, kArmLinkCount> T_base_link_link;
+};
+
+/// The built-in arms: "ur5" (CB3), "ur5e", "ur10e".
+const std::vector<std::string>& builtin_robot_names();
+/// A built-in arm by name; throws std::invalid_argument for an unknown name.
+const RobotDescription& builtin_robot(const std::string& name);
+
+/// ROS-style name of a link index (0..7): base, shoulder, upper_arm, forearm, wrist_1,
+/// wrist_2, wrist_3, tool; "link<i>" outside that range.
+std::string link_name(int link);
+
+/// ROS-style name of a joint index (0..5): shoulder_pan, shoulder_lift, elbow, wrist_1,
+/// wrist_2, wrist_3; "joint<i+1>" outside that range.
+std::string joint_name(int joint);
+
+/// Why `description` cannot be used (a field named as in the YAML format, e.g.
+/// "links.forearm[1].radius_m: expected a number >= 0"), or "" when it is valid.
+std::string description_problem(const RobotDescription& description);
+
+/// The first joint outside its limits (0-based) or -1 when all are inside. A NaN angle is
+/// outside.
+int joint_outside_limits(const RobotDescription& description, const JointAngles& joints_rad);
+
+/// T_base_base_link: the pendant/ROS `base` frame from UR's DH frame (a rotation of π about z).
+Pose T_base_base_link();
+
+/// Forward kinematics: every link frame in base_link for the joint state.
+LinkFrames forward_kinematics(const RobotDescription& description, const JointAngles& joints_rad);
+
+/// The capsules the proximity search uses, in `frame`: every link and tool capsule moved by
+/// forward kinematics, radius = link radius + `padding_m`, Capsule::link = link index 0..6,
+/// kToolLink for the tool. Writes into `out`, reusing its buffer (no allocation once sized).
+void robot_capsules(const RobotDescription& description, const JointAngles& joints_rad, double padding_m,
+                    BaseFrame frame, RobotModel& out);
+/// Same, returning a new model.
+RobotModel robot_capsules(const RobotDescription& description, const JointAngles& joints_rad, double padding_m,
+                          BaseFrame frame);
+
+/// The arm's own geometry for rendering (the simulator): the same capsules with radius = link
+/// radius, no padding, so every rendered surface lies inside the searched capsules.
+RobotModel robot_render_capsules(const RobotDescription& description, const JointAngles& joints_rad,
+                                 BaseFrame frame);
+
+/// The thesis's robot: one zero-length capsule per point (base frame), radius `padding_m`,
+/// link = the point's index.
+RobotModel robot_points(const std::vector<Eigen::Vector3f>& points_base, double padding_m);
+
+}  // namespace hrcsense

@@ -1,0 +1,322 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense config — the `robot.*` keys and robot description files (docs/ROBOT.md): the
+// thesis's points or an arm (built-in or described in YAML) posed by its joint angles.
+#include "robot_config.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace hrcsense {
+namespace config_detail {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Degrees in the file, radians inside; (deg / 180) · π keeps ±90° and ±360° exact.
+double rad_from_deg(double deg) { return (deg / 180.0) * kPi; }
+double deg_from_rad(double rad) { return (rad / kPi) * 180.0; }
+
+// Errors name the field by its path in the description, e.g. links.forearm[1].radius_m.
+struct DescriptionReader {
+  const std::string& where;
+  const std::string& prefix;
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    config_detail::fail(where, prefix + key, what);
+  }
+
+  void only_keys(const YAML::Node& map, const std::string& key, const std::vector<std::string>& allowed) const {
+    if (!map.IsMap()) fail(key, "expected a map");
+    for (const auto& entry : map) {
+      const std::string name = entry.first.Scalar();
+      bool ok = false;
+      for (const std::string& option : allowed) ok = ok || name == option;
+      if (!ok) {
+        throw ConfigError(where + ": unknown key '" + prefix + (key.empty() ? name : key + "." + name) + "'");
+      }
+    }
+  }
+
+  YAML::Node child(const YAML::Node& map, const std::string& name) const {
+    const YAML::Node& const_map = map;  // const access never inserts
+    YAML::Node node = const_map[name];
+    if (!node.IsDefined() || node.IsNull()) return YAML::Node(YAML::NodeType::Undefined);
+    return node;
+  }
+
+  YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& name) const {
+    YAML::Node node = child(map, name);
+    if (!node.IsDefined()) fail(key.empty() ? name : key + "." + name, "is required");
+    return node;
+  }
+
+  double number(const YAML::Node& node, const std::string& key) const {
+    double value = 0.0;
+    if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value)) {
+      fail(key, "expected a number");
+    }
+    return value;
+  }
+
+  Eigen::Vector3d vec3(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsSequence() || node.size() != 3) fail(key, "expected a list of 3 numbers [x, y, z]");
+    return {number(node[0], key), number(node[1], key), number(node[2], key)};
+  }
+
+  LinkCapsule capsule(const YAML::Node& node, const std::string& key) const {
+    only_keys(node, key, {"a_m", "b_m", "radius_m"});
+    LinkCapsule out;
+    out.a_m = vec3(required(node, key, "a_m"), key + ".a_m");
+    out.b_m = vec3(required(node, key, "b_m"), key + ".b_m");
+    out.radius_m = number(required(node, key, "radius_m"), key + ".radius_m");
+    if (out.radius_m < 0.0) fail(key + ".radius_m", "expected a number >= 0");
+    return out;
+  }
+
+  std::vector<LinkCapsule> capsules(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsDefined()) return {};
+    if (!node.IsSequence()) fail(key, "expected a list of capsules {a_m, b_m, radius_m}");
+    std::vector<LinkCapsule> out;
+    for (size_t i = 0; i < node.size(); ++i) out.push_back(capsule(node[i], key + "[" + std::to_string(i) + "]"));
+    return out;
+  }
+
+  void dh(const YAML::Node& node, RobotDescription& out) const {
+    if (!node.IsSequence() || node.size() != kJointCount) {
+      fail("dh", "expected a list of 6 rows {d_m, a_m, alpha_deg}, joint 1 first");
+    }
+    for (size_t j = 0; j < node.size(); ++j) {
+      const std::string key = "dh[" + std::to_string(j) + "]";
+      only_keys(node[j], key, {"d_m", "a_m", "alpha_deg"});
+      out.dh[j].d_m = number(required(node[j], key, "d_m"), key + ".d_m");
+      out.dh[j].a_m = number(required(node[j], key, "a_m"), key + ".a_m");
+      out.dh[j].alpha_rad = rad_from_deg(number(required(node[j], key, "alpha_deg"), key + ".alpha_deg"));
+    }
+  }
+
+  void limits(const YAML::Node& node, RobotDescription& out) const {
+    if (!node.IsDefined()) return;  // UR's ±360° defaults
+    if (!node.IsSequence() || node.size() != kJointCount) {
+      fail("joint_limits_deg", "expected a list of 6 [min, max] pairs, joint 1 first");
+    }
+    for (size_t j = 0; j < node.size(); ++j) {
+      const std::string key = "joint_limits_deg[" + std::to_string(j) + "]";
+      if (!node[j].IsSequence() || node[j].size() != 2) fail(key, "expected [min, max]");
+      const double min_deg = number(node[j][0], key);
+      const double max_deg = number(node[j][1], key);
+      if (min_deg > max_deg) fail(key, "expected min <= max");
+      out.limits[j] = JointLimit{rad_from_deg(min_deg), rad_from_deg(max_deg)};
+    }
+  }
+
+  RobotDescription description(const YAML::Node& map) const {
+    only_keys(map, "", {"name", "dh", "joint_limits_deg", "padding_m", "links", "tool"});
+    RobotDescription out;
+    const YAML::Node name = child(map, "name");
+    if (name.IsDefined()) {
+      if (!name.IsScalar()) fail("name", "expected a string");
+      out.name = name.Scalar();
+    }
+    dh(required(map, "", "dh"), out);
+    limits(child(map, "joint_limits_deg"), out);
+    const YAML::Node padding = child(map, "padding_m");
+    if (padding.IsDefined()) {
+      out.padding_m = number(padding, "padding_m");
+      if (out.padding_m < 0.0) fail("padding_m", "expected a number >= 0");
+    }
+    const YAML::Node links = required(map, "", "links");
+    std::vector<std::string> link_names;
+    for (int link = 0; link < kArmLinkCount; ++link) link_names.push_back(link_name(link));
+    only_keys(links, "links", link_names);
+    for (int link = 0; link < kArmLinkCount; ++link) {
+      out.links[static_cast<size_t>(link)] = capsules(child(links, link_name(link)), "links." + link_name(link));
+    }
+    out.tool = capsules(child(map, "tool"), "tool");
+    const std::string problem = description_problem(out);
+    if (!problem.empty()) {
+      const size_t colon = problem.find(": ");
+      fail(problem.substr(0, colon), problem.substr(colon + 2));
+    }
+    return out;
+  }
+};
+
+YAML::Node flow_sequence() {
+  YAML::Node node(YAML::NodeType::Sequence);
+  node.SetStyle(YAML::EmitterStyle::Flow);
+  return node;
+}
+
+YAML::Node vec3_node(const Eigen::Vector3d& v) {
+  YAML::Node out = flow_sequence();
+  for (int i = 0; i < 3; ++i) out.push_back(double_text(v[i]));
+  return out;
+}
+
+YAML::Node capsules_node(const std::vector<LinkCapsule>& capsules) {
+  YAML::Node out = flow_sequence();
+  for (const LinkCapsule& c : capsules) {
+    YAML::Node item(YAML::NodeType::Map);
+    item.SetStyle(YAML::EmitterStyle::Flow);
+    item["a_m"] = vec3_node(c.a_m);
+    item["b_m"] = vec3_node(c.b_m);
+    item["radius_m"] = double_text(c.radius_m);
+    out.push_back(item);
+  }
+  return out;
+}
+
+// The description robot.model names: built in, or from robot.description (a file or inline).
+RobotDescription arm_description(KeyReader& r, const std::string& model, const YAML::Node& description) {
+  if (model != "custom") {
+    if (description.IsDefined()) r.fail("robot.description", "is only read with robot.model custom");
+    return builtin_robot(model);
+  }
+  if (!description.IsDefined()) {
+    r.fail("robot.description", "is required for robot.model custom: a description file or an inline map");
+  }
+  RobotDescription out;
+  if (description.IsScalar()) {
+    try {
+      out = load_robot_description(description.Scalar());
+    } catch (const ConfigError& e) {
+      r.fail("robot.description", e.what());  // names both files
+    }
+  } else if (description.IsMap()) {
+    const std::string prefix = "robot.description.";
+    out = DescriptionReader{r.where(), prefix}.description(description);
+    if (out.name.empty()) out.name = "custom";
+  } else {
+    r.fail("robot.description", "expected a file name or a map");
+  }
+  // Inline and normalised, so that the hash follows the arm, not the file's name.
+  r.set_effective("robot.description", robot_description_node(out));
+  return out;
+}
+
+std::string limit_text(const JointLimit& limit) {
+  char text[96];
+  std::snprintf(text, sizeof text, "[%.6g, %.6g] rad ([%.6g, %.6g] deg)", limit.min_rad, limit.max_rad,
+                deg_from_rad(limit.min_rad), deg_from_rad(limit.max_rad));
+  return text;
+}
+
+}  // namespace
+
+RobotDescription read_robot_description(const YAML::Node& map, const std::string& where, const std::string& prefix) {
+  return DescriptionReader{where, prefix}.description(map);
+}
+
+YAML::Node robot_description_node(const RobotDescription& description) {
+  YAML::Node out(YAML::NodeType::Map);
+  out["name"] = description.name;
+  YAML::Node dh(YAML::NodeType::Sequence);
+  YAML::Node limits = flow_sequence();
+  for (size_t j = 0; j < kJointCount; ++j) {
+    YAML::Node row(YAML::NodeType::Map);
+    row.SetStyle(YAML::EmitterStyle::Flow);
+    row["d_m"] = double_text(description.dh[j].d_m);
+    row["a_m"] = double_text(description.dh[j].a_m);
+    row["alpha_deg"] = double_text(deg_from_rad(description.dh[j].alpha_rad));
+    dh.push_back(row);
+    YAML::Node limit = flow_sequence();
+    limit.push_back(double_text(deg_from_rad(description.limits[j].min_rad)));
+    limit.push_back(double_text(deg_from_rad(description.limits[j].max_rad)));
+    limits.push_back(limit);
+  }
+  out["dh"] = dh;
+  out["joint_limits_deg"] = limits;
+  out["padding_m"] = double_text(description.padding_m);
+  YAML::Node links(YAML::NodeType::Map);
+  for (int link = 0; link < kArmLinkCount; ++link) {
+    links[link_name(link)] = capsules_node(description.links[static_cast<size_t>(link)]);
+  }
+  out["links"] = links;
+  out["tool"] = capsules_node(description.tool);
+  return out;
+}
+
+void read_robot(KeyReader& r, Config& c) {
+  // Every key is read unconditionally first: known_keys() learns the schema from these reads.
+  r.choice("robot.model", c.robot_model, {"points", "ur5", "ur5e", "ur10e", "custom"});
+  const YAML::Node description = r.raw("robot.description");
+  // Default: the 2020 thesis's robot point (-0.5, 0.5, 0.5) m, given there with y up.
+  std::vector<Eigen::Vector3f> points_base{Eigen::Vector3f(-0.5F, -0.5F, 0.5F)};
+  r.vec3_list("robot.points_base", points_base);
+  r.number_list("robot.joints_rad", c.robot_joints_rad, kJointCount);
+  r.choice("robot.base_frame", c.robot_base_frame, {"base", "base_link"});
+  c.robot_frame = c.robot_base_frame == "base_link" ? BaseFrame::base_link : BaseFrame::base;
+
+  if (c.robot_model == "points") {
+    if (description.IsDefined()) r.fail("robot.description", "is only read with robot.model custom");
+    r.number("robot.padding_m", c.robot_padding_m, Bound::non_negative);
+    // Without a robot every distance would be "infinite" and every verdict run: refuse.
+    if (points_base.empty()) r.fail("robot.points_base", "expected at least one point [x, y, z] for robot.model points");
+    c.robot_arm.reset();
+    c.pipeline.robot = robot_points(points_base, c.robot_padding_m);
+    return;
+  }
+
+  const RobotDescription arm = arm_description(r, c.robot_model, description);
+  c.robot_padding_m = arm.padding_m;  // the arm's own padding is the default
+  r.number("robot.padding_m", c.robot_padding_m, Bound::non_negative);
+  // No default pose: a wrong pose would put the arm where it is not, which is not fail-safe.
+  if (c.robot_joints_rad.size() != kJointCount) {
+    r.fail("robot.joints_rad", "is required for robot.model " + c.robot_model +
+                                   ": 6 joint angles in radians, joint 1 (base) first");
+  }
+  JointAngles joints_rad{};
+  for (size_t j = 0; j < kJointCount; ++j) joints_rad[j] = c.robot_joints_rad[j];
+  const int outside = joint_outside_limits(arm, joints_rad);
+  if (outside >= 0) {
+    const size_t j = static_cast<size_t>(outside);
+    r.fail("robot.joints_rad", "joint " + std::to_string(outside + 1) + " (" + joint_name(outside) + ") is " +
+                                   double_text(joints_rad[j]) + " rad, outside its limits " +
+                                   limit_text(arm.limits[j]));
+  }
+  c.robot_arm = arm;
+  c.pipeline.robot = robot_capsules(arm, joints_rad, c.robot_padding_m, c.robot_frame);
+}
+
+}  // namespace config_detail
+
+std::optional<SceneObject> robot_scene_object(const Config& config) {
+  if (!config.robot_arm || config.robot_joints_rad.size() != kJointCount) return std::nullopt;
+  JointAngles joints_rad{};
+  for (size_t j = 0; j < kJointCount; ++j) joints_rad[j] = config.robot_joints_rad[j];
+  SceneObject arm;
+  arm.name = "robot";
+  arm.is_static = true;
+  for (const Capsule& capsule : robot_render_capsules(*config.robot_arm, joints_rad, config.robot_frame).capsules) {
+    if (capsule.radius_m <= 0.0F) continue;  // a bare segment has no surface to see
+    Shape shape;
+    shape.type = Shape::Type::capsule;
+    shape.a = capsule.a;
+    shape.b = capsule.b;
+    shape.radius_m = capsule.radius_m;
+    arm.shapes.push_back(shape);
+  }
+  return arm;
+}
+
+RobotDescription load_robot_description(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw ConfigError(path + ": cannot open robot description");
+  YAML::Node root;
+  try {
+    root = YAML::Load(file);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                      ": YAML syntax error: " + e.msg);
+  }
+  if (!root.IsMap()) throw ConfigError(path + ": expected a robot description (a map with dh and links)");
+  RobotDescription description = config_detail::read_robot_description(root, path, "");
+  if (description.name.empty()) description.name = path;
+  return description;
+}
+
+}  // namespace hrcsense

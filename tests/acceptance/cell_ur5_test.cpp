@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: Apache-2.0
+// Acceptance: the UR5 cell. The arm is rendered as part of the static scene, learnt as
+// background, and searched as capsules; a person walks up to it.
+
+#include "hrcsense/config.hpp"
+#include "hrcsense/pipeline.hpp"
+
+#include <gtest/gtest.h>
+
+#include <set>
+#include <string>
+
+namespace hrcsense {
+namespace {
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr int kFrameStep = 6;  // sanitizers check every sixth frame of the approach
+#else
+constexpr int kFrameStep = 1;
+#endif
+
+// Noise-free and unfiltered, so that the measured contact can be held to the truth within 1 mm
+// (the only error left is the 1 mm depth quantisation of the sensor model). The person enters
+// at frame 100, so 30 learning frames leave 70 empty frames to check.
+Config noise_free_cell(const std::string& backend) {
+  return load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5.yaml",
+                     {"sim.noise=false", "filters.preset=none", "background.frames=30",
+                      "proximity.backend=" + backend});
+}
+
+TEST(CellUr5, ArmIsSearchedAsPaddedCapsules) {
+  const Config config = noise_free_cell("brute");
+  // Base, six links and the tool: the model's capsules carry link indices 0..7.
+  ASSERT_FALSE(config.pipeline.robot.capsules.empty());
+  std::set<int> links;
+  for (const Capsule& capsule : config.pipeline.robot.capsules) {
+    links.insert(capsule.link);
+    EXPECT_GE(capsule.radius_m, 0.05F);  // every capsule carries the 5 cm padding
+  }
+  EXPECT_EQ(*links.begin(), 0);
+  EXPECT_GE(*links.rbegin(), 6);
+}
+
+// Empty while learning (the arm is background, so no foreground at all), then the person's
+// contact lies on the arm link the ground truth names, within 1 mm of the true distance.
+TEST(CellUr5, ContactIsOnTheTrueLinkWithinOneMillimetre) {
+  for (const char* backend : {"brute", "octree", "kdtree"}) {
+    const Config config = noise_free_cell(backend);
+    Simulator sim = make_simulator(config);
+    Pipeline pipeline(config.pipeline);
+    Frame frame;
+    FrameResult result;
+    const int64_t learning = config.pipeline.background.frames;
+    int checked = 0;
+    std::set<int> links_seen;
+    float closest_m = 1e9F;
+    for (int64_t i = 0; i < sim.params.frames; ++i) {
+      if (i > learning && i % kFrameStep != 0) continue;
+      sim.render(i, frame);
+      pipeline.process(frame, result);
+      if (i < learning) continue;
+      ASSERT_TRUE(result.valid) << backend << " frame " << i;
+      const Contact& truth = frame.truth->contact;
+      if (!truth.valid) {
+        // Nobody in the cell: the learnt arm must not show up as foreground.
+        EXPECT_FALSE(result.contact.valid) << backend << " frame " << i;
+        continue;
+      }
+      ASSERT_TRUE(result.contact.valid) << backend << " frame " << i;
+      EXPECT_NEAR(result.contact.distance_m, truth.distance_m, 1e-3) << backend << " frame " << i;
+      EXPECT_EQ(result.contact.robot_link, truth.robot_link) << backend << " frame " << i;
+      links_seen.insert(truth.robot_link);
+      closest_m = std::min(closest_m, truth.distance_m);
+      ++checked;
+    }
+    EXPECT_GE(checked, 200 / kFrameStep) << backend;
+    // The person ends up within 5 cm of the wrist: the arm's links, not the base, are closest.
+    EXPECT_LT(closest_m, 0.05F) << backend;
+    EXPECT_TRUE(links_seen.count(5) == 1 || links_seen.count(6) == 1) << backend;
+  }
+}
+
+}  // namespace
+}  // namespace hrcsense

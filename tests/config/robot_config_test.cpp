@@ -1,0 +1,313 @@
+// SPDX-License-Identifier: Apache-2.0
+// Tests of the robot keys (robot.model, robot.description, robot.joints_rad, robot.padding_m,
+// robot.base_frame) and of robot description files.
+#include "config_test_util.hpp"
+
+#include <gtest/gtest.h>
+
+#include "hrcsense/camera.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace hrcsense {
+namespace {
+
+using test::expect_config_error;
+using test::TempDir;
+
+const std::string kZeroPose = "robot.joints_rad=[0, 0, 0, 0, 0, 0]";
+
+std::string robots_dir() { return std::string(HRCSENSE_SOURCE_DIR) + "/config/robots/"; }
+
+// A small custom arm: a 1 m vertical post (link 0) and a 0.5 m arm along x of frame 1 that
+// joint 1 turns; the other joints carry nothing. DH: d1 = 1, all else 0.
+const char* const kPostArm = R"(name: post
+dh:
+  - {d_m: 1, a_m: 0, alpha_deg: 0}
+  - {d_m: 0, a_m: 0, alpha_deg: 0}
+  - {d_m: 0, a_m: 0, alpha_deg: 0}
+  - {d_m: 0, a_m: 0, alpha_deg: 0}
+  - {d_m: 0, a_m: 0, alpha_deg: 0}
+  - {d_m: 0, a_m: 0, alpha_deg: 0}
+joint_limits_deg: [[-90, 90], [-360, 360], [-360, 360], [-360, 360], [-360, 360], [-360, 360]]
+padding_m: 0.02
+links:
+  base: [{a_m: [0, 0, 0], b_m: [0, 0, 1], radius_m: 0.1}]
+  shoulder: [{a_m: [0, 0, 0], b_m: [0.5, 0, 0], radius_m: 0.05}]
+)";
+
+TEST(RobotConfig, Ur5CapsulesFollowTheJointsAndTheFrame) {
+  const Config c = load_config("", {"robot.model=ur5", kZeroPose});
+  ASSERT_TRUE(c.robot_arm.has_value());
+  EXPECT_EQ(c.robot_arm->name, "ur5");
+  ASSERT_EQ(c.pipeline.robot.capsules.size(), 8U);
+  // Default frame `base`: the flange (end of wrist 3) at (0.81725, 0.19145, −0.005491).
+  const Capsule& wrist_3 = c.pipeline.robot.capsules.back();
+  EXPECT_EQ(wrist_3.link, 6);
+  EXPECT_LT((wrist_3.b - Eigen::Vector3f(0.81725F, 0.19145F, -0.005491F)).norm(), 1e-6F);
+  EXPECT_FLOAT_EQ(wrist_3.radius_m, 0.045F);  // the built-in's wrist radius, no padding by default
+
+  const Config link = load_config("", {"robot.model=ur5", kZeroPose, "robot.base_frame=base_link",
+                                       "robot.padding_m=0.05"});
+  EXPECT_EQ(link.robot_frame, BaseFrame::base_link);
+  const Capsule& flange = link.pipeline.robot.capsules.back();
+  EXPECT_LT((flange.b - Eigen::Vector3f(-0.81725F, -0.19145F, -0.005491F)).norm(), 1e-6F);
+  EXPECT_FLOAT_EQ(flange.radius_m, 0.095F);
+  EXPECT_DOUBLE_EQ(link.robot_padding_m, 0.05);
+
+  // Joint 1 at +90° turns the whole arm about z: in base, Rz(90°)(0.81725, 0.19145) = (−0.19145, 0.81725).
+  const Config turned = load_config("", {"robot.model=ur5", "robot.joints_rad=[1.5707963267948966, 0, 0, 0, 0, 0]"});
+  EXPECT_LT((turned.pipeline.robot.capsules.back().b - Eigen::Vector3f(-0.19145F, 0.81725F, -0.005491F)).norm(), 1e-6F);
+}
+
+TEST(RobotConfig, EveryBuiltinArmLoads) {
+  for (const std::string model : {"ur5", "ur5e", "ur10e"}) {
+    const Config c = load_config("", {"robot.model=" + model, kZeroPose});
+    EXPECT_EQ(c.pipeline.robot.capsules.size(), 8U) << model;
+    EXPECT_EQ(c.robot_arm->name, model);
+  }
+}
+
+TEST(RobotConfig, PointsModelIsTheThesisPoint) {
+  const Config c = load_config("", {});
+  EXPECT_EQ(c.robot_model, "points");
+  EXPECT_FALSE(c.robot_arm.has_value());
+  ASSERT_EQ(c.pipeline.robot.capsules.size(), 1U);
+  EXPECT_EQ(c.pipeline.robot.capsules[0].a, Eigen::Vector3f(-0.5F, -0.5F, 0.5F));
+  EXPECT_EQ(c.pipeline.robot.capsules[0].radius_m, 0.0F);
+}
+
+TEST(RobotConfig, ShippedDescriptionFilesEqualTheBuiltins) {
+  for (const std::string& name : builtin_robot_names()) {
+    const std::string path = robots_dir() + name + ".yaml";
+    const RobotDescription file = load_robot_description(path);
+    const RobotDescription& builtin = builtin_robot(name);
+    EXPECT_EQ(file.name, builtin.name) << path;
+    EXPECT_DOUBLE_EQ(file.padding_m, builtin.padding_m) << path;
+    for (size_t j = 0; j < kJointCount; ++j) {
+      EXPECT_NEAR(file.dh[j].d_m, builtin.dh[j].d_m, 1e-12) << path << " dh[" << j << "]";
+      EXPECT_NEAR(file.dh[j].a_m, builtin.dh[j].a_m, 1e-12) << path << " dh[" << j << "]";
+      EXPECT_NEAR(file.dh[j].alpha_rad, builtin.dh[j].alpha_rad, 1e-12) << path << " dh[" << j << "]";
+      EXPECT_NEAR(file.limits[j].min_rad, builtin.limits[j].min_rad, 1e-12) << path;
+      EXPECT_NEAR(file.limits[j].max_rad, builtin.limits[j].max_rad, 1e-12) << path;
+    }
+    for (size_t link = 0; link < kArmLinkCount; ++link) {
+      ASSERT_EQ(file.links[link].size(), builtin.links[link].size()) << path << " " << link_name(static_cast<int>(link));
+      for (size_t i = 0; i < file.links[link].size(); ++i) {
+        EXPECT_LT((file.links[link][i].a_m - builtin.links[link][i].a_m).norm(), 1e-12)
+            << path << " " << link_name(static_cast<int>(link)) << "[" << i << "].a_m";
+        EXPECT_LT((file.links[link][i].b_m - builtin.links[link][i].b_m).norm(), 1e-12)
+            << path << " " << link_name(static_cast<int>(link)) << "[" << i << "].b_m";
+        EXPECT_NEAR(file.links[link][i].radius_m, builtin.links[link][i].radius_m, 1e-12);
+      }
+    }
+    EXPECT_TRUE(file.tool.empty());
+  }
+}
+
+TEST(RobotConfig, CustomArmFromAFileOrInline) {
+  TempDir dir;
+  const std::string arm = dir.write("post.yaml", kPostArm);
+  // Joint 1 at 90°: the shoulder capsule turns from +x to +y of base_link; in `base` (x and y
+  // negated) it runs from (0, 0, 1) to (0, −0.5, 1). The arm's own padding (0.02) is the default.
+  const Config c = load_config("", {"robot.model=custom", "robot.description=" + arm,
+                                    "robot.joints_rad=[1.5707963267948966, 0, 0, 0, 0, 0]"});
+  ASSERT_EQ(c.pipeline.robot.capsules.size(), 2U);
+  EXPECT_EQ(c.robot_arm->name, "post");
+  const Capsule& shoulder = c.pipeline.robot.capsules[1];
+  EXPECT_EQ(shoulder.link, 1);
+  EXPECT_LT((shoulder.a - Eigen::Vector3f(0, 0, 1)).norm(), 1e-6F);
+  EXPECT_LT((shoulder.b - Eigen::Vector3f(0, -0.5F, 1)).norm(), 1e-6F);
+  EXPECT_FLOAT_EQ(shoulder.radius_m, 0.07F);
+  EXPECT_FLOAT_EQ(c.pipeline.robot.capsules[0].radius_m, 0.12F);
+  // robot.padding_m replaces the arm's own padding.
+  const Config padded = load_config("", {"robot.model=custom", "robot.description=" + arm, kZeroPose,
+                                         "robot.padding_m=0"});
+  EXPECT_FLOAT_EQ(padded.pipeline.robot.capsules[1].radius_m, 0.05F);
+
+  // The shipped UR5 file gives the built-in's capsules.
+  const Config from_file = load_config("", {"robot.model=custom", "robot.description=" + robots_dir() + "ur5.yaml",
+                                            "robot.joints_rad=[0.3, -1, 1, 0.2, 0.4, 0.5]"});
+  const Config builtin = load_config("", {"robot.model=ur5", "robot.joints_rad=[0.3, -1, 1, 0.2, 0.4, 0.5]"});
+  ASSERT_EQ(from_file.pipeline.robot.capsules.size(), builtin.pipeline.robot.capsules.size());
+  for (size_t i = 0; i < builtin.pipeline.robot.capsules.size(); ++i) {
+    EXPECT_LT((from_file.pipeline.robot.capsules[i].a - builtin.pipeline.robot.capsules[i].a).norm(), 1e-6F);
+    EXPECT_LT((from_file.pipeline.robot.capsules[i].b - builtin.pipeline.robot.capsules[i].b).norm(), 1e-6F);
+  }
+
+  // Inline in the configuration, the same arm.
+  const std::string config = dir.write("cell.yaml", std::string("robot:\n  model: custom\n  joints_rad: [0, 0, 0, 0, 0, 0]\n"
+                                                                "  description:\n") +
+                                                        [] {
+                                                          std::string indented;
+                                                          for (const char* p = kPostArm; *p != '\0'; ++p) {
+                                                            if (p == kPostArm || p[-1] == '\n') indented += "    ";
+                                                            indented += *p;
+                                                          }
+                                                          return indented;
+                                                        }());
+  const Config inline_arm = load_config(config, {});
+  ASSERT_EQ(inline_arm.pipeline.robot.capsules.size(), 2U);
+  EXPECT_FLOAT_EQ(inline_arm.pipeline.robot.capsules[0].radius_m, 0.12F);
+}
+
+TEST(RobotConfig, HashFollowsTheArmNotTheFileName) {
+  TempDir dir;
+  const std::string a = dir.write("a.yaml", kPostArm);
+  const std::string b = dir.write("b.yaml", std::string(kPostArm) + "# a comment changes nothing\n");
+  std::string longer = kPostArm;
+  longer.replace(longer.find("[0.5, 0, 0]"), 11, "[0.6, 0, 0]");
+  const std::string c = dir.write("c.yaml", longer);
+  const auto hash = [&](const std::string& file) {
+    return config_hash(load_config("", {"robot.model=custom", "robot.description=" + file, kZeroPose}));
+  };
+  EXPECT_EQ(hash(a), hash(b));
+  EXPECT_NE(hash(a), hash(c));
+  // The canonical configuration holds the arm inline and reads back to the same effect.
+  const Config original = load_config("", {"robot.model=custom", "robot.description=" + a, kZeroPose});
+  const std::string again = dir.write("canonical.yaml", original.canonical_yaml);
+  const Config reread = load_config(again, {});
+  EXPECT_EQ(config_hash(reread), config_hash(original));
+  ASSERT_EQ(reread.pipeline.robot.capsules.size(), original.pipeline.robot.capsules.size());
+  EXPECT_EQ(reread.pipeline.robot.capsules[1].b, original.pipeline.robot.capsules[1].b);
+}
+
+// Distance from p to the segment ab (double precision, independent of the proximity code).
+double segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (p - (a + t * ab)).norm();
+}
+
+TEST(RobotSceneObject, IsTheArmWithoutPadding) {
+  EXPECT_FALSE(robot_scene_object(load_config("", {})).has_value());  // points: nothing to render
+  const Config c = load_config("", {"robot.model=ur5", "robot.joints_rad=[0.2, -1.2, 1.1, -0.4, 0.6, 0]",
+                                    "robot.padding_m=0.04"});
+  const std::optional<SceneObject> arm = robot_scene_object(c);
+  ASSERT_TRUE(arm.has_value());
+  EXPECT_TRUE(arm->is_static);  // learnt as background
+  ASSERT_EQ(arm->shapes.size(), c.pipeline.robot.capsules.size());
+  for (size_t i = 0; i < arm->shapes.size(); ++i) {
+    EXPECT_EQ(arm->shapes[i].type, Shape::Type::capsule);
+    EXPECT_EQ(arm->shapes[i].a, c.pipeline.robot.capsules[i].a);
+    EXPECT_FLOAT_EQ(arm->shapes[i].radius_m + 0.04F, c.pipeline.robot.capsules[i].radius_m);
+  }
+}
+
+// Renders the configured arm alone (noise-free) and checks every pixel that hit something:
+// it lies on the rendered surface (the union of the unpadded capsules) and so inside the
+// searched, padded ones. Counts the pixels per link (the nearest capsule's link).
+void expect_rendered_inside(const Config& c, double padding_m, std::vector<int>& seen_per_link) {
+  Simulator sim = make_simulator(c);
+  sim.scene.objects.clear();
+  sim.scene.objects.push_back(*robot_scene_object(c));
+  Frame frame;
+  sim.render(0, frame);
+  ASSERT_TRUE(frame.truth.has_value());
+  size_t seen = 0;
+  for (int v = 0; v < frame.intrinsics.height; ++v) {
+    for (int u = 0; u < frame.intrinsics.width; ++u) {
+      const float z_m = frame.truth->depth_m[static_cast<size_t>(v) * frame.intrinsics.width + u];
+      if (z_m <= 0.0F) continue;
+      const std::optional<Eigen::Vector3f> p_camera =
+          deproject(frame.intrinsics, Eigen::Vector2f(static_cast<float>(u), static_cast<float>(v)), z_m);
+      ASSERT_TRUE(p_camera.has_value());
+      const Eigen::Vector3d p_base = c.pipeline.T_base_camera * p_camera->cast<double>();
+      double to_rendered_m = 1e9;  // signed distance to the union of the rendered capsules
+      double to_searched_m = 1e9;  // signed distance to the union of the searched capsules
+      int link = -1;
+      for (const Capsule& capsule : c.pipeline.robot.capsules) {
+        const double axis_m = segment_distance(p_base, capsule.a.cast<double>(), capsule.b.cast<double>());
+        to_searched_m = std::min(to_searched_m, axis_m - capsule.radius_m);
+        if (axis_m - (capsule.radius_m - padding_m) < to_rendered_m) {
+          to_rendered_m = axis_m - (capsule.radius_m - padding_m);
+          link = capsule.link;
+        }
+      }
+      EXPECT_LT(std::abs(to_rendered_m), 1e-3) << "pixel " << u << "," << v << " at " << p_base.transpose();
+      EXPECT_LT(to_searched_m, 0.0) << "pixel " << u << "," << v << " at " << p_base.transpose();
+      ++seen;
+      ++seen_per_link[static_cast<size_t>(link)];
+    }
+  }
+  EXPECT_GT(seen, 1000U);  // the arm is in view
+}
+
+TEST(RobotSceneObject, RenderedArmLiesInsideTheSearchedCapsules) {
+  // A UR5 lying along +x of `base` (q = 0 but wrist 2 at 90°, so wrist 3 points along +x),
+  // seen from two cameras 1.4-1.5 m away so that every moving link shows somewhere.
+  const std::vector<std::string> arm{"robot.model=ur5", "robot.joints_rad=[0, 0, 0, 0, 1.5707963267948966, 0]",
+                                     "robot.padding_m=0.01", "sim.width=424", "sim.height=240",
+                                     "sim.noise=false", "sim.frames=1"};
+  std::vector<int> seen_per_link(kArmLinkCount, 0);
+  // In front, looking along +y: camera x = base x, camera y (down) = −z: Rx(−90°).
+  std::vector<std::string> side = arm;
+  side.push_back("camera.T_base_camera.translation_m=[0.4, -1.5, 0.1]");
+  side.push_back("camera.T_base_camera.rotation_rpy_deg=[-90, 0, 0]");
+  expect_rendered_inside(load_config("", side), 0.01, seen_per_link);
+  // Above, looking down: camera x = base x, camera y = −y, z = −z: Rx(180°).
+  std::vector<std::string> top = arm;
+  top.push_back("camera.T_base_camera.translation_m=[0.4, 0.1, 1.5]");
+  top.push_back("camera.T_base_camera.rotation_rpy_deg=[180, 0, 0]");
+  expect_rendered_inside(load_config("", top), 0.01, seen_per_link);
+  for (int link = 0; link < kArmLinkCount; ++link) {
+    EXPECT_GT(seen_per_link[static_cast<size_t>(link)], 0) << link_name(link);
+  }
+}
+
+TEST(RobotConfigErrors, KeysAndJointsAreNamed) {
+  expect_config_error("", {"robot.model=ur5"}, {"'robot.joints_rad'", "required for robot.model ur5"});
+  expect_config_error("", {"robot.model=ur5e", "robot.joints_rad=[0, 0, 7, 0, 0, 0]"},
+                      {"'robot.joints_rad'", "joint 3 (elbow)", "outside its limits"});
+  expect_config_error("", {"robot.model=ur10e", "robot.joints_rad=[0, 0, 0, 0, 0, -6.5]"},
+                      {"'robot.joints_rad'", "joint 6 (wrist_3)"});
+  expect_config_error("", {"robot.model=ur5", "robot.joints_rad=[0, 0, 0]"}, {"'robot.joints_rad'", "6 numbers"});
+  expect_config_error("", {"robot.model=ur5", kZeroPose, "robot.padding_m=-1"}, {"'robot.padding_m'", ">= 0"});
+  expect_config_error("", {"robot.model=ur3"}, {"'robot.model'", "points, ur5, ur5e, ur10e, custom"});
+  expect_config_error("", {"robot.model=custom", kZeroPose}, {"'robot.description'", "required for robot.model custom"});
+  expect_config_error("", {"robot.model=ur5", kZeroPose, "robot.description=arm.yaml"},
+                      {"'robot.description'", "only read with robot.model custom"});
+  TempDir dir;
+  const std::string cell = dir.write("cell.yaml", "robot: {model: custom, description: no/such/arm.yaml}\n");
+  expect_config_error(cell, {}, {"cell.yaml", "'robot.description'", "no/such/arm.yaml", "cannot open"});
+}
+
+TEST(RobotConfigErrors, DescriptionFilesNameFileAndField) {
+  TempDir dir;
+  const auto check = [&](const std::string& from, const std::string& to, const std::vector<std::string>& needles) {
+    std::string text = kPostArm;
+    const size_t at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+    const std::string arm = dir.write("bad_arm.yaml", text);
+    std::vector<std::string> all = needles;
+    all.push_back("bad_arm.yaml");
+    expect_config_error("", {"robot.model=custom", "robot.description=" + arm, kZeroPose}, all);
+  };
+  check("radius_m: 0.05", "radius_m: -0.05", {"'links.shoulder[0].radius_m'", ">= 0"});
+  check("radius_m: 0.05", "radius_m: thick", {"'links.shoulder[0].radius_m'", "number"});
+  check("shoulder:", "elbow:", {"unknown key 'links.elbow'"});
+  check("padding_m: 0.02", "padding: 0.02", {"unknown key 'padding'"});
+  check("b_m: [0.5, 0, 0]", "b_m: [0.5, 0]", {"'links.shoulder[0].b_m'", "3 numbers"});
+  check("  - {d_m: 1, a_m: 0, alpha_deg: 0}\n", "", {"'dh'", "6 rows"});
+  check("{d_m: 1, a_m: 0, alpha_deg: 0}", "{d_m: 1, a_m: 0}", {"'dh[0].alpha_deg'", "required"});
+  check("[[-90, 90],", "[[90, -90],", {"'joint_limits_deg[0]'", "min <= max"});
+  check("links:\n  base: [{a_m: [0, 0, 0], b_m: [0, 0, 1], radius_m: 0.1}]\n  shoulder: [{a_m: [0, 0, 0], b_m: [0.5, 0, 0], radius_m: 0.05}]\n",
+        "links: {}\n", {"'links'", "at least one capsule"});
+  check("name: post", "name: [post", {"YAML syntax error"});
+  // The joint limits come from the description: ±90° on joint 1 of the post arm.
+  const std::string arm = dir.write("post.yaml", kPostArm);
+  expect_config_error("", {"robot.model=custom", "robot.description=" + arm, "robot.joints_rad=[2, 0, 0, 0, 0, 0]"},
+                      {"'robot.joints_rad'", "joint 1 (shoulder_pan)"});
+  // Inline descriptions name the field below robot.description.
+  expect_config_error("", {"robot.model=custom", kZeroPose, "robot.description={dh: [], links: {}}"},
+                      {"'robot.description.dh'"});
+}
+
+}  // namespace
+}  // namespace hrcsense
