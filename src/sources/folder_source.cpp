@@ -12,6 +12,7 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -49,7 +50,10 @@ bool parse_seconds_ns(const std::string& text, int64_t& out_ns) {
   };
   if (!digits(whole) || !digits(fraction)) return false;
   fraction.resize(9, '0');
-  out_ns = std::stoll(whole) * 1000000000LL + std::stoll(fraction);
+  // Ten digits of seconds can exceed int64 nanoseconds (year 2262): refuse those.
+  const int64_t seconds = std::stoll(whole);
+  if (seconds > std::numeric_limits<int64_t>::max() / 1000000000LL - 1) return false;
+  out_ns = seconds * 1000000000LL + std::stoll(fraction);
   return true;
 }
 
@@ -105,7 +109,7 @@ void check_3x3(const nlohmann::json& m, const std::string& what) {
 void color_calibration_from_dataset_json(const nlohmann::json& doc, const std::string& path, bool one_based,
                                          Intrinsics& color, std::optional<Extrinsics>& depth_to_color) {
   if (doc.contains("rgb_K")) {
-    const nlohmann::json& k = doc["rgb_K"];
+    const nlohmann::json& k = doc.at("rgb_K");
     check_3x3(k, path + ": rgb_K");
     color.fx = json_number(k[0][0], path + ": rgb_K[0][0]");
     color.ppx = json_number(k[0][2], path + ": rgb_K[0][2]") - (one_based ? 1.0F : 0.0F);
@@ -113,8 +117,8 @@ void color_calibration_from_dataset_json(const nlohmann::json& doc, const std::s
     color.ppy = json_number(k[1][2], path + ": rgb_K[1][2]") - (one_based ? 1.0F : 0.0F);
   }
   if (doc.contains("depth_to_rgb_R") && doc.contains("depth_to_rgb_T_m")) {
-    const nlohmann::json& r = doc["depth_to_rgb_R"];
-    const nlohmann::json& t = doc["depth_to_rgb_T_m"];
+    const nlohmann::json& r = doc.at("depth_to_rgb_R");
+    const nlohmann::json& t = doc.at("depth_to_rgb_T_m");
     check_3x3(r, path + ": depth_to_rgb_R");
     if (!t.is_array() || t.size() != 3) throw IoError(path + ": depth_to_rgb_T_m: expected 3 numbers");
     Extrinsics e;
@@ -129,17 +133,17 @@ void color_calibration_from_dataset_json(const nlohmann::json& doc, const std::s
 
 /// The datasets' form: {"width", "height", "depth_K", "depth_units_m", "pixel_convention"}.
 Intrinsics intrinsics_from_dataset_json(const nlohmann::json& doc, const std::string& path, float& scale_m) {
-  const nlohmann::json& k = doc["depth_K"];
-  if (!k.is_array() || k.size() != 3 || !k[0].is_array() || k[0].size() != 3 || !k[1].is_array() ||
-      k[1].size() != 3) {
-    throw IoError(path + ": depth_K: expected a 3x3 matrix");
-  }
+  // .at() and contains(), never operator[] on a const document: a missing key must be an
+  // error, not a read past the end of the object (found by fuzz/folder_fuzz.cpp).
+  const nlohmann::json& k = doc.at("depth_K");
+  check_3x3(k, path + ": depth_K");
   Intrinsics in;
-  if (!doc["width"].is_number_integer() || !doc["height"].is_number_integer()) {
+  if (!doc.contains("width") || !doc.contains("height") || !doc.at("width").is_number_integer() ||
+      !doc.at("height").is_number_integer()) {
     throw IoError(path + ": width, height: expected integers");
   }
-  in.width = doc["width"].get<int>();
-  in.height = doc["height"].get<int>();
+  in.width = doc.at("width").get<int>();
+  in.height = doc.at("height").get<int>();
   in.fx = json_number(k[0][0], path + ": depth_K[0][0]");
   in.ppx = json_number(k[0][2], path + ": depth_K[0][2]");
   in.fy = json_number(k[1][1], path + ": depth_K[1][1]");
@@ -150,7 +154,7 @@ Intrinsics intrinsics_from_dataset_json(const nlohmann::json& doc, const std::st
     in.ppx -= 1.0F;
     in.ppy -= 1.0F;
   }
-  if (doc.contains("depth_units_m")) scale_m = json_number(doc["depth_units_m"], path + ": depth_units_m");
+  if (doc.contains("depth_units_m")) scale_m = json_number(doc.at("depth_units_m"), path + ": depth_units_m");
   return in;
 }
 
