@@ -3,6 +3,7 @@
 // header says in which domain the filters ran (depth without a stereo baseline) and at which
 // resolution, and a background saved at the decimated resolution loads again.
 #include "recordings_test_util.hpp"
+#include "../support/run_cli.hpp"
 
 #include "hrcsense/io.hpp"
 
@@ -12,28 +13,12 @@
 #include <cstdio>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 
 namespace hrcsense {
 namespace {
 
-struct CliResult {
-  int exit_code = -1;
-  std::string out;  ///< stdout and stderr together
-};
-
-CliResult cli(const std::string& arguments) {
-  CliResult result;
-  const std::string command = std::string(HRCSENSE_CLI) + " " + arguments + " 2>&1";
-  std::FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  char buffer[4096];
-  size_t n = 0;
-  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.out.append(buffer, n);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using test::cli;
+using test::CliResult;
 
 /// A folder recording of `frames` 64x48 frames of a wall at 1.5 m (no stereo baseline: the
 /// folder layout does not carry one).

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // `hrcsense info <recording>` and `hrcsense run` on recorded sources, through the real CLI.
 #include "recordings_test_util.hpp"
+#include "../support/run_cli.hpp"
 
 #include "hrcsense/io.hpp"
 
@@ -8,28 +9,12 @@
 
 #include <cstdio>
 #include <string>
-#include <sys/wait.h>
 
 namespace hrcsense {
 namespace {
 
-struct CliResult {
-  int exit_code = -1;
-  std::string out;  ///< stdout and stderr together
-};
-
-CliResult cli(const std::string& arguments) {
-  CliResult result;
-  const std::string command = std::string(HRCSENSE_CLI) + " " + arguments + " 2>&1";
-  std::FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  char buffer[4096];
-  size_t n = 0;
-  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.out.append(buffer, n);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using test::cli;
+using test::CliResult;
 
 void expect_line(const std::string& out, const std::string& line) {
   EXPECT_NE(out.find(line + "\n"), std::string::npos) << "missing line: " << line << "\n" << out;
