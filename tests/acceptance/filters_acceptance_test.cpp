@@ -5,6 +5,7 @@
 // frames at 848x480; and the default sdk preset runs the pipeline at the decimated resolution.
 // The numbers these tests print are the ones in docs/ACCURACY.md.
 
+#include "../support/sanitized.hpp"
 #include "hrcsense/camera.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/pipeline.hpp"
@@ -19,17 +20,7 @@
 namespace hrcsense {
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
+using test::kSanitized;
 
 std::string scene_path(const char* name) { return std::string(HRCSENSE_SOURCE_DIR) + "/config/" + name; }
 

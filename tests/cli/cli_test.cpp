@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tests of the `hrcsense` executable: exit codes, one-line errors, JSON Lines from `run`, `info`.
+#include "../support/sanitized.hpp"
 #include "hrcsense/camera.hpp"
 
 #include <gtest/gtest.h>
@@ -21,17 +22,7 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
+using hrcsense::test::kSanitized;
 
 struct Outcome {
   int exit_code = -1;
