@@ -18,13 +18,6 @@
 #include <fstream>
 #include <iostream>
 
-#ifndef HRCSENSE_VERSION
-#define HRCSENSE_VERSION "unknown"
-#endif
-#ifndef HRCSENSE_COMMIT
-#define HRCSENSE_COMMIT "unknown"
-#endif
-
 namespace hrcsense::app {
 namespace {
 
@@ -104,9 +97,7 @@ int run_command(const CommandArgs& args) {
   ConsoleSink console;
   TeeSink sinks{&jsonl, &console};
 
-  RunHeader header;
-  header.version = HRCSENSE_VERSION;
-  header.commit = HRCSENSE_COMMIT;
+  RunHeader header;  // version and commit: the sink fills in the build's own
   header.config_hash = config_hash(config);
   header.source = info;
   header.filters = describe_filters(config, info);

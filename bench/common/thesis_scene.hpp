@@ -13,14 +13,6 @@ namespace hrcsense::bench {
 
 inline constexpr int kLearnFrames = 100;
 
-inline Shape box_shape(Eigen::Vector3f min, Eigen::Vector3f max) {
-  Shape s;
-  s.type = Shape::Type::box;
-  s.min = min;
-  s.max = max;
-  return s;
-}
-
 /// The simulator for the thesis box scene at 848x480 with D435-like noise.
 inline Simulator thesis_box_simulator() {
   Simulator sim;
@@ -29,19 +21,15 @@ inline Simulator thesis_box_simulator() {
   sim.params.frames = 400;
   SceneObject wall;
   wall.name = "wall";
-  Shape plane;
-  plane.type = Shape::Type::plane;
-  plane.point = {0.0F, 0.0F, 2.0F};
-  plane.normal = {0.0F, 0.0F, -1.0F};
-  wall.shapes.push_back(plane);
+  wall.shapes.push_back(Shape::plane({0.0F, 0.0F, 2.0F}, {0.0F, 0.0F, -1.0F}));
   SceneObject table;
   table.name = "table";
-  table.shapes.push_back(box_shape({-0.8F, 0.05F, 0.6F}, {1.2F, 0.10F, 1.6F}));
+  table.shapes.push_back(Shape::box({-0.8F, 0.05F, 0.6F}, {1.2F, 0.10F, 1.6F}));
   SceneObject box;
   box.name = "box";
   box.is_static = false;
   box.first_frame = kLearnFrames;
-  box.shapes.push_back(box_shape({0.5F, 0.0F, 1.0F}, {0.64F, 0.05F, 1.09F}));
+  box.shapes.push_back(Shape::box({0.5F, 0.0F, 1.0F}, {0.64F, 0.05F, 1.09F}));
   sim.scene.objects = {wall, table, box};
   Capsule robot_point;
   robot_point.a = robot_point.b = {-0.5F, -0.5F, 0.5F};

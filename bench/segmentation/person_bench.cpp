@@ -12,23 +12,6 @@ namespace {
 
 constexpr int kPersonFrame = bench::kLearnFrames;
 
-Shape plane_shape(Eigen::Vector3f point, Eigen::Vector3f normal) {
-  Shape s;
-  s.type = Shape::Type::plane;
-  s.point = point;
-  s.normal = normal;
-  return s;
-}
-
-Shape capsule_shape(Eigen::Vector3f a, Eigen::Vector3f b, float radius_m) {
-  Shape s;
-  s.type = Shape::Type::capsule;
-  s.a = a;
-  s.b = b;
-  s.radius_m = radius_m;
-  return s;
-}
-
 /// The walk scene (camera frame = base frame): floor, walls, a workbench, the robot's pedestal,
 /// and from frame kPersonFrame a person standing 2.06 m away right behind the robot point.
 Simulator person_simulator() {
@@ -38,26 +21,22 @@ Simulator person_simulator() {
   sim.params.frames = 400;
   SceneObject room;
   room.name = "room";
-  room.shapes = {plane_shape({0.0F, 1.2F, 0.0F}, {0.0F, -1.0F, 0.0F}),
-                 plane_shape({0.0F, 0.0F, 3.5F}, {0.0F, 0.0F, -1.0F}),
-                 plane_shape({-2.0F, 0.0F, 0.0F}, {1.0F, 0.0F, 0.0F}),
-                 bench::box_shape({-1.9F, 0.45F, 2.6F}, {-1.1F, 1.2F, 3.4F}),
-                 bench::box_shape({-0.45F, 0.5F, 1.45F}, {-0.15F, 1.2F, 1.75F})};
+  room.shapes = {Shape::plane({0.0F, 1.2F, 0.0F}, {0.0F, -1.0F, 0.0F}),
+                 Shape::plane({0.0F, 0.0F, 3.5F}, {0.0F, 0.0F, -1.0F}),
+                 Shape::plane({-2.0F, 0.0F, 0.0F}, {1.0F, 0.0F, 0.0F}),
+                 Shape::box({-1.9F, 0.45F, 2.6F}, {-1.1F, 1.2F, 3.4F}),
+                 Shape::box({-0.45F, 0.5F, 1.45F}, {-0.15F, 1.2F, 1.75F})};
   SceneObject person;
   person.name = "person";
   person.is_static = false;
   person.first_frame = kPersonFrame;
   const Eigen::Vector3f at(-0.3F, 0.0F, 2.06F);
-  person.shapes = {capsule_shape(at + Eigen::Vector3f(-0.1F, 1.12F, 0.0F), at + Eigen::Vector3f(-0.1F, 0.35F, 0.0F), 0.08F),
-                   capsule_shape(at + Eigen::Vector3f(0.1F, 1.12F, 0.0F), at + Eigen::Vector3f(0.1F, 0.35F, 0.0F), 0.08F),
-                   capsule_shape(at + Eigen::Vector3f(0.0F, 0.25F, 0.0F), at + Eigen::Vector3f(0.0F, -0.2F, 0.0F), 0.17F),
-                   capsule_shape(at + Eigen::Vector3f(-0.25F, -0.22F, 0.0F), at + Eigen::Vector3f(-0.3F, 0.35F, 0.0F), 0.05F),
-                   capsule_shape(at + Eigen::Vector3f(0.25F, -0.22F, 0.0F), at + Eigen::Vector3f(0.3F, 0.35F, 0.0F), 0.05F)};
-  Shape head;
-  head.type = Shape::Type::sphere;
-  head.point = at + Eigen::Vector3f(0.0F, -0.47F, 0.0F);
-  head.radius_m = 0.11F;
-  person.shapes.push_back(head);
+  person.shapes = {Shape::capsule(at + Eigen::Vector3f(-0.1F, 1.12F, 0.0F), at + Eigen::Vector3f(-0.1F, 0.35F, 0.0F), 0.08F),
+                   Shape::capsule(at + Eigen::Vector3f(0.1F, 1.12F, 0.0F), at + Eigen::Vector3f(0.1F, 0.35F, 0.0F), 0.08F),
+                   Shape::capsule(at + Eigen::Vector3f(0.0F, 0.25F, 0.0F), at + Eigen::Vector3f(0.0F, -0.2F, 0.0F), 0.17F),
+                   Shape::capsule(at + Eigen::Vector3f(-0.25F, -0.22F, 0.0F), at + Eigen::Vector3f(-0.3F, 0.35F, 0.0F), 0.05F),
+                   Shape::capsule(at + Eigen::Vector3f(0.25F, -0.22F, 0.0F), at + Eigen::Vector3f(0.3F, 0.35F, 0.0F), 0.05F)};
+  person.shapes.push_back(Shape::sphere(at + Eigen::Vector3f(0.0F, -0.47F, 0.0F), 0.11F));
   sim.scene.objects = {room, person};
   Capsule robot_point;
   robot_point.a = robot_point.b = {-0.3F, 0.3F, 1.6F};

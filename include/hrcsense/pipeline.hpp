@@ -54,8 +54,8 @@ class SimSource : public Source {
 
 /// What the run is about, written once before the first frame.
 struct RunHeader {
-  std::string version;
-  std::string commit;
+  std::string version;  ///< empty: the JSON Lines sink writes the version it was built as
+  std::string commit;   ///< empty: likewise the commit
   std::string config_hash;
   SourceInfo source;
   /// The depth filters as they run: `filters.preset`, the domain of filter_domain(), a note

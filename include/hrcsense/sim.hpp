@@ -26,6 +26,36 @@ struct Shape {
   Eigen::Vector3f a = Eigen::Vector3f::Zero();       ///< capsule: segment start
   Eigen::Vector3f b = Eigen::Vector3f::Zero();       ///< capsule: segment end
   float radius_m = 0.0F;                             ///< sphere and capsule
+
+  static Shape plane(const Eigen::Vector3f& point, const Eigen::Vector3f& normal) {
+    Shape s;
+    s.type = Type::plane;
+    s.point = point;
+    s.normal = normal;
+    return s;
+  }
+  static Shape box(const Eigen::Vector3f& min, const Eigen::Vector3f& max) {
+    Shape s;
+    s.type = Type::box;
+    s.min = min;
+    s.max = max;
+    return s;
+  }
+  static Shape sphere(const Eigen::Vector3f& center, float radius_m) {
+    Shape s;
+    s.type = Type::sphere;
+    s.point = center;
+    s.radius_m = radius_m;
+    return s;
+  }
+  static Shape capsule(const Eigen::Vector3f& a, const Eigen::Vector3f& b, float radius_m) {
+    Shape s;
+    s.type = Type::capsule;
+    s.a = a;
+    s.b = b;
+    s.radius_m = radius_m;
+    return s;
+  }
 };
 
 /// Where a moving object is at a time: its shape is translated by `offset_m`.

@@ -3,12 +3,12 @@
 // per key into the stages' parameter structs (the table is read_all below).
 #include "key_reader.hpp"
 #include "robot_config.hpp"
+#include "yaml_tree.hpp"
 
 #include "hrcsense/camera.hpp"
 
 #include <cctype>
 #include <cstdio>
-#include <fstream>
 #include <limits>
 
 namespace hrcsense {
@@ -84,6 +84,13 @@ void read_segmentation(KeyReader& r, Config& c) {
   r.number("background.moving_min_spread_m", bg.moving_min_spread_m, Bound::non_negative);
   r.number("background.max_moving_share", bg.max_moving_share, Bound::non_negative);
   if (bg.max_moving_share > 1.0F) r.fail("background.max_moving_share", "expected a share in [0, 1]");
+  r.integer("background.motion_min_width_px", bg.motion_min_width_px, 1, 31);
+  if (bg.motion_min_width_px % 2 == 0) r.fail("background.motion_min_width_px", "expected an odd width in [1, 31]");
+  r.number("background.min_valid_ratio", bg.min_valid_ratio, Bound::non_negative);
+  if (bg.min_valid_ratio > 1.0F) r.fail("background.min_valid_ratio", "expected a share in [0, 1]");
+  r.integer("background.fill_radius_px", bg.fill_radius_px, 0, 1000);
+  r.integer("background.unseen_min_frames", bg.unseen_min_frames, 1, std::numeric_limits<int>::max());
+  r.number("background.max_noise_per_z2", bg.max_noise_per_z2, Bound::positive);
 
   ForegroundParams& fg = c.pipeline.foreground;
   r.number("foreground.k_sigma", fg.k_sigma, Bound::positive);
@@ -155,15 +162,7 @@ void check_keys(const YAML::Node& map, const std::string& prefix, const std::str
 
 YAML::Node load_file(const std::string& path) {
   if (path.empty()) return YAML::Node(YAML::NodeType::Map);
-  std::ifstream file(path);
-  if (!file) throw ConfigError(path + ": cannot open configuration file");
-  YAML::Node root;
-  try {
-    root = YAML::Load(file);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                      ": YAML syntax error: " + e.msg);
-  }
+  const YAML::Node root = config_detail::load_yaml_file(path, "configuration file");
   if (root.IsNull() || !root.IsDefined()) return YAML::Node(YAML::NodeType::Map);
   if (!root.IsMap()) throw ConfigError(path + ": expected a map of sections (source, sim, ...) at the top");
   return root;

@@ -3,9 +3,10 @@
 // thesis's points or an arm (built-in or described in YAML) posed by its joint angles.
 #include "robot_config.hpp"
 
+#include "yaml_tree.hpp"
+
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,52 +22,7 @@ double rad_from_deg(double deg) { return (deg / 180.0) * kPi; }
 double deg_from_rad(double rad) { return (rad / kPi) * 180.0; }
 
 // Errors name the field by its path in the description, e.g. links.forearm[1].radius_m.
-struct DescriptionReader {
-  const std::string& where;
-  const std::string& prefix;
-
-  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    config_detail::fail(where, prefix + key, what);
-  }
-
-  void only_keys(const YAML::Node& map, const std::string& key, const std::vector<std::string>& allowed) const {
-    if (!map.IsMap()) fail(key, "expected a map");
-    for (const auto& entry : map) {
-      const std::string name = entry.first.Scalar();
-      bool ok = false;
-      for (const std::string& option : allowed) ok = ok || name == option;
-      if (!ok) {
-        throw ConfigError(where + ": unknown key '" + prefix + (key.empty() ? name : key + "." + name) + "'");
-      }
-    }
-  }
-
-  YAML::Node child(const YAML::Node& map, const std::string& name) const {
-    const YAML::Node& const_map = map;  // const access never inserts
-    YAML::Node node = const_map[name];
-    if (!node.IsDefined() || node.IsNull()) return YAML::Node(YAML::NodeType::Undefined);
-    return node;
-  }
-
-  YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& name) const {
-    YAML::Node node = child(map, name);
-    if (!node.IsDefined()) fail(key.empty() ? name : key + "." + name, "is required");
-    return node;
-  }
-
-  double number(const YAML::Node& node, const std::string& key) const {
-    double value = 0.0;
-    if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value)) {
-      fail(key, "expected a number");
-    }
-    return value;
-  }
-
-  Eigen::Vector3d vec3(const YAML::Node& node, const std::string& key) const {
-    if (!node.IsSequence() || node.size() != 3) fail(key, "expected a list of 3 numbers [x, y, z]");
-    return {number(node[0], key), number(node[1], key), number(node[2], key)};
-  }
-
+struct DescriptionReader : YamlTree {
   LinkCapsule capsule(const YAML::Node& node, const std::string& key) const {
     only_keys(node, key, {"a_m", "b_m", "radius_m"});
     LinkCapsule out;
@@ -188,7 +144,7 @@ RobotDescription arm_description(KeyReader& r, const std::string& model, const Y
     }
   } else if (description.IsMap()) {
     const std::string prefix = "robot.description.";
-    out = DescriptionReader{r.where(), prefix}.description(description);
+    out = DescriptionReader{{r.where(), prefix}}.description(description);
     if (out.name.empty()) out.name = "custom";
   } else {
     r.fail("robot.description", "expected a file name or a map");
@@ -208,7 +164,7 @@ std::string limit_text(const JointLimit& limit) {
 }  // namespace
 
 RobotDescription read_robot_description(const YAML::Node& map, const std::string& where, const std::string& prefix) {
-  return DescriptionReader{where, prefix}.description(map);
+  return DescriptionReader{{where, prefix}}.description(map);
 }
 
 YAML::Node robot_description_node(const RobotDescription& description) {
@@ -304,15 +260,7 @@ std::optional<SceneObject> robot_scene_object(const Config& config) {
 }
 
 RobotDescription load_robot_description(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) throw ConfigError(path + ": cannot open robot description");
-  YAML::Node root;
-  try {
-    root = YAML::Load(file);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                      ": YAML syntax error: " + e.msg);
-  }
+  const YAML::Node root = config_detail::load_yaml_file(path, "robot description");
   if (!root.IsMap()) throw ConfigError(path + ": expected a robot description (a map with dh and links)");
   RobotDescription description = config_detail::read_robot_description(root, path, "");
   if (description.name.empty()) description.name = path;

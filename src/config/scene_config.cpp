@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense config — `scene.objects`: simulated objects made of planes, boxes, spheres, capsules.
-#include "key_reader.hpp"
+#include "yaml_tree.hpp"
 
 #include "hrcsense/sim.hpp"
 
@@ -14,45 +14,7 @@ namespace hrcsense::config_detail {
 namespace {
 
 // Errors inside the scene name the item by its position, e.g. scene.objects[2].shapes[0].
-struct SceneReader {
-  const std::string& where;
-
-  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    config_detail::fail(where, key, what);
-  }
-
-  void only_keys(const YAML::Node& map, const std::string& key,
-                 const std::vector<std::string>& allowed) const {
-    if (!map.IsMap()) fail(key, "expected a map");
-    for (const auto& entry : map) {
-      const std::string name = entry.first.Scalar();
-      bool ok = false;
-      for (const std::string& option : allowed) ok = ok || name == option;
-      if (!ok) throw ConfigError(where + ": unknown key '" + key + "." + name + "'");
-    }
-  }
-
-  YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& name) const {
-    const YAML::Node& const_map = map;
-    YAML::Node node = const_map[name];
-    if (!node.IsDefined() || node.IsNull()) fail(key + "." + name, "is required");
-    return node;
-  }
-
-  double number(const YAML::Node& node, const std::string& key) const {
-    double value = 0.0;
-    if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value)) {
-      fail(key, "expected a number");
-    }
-    return value;
-  }
-
-  Eigen::Vector3f vec3(const YAML::Node& node, const std::string& key) const {
-    if (!node.IsSequence() || node.size() != 3) fail(key, "expected a list of 3 numbers [x, y, z]");
-    return {static_cast<float>(number(node[0], key)), static_cast<float>(number(node[1], key)),
-            static_cast<float>(number(node[2], key))};
-  }
-
+struct SceneReader : YamlTree {
   float radius(const YAML::Node& map, const std::string& key) const {
     const double r = number(required(map, key, "radius_m"), key + ".radius_m");
     if (r <= 0.0) fail(key + ".radius_m", "expected a number > 0");
@@ -70,26 +32,26 @@ struct SceneReader {
     if (type == "plane") {
       only_keys(body, sub, {"point", "normal"});
       out.type = Shape::Type::plane;
-      out.point = vec3(required(body, sub, "point"), sub + ".point");
-      const Eigen::Vector3f normal = vec3(required(body, sub, "normal"), sub + ".normal");
+      out.point = vec3f(required(body, sub, "point"), sub + ".point");
+      const Eigen::Vector3f normal = vec3f(required(body, sub, "normal"), sub + ".normal");
       if (normal.norm() < 1e-6F) fail(sub + ".normal", "expected a non-zero vector");
       out.normal = normal.normalized();
     } else if (type == "box") {
       only_keys(body, sub, {"min", "max"});
       out.type = Shape::Type::box;
-      out.min = vec3(required(body, sub, "min"), sub + ".min");
-      out.max = vec3(required(body, sub, "max"), sub + ".max");
+      out.min = vec3f(required(body, sub, "min"), sub + ".min");
+      out.max = vec3f(required(body, sub, "max"), sub + ".max");
       if ((out.min.array() > out.max.array()).any()) fail(sub, "expected min <= max on every axis");
     } else if (type == "sphere") {
       only_keys(body, sub, {"center", "radius_m"});
       out.type = Shape::Type::sphere;
-      out.point = vec3(required(body, sub, "center"), sub + ".center");
+      out.point = vec3f(required(body, sub, "center"), sub + ".center");
       out.radius_m = radius(body, sub);
     } else if (type == "capsule") {
       only_keys(body, sub, {"a", "b", "radius_m"});
       out.type = Shape::Type::capsule;
-      out.a = vec3(required(body, sub, "a"), sub + ".a");
-      out.b = vec3(required(body, sub, "b"), sub + ".b");
+      out.a = vec3f(required(body, sub, "a"), sub + ".a");
+      out.b = vec3f(required(body, sub, "b"), sub + ".b");
       out.radius_m = radius(body, sub);
     } else {
       fail(key, "unknown shape '" + type + "'; expected plane, box, sphere or capsule");
@@ -117,7 +79,7 @@ struct SceneReader {
       only_keys(node[i], item, {"t_s", "offset_m"});
       Waypoint point;
       point.t_s = number(required(node[i], item, "t_s"), item + ".t_s");
-      point.offset_m = vec3(required(node[i], item, "offset_m"), item + ".offset_m");
+      point.offset_m = vec3f(required(node[i], item, "offset_m"), item + ".offset_m");
       if (!out.empty() && point.t_s < out.back().t_s) fail(item + ".t_s", "expected times in increasing order");
       out.push_back(point);
     }
@@ -309,7 +271,8 @@ void read_sim_effects(KeyReader& r, SimParams& sim) {
 Scene read_scene_objects(const YAML::Node& objects, const std::string& where, const std::string& key) {
   Scene scene;
   if (!objects.IsDefined() || objects.IsNull()) return scene;
-  const SceneReader reader{where};
+  const std::string no_prefix;
+  const SceneReader reader{{where, no_prefix}};
   if (!objects.IsSequence()) reader.fail(key, "expected a list of objects");
   for (size_t i = 0; i < objects.size(); ++i) {
     scene.objects.push_back(reader.object(objects[i], key + "[" + std::to_string(i) + "]", i));

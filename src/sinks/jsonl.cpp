@@ -102,213 +102,178 @@ void put_vec3(std::string& line, const Eigen::Vector3f& v) {
   line += ']';
 }
 
-void put_truth(std::string& line, const Contact& truth) {
-  line += '{';
-  put_key(line, "distance_m");
-  if (truth.valid) {
-    put_float(line, truth.distance_m);
-  } else {
+/// Appends `"key":value` members to a line, one call per member, so that each field of the
+/// output is one line here. Values a contact lacks are written as null.
+struct Members {
+  std::string& line;
+
+  void text(const char* key, std::string_view value) {
+    put_key(line, key);
+    put_string(line, value);
+  }
+  void integer(const char* key, int64_t value) {
+    put_key(line, key);
+    put_int(line, value);
+  }
+  void number(const char* key, float value) {
+    put_key(line, key);
+    put_float(line, value);
+  }
+  void number(const char* key, double value) {
+    put_key(line, key);
+    put_double(line, value);
+  }
+  void boolean(const char* key, bool value) {
+    put_key(line, key);
+    line += value ? "true" : "false";
+  }
+  void null(const char* key) {
+    put_key(line, key);
     line += "null";
   }
-  put_key(line, "closest_base");
-  if (truth.valid) {
-    put_vec3(line, truth.closest_base);
-  } else {
-    line += "null";
+  template <typename T>
+  void number_or_null(const char* key, bool present, T value) {
+    if (present) {
+      number(key, value);
+    } else {
+      null(key);
+    }
   }
-  line += '}';
+  void point_or_null(const char* key, bool present, const Eigen::Vector3f& value) {
+    put_key(line, key);
+    if (present) {
+      put_vec3(line, value);
+    } else {
+      line += "null";
+    }
+  }
+  void open(const char* key) {
+    put_key(line, key);
+    line += '{';
+  }
+  void close() { line += '}'; }
+};
+
+void put_pinhole(Members& m, const Intrinsics& in) {
+  m.integer("width", in.width);
+  m.integer("height", in.height);
+  m.number("fx", in.fx);
+  m.number("fy", in.fy);
+  m.number("ppx", in.ppx);
+  m.number("ppy", in.ppy);
 }
 
 // The filters as they run; the filtered resolution is the one contact pixels and the learnt
 // background refer to. Left out when no configuration said (preset empty).
-void put_filters(std::string& line, const RunHeader::Filters& filters) {
+void put_filters(Members& m, const RunHeader::Filters& filters) {
   if (filters.preset.empty()) return;
-  put_key(line, "filters");
-  line += '{';
-  put_key(line, "preset");
-  put_string(line, filters.preset);
-  put_key(line, "domain");
-  put_string(line, filters.domain);
-  if (!filters.note.empty()) {
-    put_key(line, "note");
-    put_string(line, filters.note);
-  }
-  put_key(line, "width");
-  put_int(line, filters.intrinsics.width);
-  put_key(line, "height");
-  put_int(line, filters.intrinsics.height);
-  put_key(line, "fx");
-  put_float(line, filters.intrinsics.fx);
-  put_key(line, "fy");
-  put_float(line, filters.intrinsics.fy);
-  put_key(line, "ppx");
-  put_float(line, filters.intrinsics.ppx);
-  put_key(line, "ppy");
-  put_float(line, filters.intrinsics.ppy);
-  line += '}';
+  m.open("filters");
+  m.text("preset", filters.preset);
+  m.text("domain", filters.domain);
+  if (!filters.note.empty()) m.text("note", filters.note);
+  put_pinhole(m, filters.intrinsics);
+  m.close();
 }
 
 }  // namespace
 
 void JsonLinesSink::header(const RunHeader& header) {
-  std::string& line = line_;
-  line.assign("{");
-  put_key(line, "type");
-  put_string(line, "header");
-  put_key(line, "version");
-  put_string(line, header.version.empty() ? HRCSENSE_VERSION : header.version);
-  put_key(line, "commit");
-  put_string(line, header.commit.empty() ? HRCSENSE_COMMIT : header.commit);
-  put_key(line, "config_hash");
-  put_string(line, header.config_hash);
+  line_.assign("{");
+  Members m{line_};
+  m.text("type", "header");
+  m.text("version", header.version.empty() ? HRCSENSE_VERSION : header.version);
+  m.text("commit", header.commit.empty() ? HRCSENSE_COMMIT : header.commit);
+  m.text("config_hash", header.config_hash);
 
   const SourceInfo& source = header.source;
-  put_key(line, "source");
-  line += '{';
-  put_key(line, "type");
-  put_string(line, source.type);
-  put_key(line, "description");
-  put_string(line, source.description);
-  put_key(line, "frame_count");
-  put_int(line, source.frame_count);
-  put_key(line, "nominal_fps");
-  put_double(line, source.nominal_fps);
-  put_key(line, "stereo_baseline_mm");
-  put_float(line, source.stereo_baseline_mm);
-  line += '}';
+  m.open("source");
+  m.text("type", source.type);
+  m.text("description", source.description);
+  m.integer("frame_count", source.frame_count);
+  m.number("nominal_fps", source.nominal_fps);
+  m.number("stereo_baseline_mm", source.stereo_baseline_mm);
+  m.close();
 
   const Intrinsics& in = source.intrinsics;
-  put_key(line, "intrinsics");
-  line += '{';
-  put_key(line, "width");
-  put_int(line, in.width);
-  put_key(line, "height");
-  put_int(line, in.height);
-  put_key(line, "fx");
-  put_float(line, in.fx);
-  put_key(line, "fy");
-  put_float(line, in.fy);
-  put_key(line, "ppx");
-  put_float(line, in.ppx);
-  put_key(line, "ppy");
-  put_float(line, in.ppy);
-  put_key(line, "model");
-  put_string(line, distortion_name(in.model));
-  put_key(line, "coeffs");
-  line += '[';
+  m.open("intrinsics");
+  put_pinhole(m, in);
+  m.text("model", distortion_name(in.model));
+  put_key(line_, "coeffs");
+  line_ += '[';
   for (size_t i = 0; i < in.coeffs.size(); ++i) {
-    if (i > 0) line += ',';
-    put_float(line, in.coeffs[i]);
+    if (i > 0) line_ += ',';
+    put_float(line_, in.coeffs[i]);
   }
-  line += "]}";
-  put_filters(line, header.filters);
-  line += "}\n";
-  out_ << line;
+  line_ += ']';
+  m.close();
+  put_filters(m, header.filters);
+  line_ += "}\n";
+  out_ << line_;
 }
 
 void JsonLinesSink::frame(const FrameResult& result) {
-  std::string& line = line_;
   const Contact& contact = result.contact;
-  line.assign("{");
-  put_key(line, "type");
-  put_string(line, result.source_frame ? "frame" : "verdict");
-  put_key(line, "frame");
-  put_int(line, result.frame);
-  put_key(line, "timestamp_ns");
-  put_int(line, result.timestamp_ns);
-  put_key(line, "timestamp_s");
-  put_seconds(line, result.timestamp_ns);
-  put_key(line, "valid");
-  line += result.valid ? "true" : "false";
-  put_key(line, "verdict");
-  put_string(line, verdict_name(result.verdict.state));
-  put_key(line, "verdict_reason");
-  put_string(line, result.verdict.reason);
-  put_key(line, "speed_scale");
-  put_float(line, result.verdict.speed_scale);
+  line_.assign("{");
+  Members m{line_};
+  m.text("type", result.source_frame ? "frame" : "verdict");
+  m.integer("frame", result.frame);
+  m.integer("timestamp_ns", result.timestamp_ns);
+  put_key(line_, "timestamp_s");
+  put_seconds(line_, result.timestamp_ns);
+  m.boolean("valid", result.valid);
+  m.text("verdict", verdict_name(result.verdict.state));
+  m.text("verdict_reason", result.verdict.reason);
+  m.number("speed_scale", result.verdict.speed_scale);
 
-  put_key(line, "distance_m");
+  m.number_or_null("distance_m", contact.valid, contact.distance_m);
+  m.point_or_null("closest_camera", contact.valid, contact.closest_camera);
+  m.point_or_null("closest_base", contact.valid, contact.closest_base);
+  m.point_or_null("closest_robot_base", contact.valid, contact.closest_robot_base);
   if (contact.valid) {
-    put_float(line, contact.distance_m);
+    m.integer("robot_link", contact.robot_link);
+    m.boolean("inside", contact.inside);  // a foreground point inside (or on) a capsule: distance 0
   } else {
-    line += "null";
+    m.null("robot_link");
+    m.null("inside");
   }
-  const std::pair<const char*, const Eigen::Vector3f*> points[] = {
-      {"closest_camera", &contact.closest_camera},
-      {"closest_base", &contact.closest_base},
-      {"closest_robot_base", &contact.closest_robot_base}};
-  for (const auto& [key, point] : points) {
-    put_key(line, key);
-    if (contact.valid) {
-      put_vec3(line, *point);
-    } else {
-      line += "null";
-    }
-  }
-  put_key(line, "robot_link");
-  if (contact.valid) {
-    put_int(line, contact.robot_link);
-  } else {
-    line += "null";
-  }
-
-  put_key(line, "inside");  // a foreground point inside (or on) a capsule: distance 0
-  line += contact.valid ? (contact.inside ? "true" : "false") : "null";
-  put_key(line, "backend");  // the one that searched (auto's pick), else the configured one
-  put_string(line, result.backend != nullptr ? result.backend : backend_.c_str());
-  put_key(line, "foreground_points");
-  put_int(line, static_cast<int64_t>(result.foreground_points));
-  put_key(line, "invalid_pixels");
-  put_int(line, static_cast<int64_t>(result.invalid_pixels));
-  put_key(line, "latency_us");
-  put_double(line, result.latency_us);
-  put_key(line, "timings_us");
-  line += '{';
-  for (const StageTiming& timing : result.timings) {
-    put_key(line, timing.stage);
-    put_double(line, timing.us);
-  }
-  line += '}';
+  // The backend that searched (auto's pick), else the configured one.
+  m.text("backend", result.backend != nullptr ? result.backend : backend_.c_str());
+  m.integer("foreground_points", static_cast<int64_t>(result.foreground_points));
+  m.integer("invalid_pixels", static_cast<int64_t>(result.invalid_pixels));
+  m.number("latency_us", result.latency_us);
+  m.open("timings_us");
+  for (const StageTiming& timing : result.timings) m.number(timing.stage, timing.us);
+  m.close();
   if (result.truth) {
-    put_key(line, "truth");
-    put_truth(line, *result.truth);
+    m.open("truth");
+    m.number_or_null("distance_m", result.truth->valid, result.truth->distance_m);
+    m.point_or_null("closest_base", result.truth->valid, result.truth->closest_base);
+    m.close();
   }
-  line += "}\n";
-  out_ << line;
+  line_ += "}\n";
+  out_ << line_;
 }
 
 void JsonLinesSink::summary(const RunSummary& summary) {
-  std::string& line = line_;
-  line.assign("{");
-  put_key(line, "type");
-  put_string(line, "summary");
-  const std::pair<const char*, int64_t> counts[] = {
-      {"frames_in", summary.frames_in},       {"frames_processed", summary.frames_processed},
-      {"frames_dropped", summary.frames_dropped}, {"frames_valid", summary.frames_valid},
-      {"verdict_run", summary.verdict_run},   {"verdict_slow", summary.verdict_slow},
-      {"verdict_stop", summary.verdict_stop}};
-  for (const auto& [key, value] : counts) {
-    put_key(line, key);
-    put_int(line, value);
-  }
-  const std::pair<const char*, double> figures[] = {{"wall_s", summary.wall_s},
-                                                    {"fps", summary.fps},
-                                                    {"latency_p50_us", summary.latency_p50_us},
-                                                    {"latency_p99_us", summary.latency_p99_us}};
-  for (const auto& [key, value] : figures) {
-    put_key(line, key);
-    put_double(line, value);
-  }
-  put_key(line, "min_distance_m");
-  if (summary.min_distance_m >= 0.0F) {
-    put_float(line, summary.min_distance_m);
-  } else {
-    line += "null";  // never any foreground
-  }
-  put_key(line, "end_reason");
-  put_string(line, summary.end_reason);
-  line += "}\n";
-  out_ << line;
+  line_.assign("{");
+  Members m{line_};
+  m.text("type", "summary");
+  m.integer("frames_in", summary.frames_in);
+  m.integer("frames_processed", summary.frames_processed);
+  m.integer("frames_dropped", summary.frames_dropped);
+  m.integer("frames_valid", summary.frames_valid);
+  m.integer("verdict_run", summary.verdict_run);
+  m.integer("verdict_slow", summary.verdict_slow);
+  m.integer("verdict_stop", summary.verdict_stop);
+  m.number("wall_s", summary.wall_s);
+  m.number("fps", summary.fps);
+  m.number("latency_p50_us", summary.latency_p50_us);
+  m.number("latency_p99_us", summary.latency_p99_us);
+  // Negative when there never was any foreground.
+  m.number_or_null("min_distance_m", summary.min_distance_m >= 0.0F, summary.min_distance_m);
+  m.text("end_reason", summary.end_reason);
+  line_ += "}\n";
+  out_ << line_;
   out_.flush();
 }
 

@@ -47,6 +47,10 @@ TEST(ConfigErrors, IllTypedValuesNameFileKeyAndExpectation) {
         "number");
   check("background: {frames: 0}\n", "'background.frames'", "integer");
   check("background: {max_moving_share: 2}\n", "'background.max_moving_share'", "[0, 1]");
+  check("background: {motion_min_width_px: 4}\n", "'background.motion_min_width_px'", "odd");
+  check("background: {min_valid_ratio: 1.5}\n", "'background.min_valid_ratio'", "[0, 1]");
+  check("background: {fill_radius_px: -1}\n", "'background.fill_radius_px'", "integer");
+  check("background: {max_noise_per_z2: 0}\n", "'background.max_noise_per_z2'", "> 0");
   check("foreground: {k_sigma: -1}\n", "'foreground.k_sigma'", "> 0");
   check("foreground: {workspace_base: {min: [0, 0, 1], max: [1, 1, 0]}}\n", "'foreground.workspace_base'", "min <= max");
   check("robot: {points_base: [[0, 0]]}\n", "'robot.points_base'", "[x, y, z]");

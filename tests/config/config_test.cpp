@@ -52,7 +52,9 @@ sim: {width: 640, height: 480, fps: 15, frames: 77, noise: false, disparity_nois
 camera:
   T_base_camera: {translation_m: [0.1, -0.2, 0.3], rotation_rpy_deg: [0, 0, 0]}
 filters: {preset: none}
-background: {frames: 12, path: bg.bin, moving_k_sigma: 5, moving_min_spread_m: 0.04, max_moving_share: 0.01}
+background: {frames: 12, path: bg.bin, moving_k_sigma: 5, moving_min_spread_m: 0.04, max_moving_share: 0.01,
+             motion_min_width_px: 5, min_valid_ratio: 0.25, fill_radius_px: 8, unseen_min_frames: 20,
+             max_noise_per_z2: 0.02}
 foreground:
   k_sigma: 3.5
   min_margin_m: 0.03
@@ -88,6 +90,11 @@ safety: {slow_distance_m: 1.5, stop_distance_m: 0.7, max_frame_age_s: 0.25}
   EXPECT_FLOAT_EQ(c.pipeline.background.moving_k_sigma, 5.0F);
   EXPECT_FLOAT_EQ(c.pipeline.background.moving_min_spread_m, 0.04F);
   EXPECT_FLOAT_EQ(c.pipeline.background.max_moving_share, 0.01F);
+  EXPECT_EQ(c.pipeline.background.motion_min_width_px, 5);
+  EXPECT_FLOAT_EQ(c.pipeline.background.min_valid_ratio, 0.25F);
+  EXPECT_EQ(c.pipeline.background.fill_radius_px, 8);
+  EXPECT_EQ(c.pipeline.background.unseen_min_frames, 20);
+  EXPECT_FLOAT_EQ(c.pipeline.background.max_noise_per_z2, 0.02F);
   EXPECT_FLOAT_EQ(c.pipeline.foreground.k_sigma, 3.5F);
   EXPECT_FLOAT_EQ(c.pipeline.foreground.min_margin_m, 0.03F);
   EXPECT_FLOAT_EQ(c.pipeline.foreground.min_object_mm, 25.0F);

@@ -19,22 +19,6 @@ constexpr int64_t kLearnFrames = 100;
 constexpr int64_t kEmptyFrames = 500;
 #endif
 
-Shape plane(const Eigen::Vector3f& point, const Eigen::Vector3f& normal) {
-  Shape s;
-  s.type = Shape::Type::plane;
-  s.point = point;
-  s.normal = normal;
-  return s;
-}
-
-Shape box(const Eigen::Vector3f& min, const Eigen::Vector3f& max) {
-  Shape s;
-  s.type = Shape::Type::box;
-  s.min = min;
-  s.max = max;
-  return s;
-}
-
 /// A cell seen from 2 m above the floor, looking straight down: floor, a back wall, a table
 /// 0.75 m high, and (from frame `box_frame`) a 0.3 m box on the table whose top is 1 m from the
 /// camera. The box sits on the optical axis, so only its top is visible.
@@ -46,13 +30,13 @@ Simulator cell(uint64_t seed, int64_t box_frame) {
   sim.T_base_camera.translation() = Eigen::Vector3d(0.0, 0.0, 2.0);
   SceneObject statics;
   statics.name = "cell";
-  statics.shapes.push_back(plane({0, 0, 0}, {0, 0, 1}));     // floor
-  statics.shapes.push_back(plane({0, 0.9F, 0}, {0, 1, 0}));  // back wall
-  statics.shapes.push_back(box({-0.6F, -0.5F, 0.0F}, {0.6F, 0.5F, 0.75F}));
+  statics.shapes.push_back(Shape::plane({0, 0, 0}, {0, 0, 1}));     // floor
+  statics.shapes.push_back(Shape::plane({0, 0.9F, 0}, {0, 1, 0}));  // back wall
+  statics.shapes.push_back(Shape::box({-0.6F, -0.5F, 0.0F}, {0.6F, 0.5F, 0.75F}));
   sim.scene.objects.push_back(statics);
   SceneObject parcel;
   parcel.name = "box";
-  parcel.shapes.push_back(box({-0.15F, -0.15F, 0.75F}, {0.15F, 0.15F, 1.0F}));
+  parcel.shapes.push_back(Shape::box({-0.15F, -0.15F, 0.75F}, {0.15F, 0.15F, 1.0F}));
   parcel.is_static = false;
   parcel.first_frame = box_frame;
   sim.scene.objects.push_back(parcel);
