@@ -2,7 +2,8 @@
 // Depth filters (issue 4): every block at 848x480 and 1280x720 on simulated D435 frames (a
 // person in a room: depth edges, the left invalid band, dropouts, speckle), SDK default options
 // unless the name says otherwise, plus the plain scalar references of the spatial and temporal
-// filters from tests/filters/reference.hpp so that the speed-up is measured in the same run.
+// filters from tests/filters/reference.hpp so that the speed-up is measured in the same run,
+// and "Portable/..." copies of the blocks with AVX2 paths, forced onto the SSE2 loops.
 // In-place blocks get a fresh copy of their input outside the timed region, so each iteration
 // sees real data (holes to fill, unsmoothed noise) rather than its own previous output.
 
@@ -165,10 +166,11 @@ void bm_to_depth(benchmark::State& state, int w, int h) {
 void bm_spatial_disparity(benchmark::State& state, int w, int h) {
   const Inputs& in = inputs(w, h);
   DisparityImage work;
+  SpatialScratch scratch;
   size_t i = 0;
   for (auto _ : state) {
     fresh_copy(state, in.disparities[i++ % kFrames], work);
-    spatial_filter(SpatialParams{}, work);
+    spatial_filter(SpatialParams{}, work, scratch);
     benchmark::DoNotOptimize(work.pixels.data());
   }
 }
@@ -176,10 +178,11 @@ void bm_spatial_disparity(benchmark::State& state, int w, int h) {
 void bm_spatial_depth(benchmark::State& state, int w, int h) {
   const Inputs& in = inputs(w, h);
   DepthImage work = in.frames[0].depth;
+  SpatialScratch scratch;
   size_t i = 0;
   for (auto _ : state) {
     fresh_copy(state, in.frames[i++ % kFrames].depth, work);
-    spatial_filter(SpatialParams{}, work);
+    spatial_filter(SpatialParams{}, work, scratch);
     benchmark::DoNotOptimize(work.pixels.data());
   }
 }
@@ -262,6 +265,20 @@ void add(const std::string& name, int w, int h, Fn fn, Args... args) {
       ->Unit(benchmark::kMicrosecond);
 }
 
+// The same benchmark forced onto the portable SSE2 loops, named "Portable/<name>": what the
+// run-time AVX2 paths buy, measured in the same run (docs/FILTERS.md).
+template <typename Fn, typename... Args>
+void add_portable(const std::string& name, int w, int h, Fn fn, Args... args) {
+  const std::string full = "Portable/" + name + "/" + std::to_string(w) + "x" + std::to_string(h);
+  benchmark::RegisterBenchmark(full.c_str(),
+                               [=](benchmark::State& state) {
+                                 set_filter_isa(FilterIsa::portable);
+                                 fn(state, w, h, args...);
+                                 set_filter_isa(FilterIsa::best);
+                               })
+      ->Unit(benchmark::kMicrosecond);
+}
+
 const bool registered = [] {
   for (const auto& [w, h] : {std::pair{848, 480}, std::pair{1280, 720}}) {
     add("Threshold/depth", w, h, bm_threshold);
@@ -279,6 +296,14 @@ const bool registered = [] {
     add("Chain/sdk", w, h, bm_chain, "sdk");
     add("Reference/Spatial/disparity", w, h, bm_reference_spatial_disparity);
     add("Reference/Temporal/disparity", w, h, bm_reference_temporal_disparity);
+    add_portable("ToDisparity", w, h, bm_to_disparity);
+    add_portable("ToDepth", w, h, bm_to_depth);
+    add_portable("Spatial/disparity", w, h, bm_spatial_disparity);
+    add_portable("Temporal/disparity", w, h, bm_temporal_disparity);
+    add_portable("HoleFilling/left", w, h, bm_hole_filling, 0);
+    add_portable("HoleFilling/farthest", w, h, bm_hole_filling, 1);
+    add_portable("HoleFilling/nearest", w, h, bm_hole_filling, 2);
+    add_portable("Chain/thesis", w, h, bm_chain, "thesis");
   }
   return true;
 }();

@@ -78,6 +78,9 @@ void BM_OctreeBuild(benchmark::State& state, int height, size_t n) {
   }
 }
 
+// Repeated queries on one build. Up to height 4 a leaf's coordinates are gathered by the first
+// query that reaches it, so this is the later queries' cost; the first query of a frame is in
+// Proximity/octree_*/ (build + query).
 void BM_OctreeQuery(benchmark::State& state, int height, std::string robot_name, size_t n) {
   const PointCloud cloud = person_cloud(n);
   std::vector<proximity_detail::CapsuleBound> capsules;

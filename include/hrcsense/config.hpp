@@ -50,7 +50,7 @@ struct Config {
   /// robot_joints_rad, robot_frame and robot_padding_m it gives pipeline.robot
   /// (robot_capsules) and the arm to render (robot_render_capsules).
   std::optional<RobotDescription> robot_arm;
-  int proximity_octree_height = 8;       ///< `proximity.octree.height` (1-10), for the octree backend
+  int proximity_octree_height = 4;       ///< `proximity.octree.height` (1-10), for the octree backend
   std::string canonical_yaml;      ///< the effective configuration, for the hash in the header
 };
 

@@ -28,6 +28,17 @@ struct DisparityImage {
   }
 };
 
+// ---- instruction set ----------------------------------------------------------------------
+
+/// Which instruction set the fast filter loops may use. Every choice gives the same bits.
+enum class FilterIsa { best, portable };
+/// `best` (the default) lets the filters take AVX2 loops where the CPU has them; `portable`
+/// forces the baseline SSE2 (or plain C++) loops for the whole process. A test hook: tests run
+/// both against the plain references. Not meant to be switched while filters run.
+void set_filter_isa(FilterIsa isa);
+/// "avx2", "sse2" or "scalar": the loops the filters take now.
+const char* filter_isa_name();
+
 // ---- threshold (spec §3) ------------------------------------------------------------------
 
 /// Keeps depths in [min_m, max_m], compared in float32 as the SDK does (so max 1.5 m drops
@@ -73,9 +84,19 @@ struct SpatialParams {
 };
 /// The hole-filling radius of `holes_fill` (0, 2, 4, 8, 16, 255).
 int spatial_holes_radius(int holes_fill);
+/// The spatial filter's working memory (a transposed strip of rows, one line of state), owned
+/// by the caller and reused so that filtering does not allocate after the first frame of a
+/// size. Carries no result from one call to the next; one scratch per thread.
+struct SpatialScratch {
+  std::vector<uint16_t> depth_strip, depth_fill;
+  std::vector<float> disparity_strip, disparity_line;
+};
 /// Filters depth in place (the SDK's Z16 path: rounding, hole filling inside the passes).
-void spatial_filter(const SpatialParams& params, DepthImage& depth);
+void spatial_filter(const SpatialParams& params, DepthImage& depth, SpatialScratch& scratch);
 /// Filters disparity in place (the SDK's float path: hole filling once after the passes).
+void spatial_filter(const SpatialParams& params, DisparityImage& disparity, SpatialScratch& scratch);
+/// The same with a scratch of its own: allocates on every call (tests, one-off use).
+void spatial_filter(const SpatialParams& params, DepthImage& depth);
 void spatial_filter(const SpatialParams& params, DisparityImage& disparity);
 
 // ---- temporal (spec §6) -------------------------------------------------------------------
@@ -199,6 +220,7 @@ class FilterChain {
   float factor_ = 0.0F;
   DisparityImage disparity_;
   DepthImage decimated_;
+  SpatialScratch spatial_scratch_;
   TemporalFilter temporal_;
 };
 

@@ -38,7 +38,7 @@ const char* proximity_backend_name(ProximityBackend backend);
 
 /// Tuning of the search; which backend is chosen separately (ProximitySearch's constructor).
 struct ProximityParams {
-  int octree_height = 8;  ///< octree depth, 1-10 (`proximity.octree.height`); leaves hold >= 1 point
+  int octree_height = 4;  ///< octree depth, 1-10 (`proximity.octree.height`); leaves hold >= 1 point
   int threads = 1;        ///< brute only: 1, or 2 for a second worker thread on large clouds
 };
 

@@ -133,9 +133,9 @@ void FilterChain::run_block(size_t i, Frame& frame) {
       break;
     case FilterBlock::spatial:
       if (in_disparity_) {
-        spatial_filter(params.spatial, disparity_);
+        spatial_filter(params.spatial, disparity_, spatial_scratch_);
       } else {
-        spatial_filter(params.spatial, frame.depth);
+        spatial_filter(params.spatial, frame.depth, spatial_scratch_);
       }
       break;
     case FilterBlock::temporal:

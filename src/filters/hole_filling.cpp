@@ -2,6 +2,7 @@
 // hrcsense filters — the SDK's hole-filling filter (spec §7): in place, raster order, looking
 // only up-left, up, left, down-left and down (never right).
 #include "hrcsense/filters.hpp"
+#include "isa.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -142,6 +143,160 @@ void fill_from_around(uint16_t* pixels, int w, int h, bool farthest) {
 }
 #endif
 
+#if HRCSENSE_FILTERS_X86
+// AVX2, all three modes in two passes per row, because most pixels are valid and holes come in
+// runs (dropouts, the left band): a branch per block on "any hole?" mispredicts at every run
+// and cost more than the filling. Pass 1, branch-free, 16 pixels at a time: every hole takes
+// the value its rule gives with the *unfilled* left neighbour (kept in a register, so no load
+// waits for the previous block's store) and the finished row above; a hole that is first in
+// its run is then final. Pass 2, per 64 pixels: the holes right of a hole ("chained", one bit
+// each) combine, in order, with their finished left neighbour.
+constexpr int kFromLeft = 0, kFarthest = 1, kNearest = 2;
+
+// x moved right by one pixel (lane k takes lane k − 1), lane 0 taking the last pixel of `before`.
+__attribute__((target("avx2"))) inline __m256i shift_in_left(__m256i x, __m256i before) {
+  return _mm256_alignr_epi8(x, _mm256_permute2x128_si256(before, x, 0x21), 14);
+}
+
+__attribute__((target("avx2"))) inline __m256i load16(const uint16_t* p) {
+  return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p));
+}
+
+// Pass 1 on the 16 pixels at u; returns the hole mask (16-bit lanes).
+template <int kMode>
+__attribute__((target("avx2"))) inline __m256i fill_block_avx2(uint16_t* row, const uint16_t* up, const uint16_t* down,
+                                                               int u, __m256i& previous) {
+  const __m256i zero = _mm256_setzero_si256();
+  const __m256i current = load16(row + u);
+  const __m256i hole = _mm256_cmpeq_epi16(current, zero);
+  const __m256i left = shift_in_left(current, previous);
+  previous = current;
+  __m256i candidate = left;
+  if (kMode == kFarthest) {
+    candidate = _mm256_max_epu16(_mm256_max_epu16(_mm256_max_epu16(load16(up + u), load16(up + u - 1)),
+                                                  _mm256_max_epu16(left, load16(down + u - 1))),
+                                 load16(down + u));
+  } else if (kMode == kNearest) {
+    // Holes become 65535 by the wrapping v − 1, so the minimum ignores them; a hole above
+    // keeps the pixel a hole (the SDK starts from the pixel above).
+    const __m256i one = _mm256_set1_epi16(1);
+    const __m256i above = load16(up + u);
+    const __m256i m = _mm256_min_epu16(
+        _mm256_min_epu16(_mm256_min_epu16(_mm256_sub_epi16(above, one), _mm256_sub_epi16(load16(up + u - 1), one)),
+                         _mm256_min_epu16(_mm256_sub_epi16(left, one), _mm256_sub_epi16(load16(down + u - 1), one))),
+        _mm256_sub_epi16(load16(down + u), one));
+    candidate = _mm256_andnot_si256(_mm256_cmpeq_epi16(above, zero), _mm256_add_epi16(m, one));
+  }
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(row + u), _mm256_blendv_epi8(current, candidate, hole));
+  return hole;
+}
+
+// Pass 2 for one chained hole at u: combine with the finished left neighbour.
+template <int kMode>
+inline uint16_t chained_value(uint16_t pixel, uint16_t left) {
+  if (kMode == kFromLeft) return left;
+  if (kMode == kFarthest) return std::max(pixel, left);
+  // Nearest keeps the pixel when either is a hole; min(0, left) is 0 already, so only the left
+  // one needs a test (a select, not a branch on data).
+  const uint16_t smaller = std::min(pixel, left);
+  return left != 0 ? smaller : pixel;
+}
+
+// One bit per pixel of two blocks' hole masks: the byte pack interleaves by 128-bit lane,
+// the permute undoes it.
+__attribute__((target("avx2"))) inline uint32_t hole_bits(__m256i a, __m256i b) {
+  return static_cast<uint32_t>(_mm256_movemask_epi8(_mm256_permute4x64_epi64(_mm256_packs_epi16(a, b), 0xD8)));
+}
+
+// Pass 1 runs over a whole segment of the row before pass 2, so that pass 2's single-pixel
+// loads do not meet still-pending 32-byte stores of the same pixels; the chained bits wait here.
+constexpr int kSegmentWords = 32;  // 2048 pixels
+
+template <int kMode>
+__attribute__((target("avx2"))) void fill_row_avx2(uint16_t* row, const uint16_t* up, const uint16_t* down, int w) {
+  // Column 0 is never filled; it is the left neighbour of the first block.
+  __m256i previous = _mm256_set1_epi16(static_cast<int16_t>(row[0]));
+  uint64_t hole_before = row[0] == 0 ? 1 : 0;  // the hole bit of the pixel left of the word
+  const __m256i zero = _mm256_setzero_si256();
+  uint64_t chains[kSegmentWords];
+  int u = 1;
+  while (u + 16 <= w) {
+    const int segment_start = u;
+    int words = 0;
+    for (; u + 16 <= w && words < kSegmentWords; ++words) {
+      // 64 pixels (or what is left of 16-pixel blocks) per word.
+      uint64_t holes = 0;
+      for (int block = 0; block < 4 && u + 16 <= w; block += 2) {
+        const __m256i a = fill_block_avx2<kMode>(row, up, down, u, previous);
+        u += 16;
+        __m256i b = zero;
+        if (u + 16 <= w) {
+          b = fill_block_avx2<kMode>(row, up, down, u, previous);
+          u += 16;
+        }
+        holes |= static_cast<uint64_t>(hole_bits(a, b)) << (16 * block);
+      }
+      // Chained: a hole whose left neighbour is a hole. Bits past the row's last block are 0.
+      chains[words] = holes & ((holes << 1) | hole_before);
+      hole_before = holes >> 63;
+    }
+    // Inside a run the left neighbour is the value just written: taken from a register rather
+    // than reloaded, so a run is not a chain of store-to-load round trips.
+    int last = -1;
+    uint16_t last_value = 0;
+    for (int k = 0; k < words; ++k) {
+      for (uint64_t bits = chains[k]; bits != 0; bits &= bits - 1) {
+        const int at = segment_start + 64 * k + __builtin_ctzll(bits);
+        const uint16_t left = at == last + 1 ? last_value : row[at - 1];
+        last_value = chained_value<kMode>(row[at], left);
+        row[at] = last_value;
+        last = at;
+      }
+    }
+  }
+  for (; u < w; ++u) {
+    if (row[u] != 0) continue;
+    if (kMode == kFromLeft) {
+      row[u] = row[u - 1];
+      continue;
+    }
+    const uint16_t neighbours[4] = {up[u - 1], row[u - 1], down[u - 1], down[u]};
+    uint16_t best = up[u];
+    for (const uint16_t value : neighbours) {
+      if (kMode == kFarthest ? value > best : (value != 0 && value < best)) best = value;
+    }
+    row[u] = best;
+  }
+}
+
+template <int kMode>
+__attribute__((target("avx2"))) void fill_avx2(uint16_t* pixels, int w, int h) {
+  // Modes 1 and 2 skip the first and last rows.
+  const int first = kMode == kFromLeft ? 0 : 1;
+  const int end = kMode == kFromLeft ? h : h - 1;
+  if (w < 1) return;
+  for (int v = first; v < end; ++v) {
+    uint16_t* row = pixels + static_cast<size_t>(v) * w;
+    // Mode 0 never reads the rows above and below; pass the row itself so no pointer leaves the image.
+    const uint16_t* up = kMode == kFromLeft ? row : row - w;
+    const uint16_t* down = kMode == kFromLeft ? row : row + w;
+    fill_row_avx2<kMode>(row, up, down, w);
+  }
+}
+
+bool fill_holes_avx2(int mode, uint16_t* pixels, int w, int h) {
+  if (!filters_detail::use_avx2()) return false;
+  if (mode == 0) {
+    fill_avx2<kFromLeft>(pixels, w, h);
+  } else if (mode == 1) {
+    fill_avx2<kFarthest>(pixels, w, h);
+  } else {
+    fill_avx2<kNearest>(pixels, w, h);
+  }
+  return true;
+}
+#endif
+
 template <typename T>
 void fill(const HoleFillingParams& params, T* pixels, int w, int h) {
   if (params.mode == 0) {
@@ -154,6 +309,9 @@ void fill(const HoleFillingParams& params, T* pixels, int w, int h) {
 }  // namespace
 
 void fill_holes(const HoleFillingParams& params, DepthImage& depth) {
+#if HRCSENSE_FILTERS_X86
+  if (fill_holes_avx2(params.mode, depth.pixels.data(), depth.width, depth.height)) return;
+#endif
   fill(params, depth.pixels.data(), depth.width, depth.height);
 }
 

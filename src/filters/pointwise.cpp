@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense filters — per-pixel blocks: threshold and the depth↔disparity transforms (spec §2, §3).
 #include "hrcsense/filters.hpp"
+#include "isa.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,6 +13,51 @@
 
 namespace hrcsense {
 namespace {
+
+#if HRCSENSE_FILTERS_X86
+// Both transforms are bound by the divider; 8-wide divisions go through it about twice as fast
+// as 4-wide ones on current x86 cores, and give the same IEEE quotients. Each returns how many
+// pixels it did; the portable loops do the rest.
+__attribute__((target("avx2"))) size_t depth_to_disparity_avx2(const uint16_t* src, float* dst, size_t n,
+                                                               float factor) {
+  const __m256 f = _mm256_set1_ps(factor);
+  const __m256i one = _mm256_set1_epi32(1);
+  const __m256i zero = _mm256_setzero_si256();
+  size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    const __m256i raw = _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + i)));
+    // Holes divide by 1 (no division by zero) and are then masked to 0.
+    const __m256 quotient = _mm256_div_ps(f, _mm256_cvtepi32_ps(_mm256_max_epi32(raw, one)));
+    _mm256_storeu_ps(dst + i, _mm256_andnot_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(raw, zero)), quotient));
+  }
+  return i;
+}
+
+// The low 16 bits of trunc(F / d + 0.5) for normal d, else 0, as 32-bit lanes sign-extended
+// from bit 15 (so that the signed saturating pack passes them on unchanged).
+__attribute__((target("avx2"))) inline __m256i to_depth8_avx2(const float* p, __m256 f) {
+  const __m256i exponent = _mm256_set1_epi32(0x7f800000);
+  const __m256i zero = _mm256_setzero_si256();
+  const __m256 d = _mm256_loadu_ps(p);
+  const __m256i e = _mm256_and_si256(_mm256_castps_si256(d), exponent);
+  const __m256i not_normal = _mm256_or_si256(_mm256_cmpeq_epi32(e, zero), _mm256_cmpeq_epi32(e, exponent));
+  const __m256 safe = _mm256_blendv_ps(d, _mm256_set1_ps(1.0F), _mm256_castsi256_ps(not_normal));
+  const __m256i raw = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_div_ps(f, safe), _mm256_set1_ps(0.5F)));
+  return _mm256_andnot_si256(not_normal, _mm256_srai_epi32(_mm256_slli_epi32(raw, 16), 16));
+}
+
+__attribute__((target("avx2"))) size_t disparity_to_depth_avx2(const float* src, uint16_t* dst, size_t n,
+                                                               float factor) {
+  const __m256 f = _mm256_set1_ps(factor);
+  size_t i = 0;
+  for (; i + 16 <= n; i += 16) {
+    // The pack interleaves the two halves by 128-bit lane; the permute restores pixel order.
+    const __m256i packed = _mm256_packs_epi32(to_depth8_avx2(src + i, f), to_depth8_avx2(src + i + 8, f));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst + i), _mm256_permute4x64_epi64(packed, 0xD8));
+  }
+  return i;
+}
+#endif
 
 // float → uint16 as the SDK's build does it on x86 (through a 32-bit integer, keeping the low
 // 16 bits), but without undefined behaviour: out-of-range values give what cvttss2si gives.
@@ -75,6 +121,9 @@ void depth_to_disparity(const DepthImage& in, float factor, DisparityImage& out)
   const uint16_t* src = in.pixels.data();
   float* dst = out.pixels.data();
   size_t i = 0;
+#if HRCSENSE_FILTERS_X86
+  if (filters_detail::use_avx2()) i = depth_to_disparity_avx2(src, dst, n, factor);
+#endif
 #if defined(__SSE2__)
   // Holes divide by 1 instead of 0 (no branch, no division by zero) and are then masked to 0.
   const __m128 f = _mm_set1_ps(factor);
@@ -104,6 +153,9 @@ void disparity_to_depth(const DisparityImage& in, float factor, DepthImage& out)
   const float* src = in.pixels.data();
   uint16_t* dst = out.pixels.data();
   size_t i = 0;
+#if HRCSENSE_FILTERS_X86
+  if (filters_detail::use_avx2()) i = disparity_to_depth_avx2(src, dst, n, factor);
+#endif
 #if defined(__SSE2__)
   // cvttps2dq is the SDK's conversion: out of range and NaN give INT32_MIN, whose low 16 bits
   // are 0. Only normal floats (exponent neither 0 nor 255) are converted.

@@ -2,13 +2,14 @@
 // hrcsense filters — the SDK's edge-preserving spatial filter (spec §5). The depth (uint16)
 // and disparity (float) domains are two different algorithms in the SDK; both are copied.
 //
-// Speed without changing a bit of the result (tests/filters/spatial_fast_test.cpp checks it
-// against the plain reference): each scan is a recursion along a line, so many lines are
+// Speed without changing a bit of the result (tests/filters/fast_test.cpp checks it against
+// the plain reference, on the SSE2 and the AVX2 path): each scan is a recursion along a line, so many lines are
 // filtered side by side. The vertical passes run across a whole image row at once (the lines
 // are the columns, adjacent in memory). The horizontal passes copy a strip of kStrip rows into
 // a small transposed buffer (column-major, hot in L1), run the same kind of scan there with
 // the rows side by side, and copy it back. No branches in the inner loops (selects), no double.
 #include "hrcsense/filters.hpp"
+#include "isa.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -23,24 +24,32 @@ namespace {
 
 constexpr int kStrip = 16;  // rows filtered side by side in a horizontal pass
 
-// Scratch reused across calls on this thread, so that filtering does not allocate after the
-// first frame of a size. Holds no result: every call overwrites what it reads.
+// The caller's SpatialScratch, sized for `width`, as raw pointers for the loops. Holds no
+// result: every call overwrites what it reads.
 template <typename T>
 struct Scratch {
-  std::vector<T> strip;          // kStrip rows, transposed: strip[column * kStrip + row]
-  std::vector<T> previous_raw;   // disparity: the previous line's unfiltered values
-  std::vector<uint16_t> fill;    // depth: hole-fill counter of every line (saturating)
+  T* strip;            // kStrip rows, transposed: strip[column * kStrip + row]
+  T* previous_raw;     // disparity: the previous line's unfiltered values
+  uint16_t* fill;      // depth: hole-fill counter of every line (saturating)
 };
 
 template <typename T>
-Scratch<T>& scratch(int width) {
-  thread_local Scratch<T> s;
+void grow(std::vector<T>& buffer, size_t size) {
+  if (buffer.size() < size) buffer.resize(size);
+}
+
+Scratch<uint16_t> depth_scratch(SpatialScratch& s, int width) {
   const size_t w = static_cast<size_t>(width);
-  if (s.strip.size() < w * kStrip) s.strip.resize(w * kStrip);
-  const size_t lanes = std::max(w, size_t{kStrip});  // a row, or a strip's rows
-  if (s.previous_raw.size() < lanes) s.previous_raw.resize(lanes);
-  if (s.fill.size() < lanes) s.fill.resize(lanes);
-  return s;
+  grow(s.depth_strip, w * kStrip);
+  grow(s.depth_fill, std::max(w, size_t{kStrip}));  // a row, or a strip's rows
+  return {s.depth_strip.data(), nullptr, s.depth_fill.data()};
+}
+
+Scratch<float> disparity_scratch(SpatialScratch& s, int width) {
+  const size_t w = static_cast<size_t>(width);
+  grow(s.disparity_strip, w * kStrip);
+  grow(s.disparity_line, std::max(w, size_t{kStrip}));
+  return {s.disparity_strip.data(), s.disparity_line.data(), nullptr};
 }
 
 // ---- transposing a strip of kStrip rows ----
@@ -212,33 +221,89 @@ void scan_disparity(float* first, ptrdiff_t step, int count, int lanes, float* p
   }
 }
 
-void horizontal_disparity(DisparityImage& image, const DisparityBlend& b, Scratch<float>& s) {
+#if HRCSENSE_FILTERS_X86
+// disparity_step() eight lanes at a time, the same operations in the same order; any lanes
+// left over (fewer than 8) take the SSE2/scalar step.
+template <int kLanes>
+__attribute__((target("avx2"))) inline void disparity_step_avx2(float* __restrict__ line,
+                                                                const float* __restrict__ previous_out,
+                                                                float* __restrict__ previous_raw, int lanes,
+                                                                const DisparityBlend& b) {
+  const int n = kLanes > 0 ? kLanes : lanes;
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 alpha = _mm256_set1_ps(b.alpha);
+  const __m256 one_minus_alpha = _mm256_set1_ps(b.one_minus_alpha);
+  const __m256 delta = _mm256_set1_ps(b.delta);
+  const __m256 sign = _mm256_set1_ps(-0.0F);
+  int u = 0;
+  for (; u + 8 <= n; u += 8) {
+    const __m256 current = _mm256_loadu_ps(line + u);
+    const __m256 previous = _mm256_loadu_ps(previous_raw + u);
+    _mm256_storeu_ps(previous_raw + u, current);
+    // Ordered greater-than and less-than: cmpgtps and cmpltps of the SSE2 step.
+    const __m256 valid = _mm256_cmp_ps(_mm256_min_ps(previous, current), zero, _CMP_GT_OS);
+    const __m256 close = _mm256_cmp_ps(_mm256_andnot_ps(sign, _mm256_sub_ps(previous, current)), delta, _CMP_LT_OS);
+    const __m256 smooth = _mm256_and_ps(valid, close);
+    const __m256 blended =
+        _mm256_add_ps(_mm256_mul_ps(current, alpha), _mm256_mul_ps(_mm256_loadu_ps(previous_out + u), one_minus_alpha));
+    _mm256_storeu_ps(line + u, _mm256_blendv_ps(current, blended, smooth));
+  }
+  if (u < n) disparity_step<0>(line + u, previous_out + u, previous_raw + u, n - u, b);
+}
+
+template <int kLanes>
+__attribute__((target("avx2"))) void scan_disparity_avx2(float* first, ptrdiff_t step, int count, int lanes,
+                                                         float* previous_raw, const DisparityBlend& b) {
+  const int n = kLanes > 0 ? kLanes : lanes;
+  std::memcpy(previous_raw, first, sizeof(float) * static_cast<size_t>(n));
+  for (int k = 1; k < count; ++k) {
+    float* line = first + step * k;
+    disparity_step_avx2<kLanes>(line, line - step, previous_raw, lanes, b);
+  }
+}
+#endif
+
+// The scan of `lanes` side-by-side lines, with the widest vectors the CPU allows.
+template <int kLanes>
+void scan_disparity_lines(float* first, ptrdiff_t step, int count, int lanes, float* previous_raw,
+                          const DisparityBlend& b) {
+#if HRCSENSE_FILTERS_X86
+  if (kLanes != 1 && filters_detail::use_avx2()) {
+    scan_disparity_avx2<kLanes>(first, step, count, lanes, previous_raw, b);
+    return;
+  }
+#endif
+  scan_disparity<kLanes>(first, step, count, lanes, previous_raw, b);
+}
+
+void horizontal_disparity(DisparityImage& image, const DisparityBlend& b, const Scratch<float>& s) {
   const int w = image.width;
   const int h = image.height;
   float* pixels = image.pixels.data();
   int v = 0;
   for (; v + kStrip <= h; v += kStrip) {
     float* rows = pixels + static_cast<ptrdiff_t>(v) * w;
-    float* strip = s.strip.data();
+    float* strip = s.strip;
     load_strip(rows, w, strip);
-    scan_disparity<kStrip>(strip, kStrip, w, kStrip, s.previous_raw.data(), b);
-    scan_disparity<kStrip>(strip + static_cast<ptrdiff_t>(w - 1) * kStrip, -kStrip, w, kStrip, s.previous_raw.data(), b);
+    scan_disparity_lines<kStrip>(strip, kStrip, w, kStrip, s.previous_raw, b);
+    scan_disparity_lines<kStrip>(strip + static_cast<ptrdiff_t>(w - 1) * kStrip, -kStrip, w, kStrip,
+                                 s.previous_raw, b);
     store_strip(strip, w, rows);
   }
   for (; v < h; ++v) {  // the last rows, one at a time
     float* row = pixels + static_cast<ptrdiff_t>(v) * w;
-    scan_disparity<1>(row, 1, w, 1, s.previous_raw.data(), b);
-    scan_disparity<1>(row + w - 1, -1, w, 1, s.previous_raw.data(), b);
+    scan_disparity<1>(row, 1, w, 1, s.previous_raw, b);
+    scan_disparity<1>(row + w - 1, -1, w, 1, s.previous_raw, b);
   }
 }
 
-void vertical_disparity(DisparityImage& image, const DisparityBlend& b, Scratch<float>& s) {
+void vertical_disparity(DisparityImage& image, const DisparityBlend& b, const Scratch<float>& s) {
   const int w = image.width;
   const int h = image.height;
   float* pixels = image.pixels.data();
-  scan_disparity<0>(pixels, w, h, w, s.previous_raw.data(), b);
-  scan_disparity<0>(pixels + static_cast<ptrdiff_t>(h - 1) * w, -static_cast<ptrdiff_t>(w), h, w,
-                    s.previous_raw.data(), b);
+  scan_disparity_lines<0>(pixels, w, h, w, s.previous_raw, b);
+  scan_disparity_lines<0>(pixels + static_cast<ptrdiff_t>(h - 1) * w, -static_cast<ptrdiff_t>(w), h, w,
+                          s.previous_raw, b);
 }
 
 bool empty_disparity(float value) {
@@ -383,23 +448,23 @@ void scan_depth(uint16_t* first, ptrdiff_t step, int count, int lanes, uint16_t*
   }
 }
 
-void horizontal_depth(DepthImage& image, const DepthBlend& b, Scratch<uint16_t>& s) {
+void horizontal_depth(DepthImage& image, const DepthBlend& b, const Scratch<uint16_t>& s) {
   const int w = image.width;
   const int h = image.height;
   uint16_t* pixels = image.pixels.data();
   int v = 0;
   for (; v + kStrip <= h; v += kStrip) {
     uint16_t* rows = pixels + static_cast<ptrdiff_t>(v) * w;
-    uint16_t* strip = s.strip.data();
+    uint16_t* strip = s.strip;
     load_strip(rows, w, strip);
-    scan_depth<kStrip, true>(strip, kStrip, w, kStrip, s.fill.data(), b);
-    scan_depth<kStrip, false>(strip + static_cast<ptrdiff_t>(w - 1) * kStrip, -kStrip, w, kStrip, s.fill.data(), b);
+    scan_depth<kStrip, true>(strip, kStrip, w, kStrip, s.fill, b);
+    scan_depth<kStrip, false>(strip + static_cast<ptrdiff_t>(w - 1) * kStrip, -kStrip, w, kStrip, s.fill, b);
     store_strip(strip, w, rows);
   }
   for (; v < h; ++v) {
     uint16_t* row = pixels + static_cast<ptrdiff_t>(v) * w;
-    scan_depth<1, true>(row, 1, w, 1, s.fill.data(), b);
-    scan_depth<1, false>(row + w - 1, -1, w, 1, s.fill.data(), b);
+    scan_depth<1, true>(row, 1, w, 1, s.fill, b);
+    scan_depth<1, false>(row + w - 1, -1, w, 1, s.fill, b);
   }
 }
 
@@ -457,26 +522,36 @@ int spatial_holes_radius(int holes_fill) {
   return 1 << holes_fill;
 }
 
-void spatial_filter(const SpatialParams& params, DepthImage& depth) {
+void spatial_filter(const SpatialParams& params, DepthImage& depth, SpatialScratch& scratch) {
   if (depth.width < 1 || depth.height < 1) return;  // one column: the vertical passes still run
   const DepthBlend b{params.alpha, 1.0F - params.alpha, params.delta, spatial_holes_radius(params.holes_fill)};
-  Scratch<uint16_t>& s = scratch<uint16_t>(depth.width);
+  const Scratch<uint16_t> s = depth_scratch(scratch, depth.width);
   for (int i = 0; i < params.magnitude; ++i) {
     horizontal_depth(depth, b, s);
     vertical_depth(depth, b);
   }
 }
 
-void spatial_filter(const SpatialParams& params, DisparityImage& disparity) {
+void spatial_filter(const SpatialParams& params, DisparityImage& disparity, SpatialScratch& scratch) {
   if (disparity.width < 1 || disparity.height < 1) return;
   const DisparityBlend b{params.alpha, 1.0F - params.alpha, static_cast<float>(params.delta)};
-  Scratch<float>& s = scratch<float>(disparity.width);
+  const Scratch<float> s = disparity_scratch(scratch, disparity.width);
   for (int i = 0; i < params.magnitude; ++i) {
     horizontal_disparity(disparity, b, s);
     vertical_disparity(disparity, b, s);
   }
   const int radius = spatial_holes_radius(params.holes_fill);
   if (radius > 0) holes_fill_disparity(disparity, radius);
+}
+
+void spatial_filter(const SpatialParams& params, DepthImage& depth) {
+  SpatialScratch scratch;
+  spatial_filter(params, depth, scratch);
+}
+
+void spatial_filter(const SpatialParams& params, DisparityImage& disparity) {
+  SpatialScratch scratch;
+  spatial_filter(params, disparity, scratch);
 }
 
 }  // namespace hrcsense

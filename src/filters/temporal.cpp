@@ -2,6 +2,7 @@
 // hrcsense filters — the SDK's temporal filter (spec §6): smoothing across frames and hole
 // filling from a rotating 8-frame validity history, with the SDK's persistence rules.
 #include "hrcsense/filters.hpp"
+#include "isa.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -147,6 +148,98 @@ size_t temporal_sse2(T* pixels, T* last, uint8_t* history, size_t n, int phase, 
 }
 #endif
 
+#if HRCSENSE_FILTERS_X86
+// The same lane operations as temporal_sse2(), eight pixels at a time.
+__attribute__((target("avx2"))) inline __m256i persistence_allows_avx2(__m256i history, const PersistenceRule& rule) {
+  const __m256i zero = _mm256_setzero_si256();
+  const __m256i all = _mm256_set1_epi32(-1);
+  const __m256i w = _mm256_set1_epi32(rule.window);
+  const __m256i m = _mm256_and_si256(history, w);
+  switch (rule.min_valid) {
+    case 0: return zero;
+    case 1: return _mm256_xor_si256(_mm256_cmpeq_epi32(m, zero), all);
+    case 2:
+      return _mm256_xor_si256(_mm256_cmpeq_epi32(_mm256_and_si256(m, _mm256_sub_epi32(m, _mm256_set1_epi32(1))), zero),
+                              all);
+    case 8: return _mm256_cmpeq_epi32(m, w);
+    default: return all;
+  }
+}
+
+// and/andnot/or rather than _mm256_blendv_epi8: with blends, this loop gave wrong results
+// (holes left unfilled) in a -march=native build on an AVX-512 CPU only; whether our code or
+// GCC 12 was at fault is not pinned down. The bitwise form, as in the SSE2 loop, is right in
+// every build; tests/filters/fast_test.cpp in a native build catches a regression.
+__attribute__((target("avx2"))) inline __m256i select8(__m256i mask, __m256i a, __m256i b) {
+  return _mm256_or_si256(_mm256_and_si256(mask, a), _mm256_andnot_si256(mask, b));
+}
+
+__attribute__((target("avx2"))) inline __m256i load8(const float* p) {
+  return _mm256_castps_si256(_mm256_loadu_ps(p));
+}
+__attribute__((target("avx2"))) inline __m256i load8(const uint16_t* p) {
+  return _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
+}
+__attribute__((target("avx2"))) inline void store8(float* p, __m256i v) {
+  _mm256_storeu_ps(p, _mm256_castsi256_ps(v));
+}
+__attribute__((target("avx2"))) inline void store8(uint16_t* p, __m256i v) {
+  // Sign-extend the low 16 bits so that the signed saturating pack passes them on unchanged.
+  const __m256i low16 = _mm256_srai_epi32(_mm256_slli_epi32(v, 16), 16);
+  const __m128i packed = _mm_packs_epi32(_mm256_castsi256_si128(low16), _mm256_extracti128_si256(low16, 1));
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(p), packed);
+}
+
+template <typename T>
+__attribute__((target("avx2"))) size_t temporal_avx2(T* pixels, T* last, uint8_t* history, size_t n, int phase,
+                                                     const TemporalParams& params) {
+  constexpr bool kFloat = std::is_same_v<T, float>;
+  const __m256i zero = _mm256_setzero_si256();
+  const __m256i all = _mm256_set1_epi32(-1);
+  const __m256i mask = _mm256_set1_epi32(1 << phase);
+  const __m256 alpha = _mm256_set1_ps(params.alpha);
+  const __m256 one_minus_alpha = _mm256_set1_ps(1.0F - params.alpha);
+  const __m256 delta_f = _mm256_set1_ps(static_cast<float>(params.delta));
+  const __m256i delta_i = _mm256_set1_epi32(params.delta);
+  const PersistenceRule rule = persistence_rule(params.persistence, phase);
+  size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    const __m256i current = load8(pixels + i);
+    const __m256i previous = load8(last + i);
+    const __m256i old_history = _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(history + i)));
+    __m256i current_valid, previous_valid, close, blended;
+    if constexpr (kFloat) {
+      const __m256 c = _mm256_castsi256_ps(current);
+      const __m256 p = _mm256_castsi256_ps(previous);
+      // Unordered not-equal and ordered less-than: cmpneqps and cmpltps of the SSE2 loop.
+      current_valid = _mm256_castps_si256(_mm256_cmp_ps(c, _mm256_setzero_ps(), _CMP_NEQ_UQ));
+      previous_valid = _mm256_castps_si256(_mm256_cmp_ps(p, _mm256_setzero_ps(), _CMP_NEQ_UQ));
+      const __m256 difference = _mm256_andnot_ps(_mm256_set1_ps(-0.0F), _mm256_sub_ps(c, p));
+      close = _mm256_castps_si256(_mm256_cmp_ps(difference, delta_f, _CMP_LT_OS));
+      blended = _mm256_castps_si256(_mm256_add_ps(_mm256_mul_ps(alpha, c), _mm256_mul_ps(one_minus_alpha, p)));
+    } else {
+      current_valid = _mm256_xor_si256(_mm256_cmpeq_epi32(current, zero), all);
+      previous_valid = _mm256_xor_si256(_mm256_cmpeq_epi32(previous, zero), all);
+      close = _mm256_cmpgt_epi32(delta_i, _mm256_abs_epi32(_mm256_sub_epi32(current, previous)));
+      const __m256 f = _mm256_add_ps(_mm256_mul_ps(alpha, _mm256_cvtepi32_ps(current)),
+                                     _mm256_mul_ps(one_minus_alpha, _mm256_cvtepi32_ps(previous)));
+      blended = _mm256_cvttps_epi32(f);  // truncated, as the SDK
+    }
+    const __m256i agree = _mm256_and_si256(_mm256_and_si256(current_valid, previous_valid), close);
+    const __m256i updated = select8(agree, blended, current);
+    const __m256i fill = _mm256_and_si256(previous_valid, persistence_allows_avx2(old_history, rule));
+    store8(pixels + i, select8(current_valid, updated, select8(fill, previous, current)));
+    store8(last + i, select8(current_valid, updated, previous));
+    const __m256i new_history = select8(current_valid, select8(agree, _mm256_or_si256(old_history, mask), mask),
+                                        _mm256_andnot_si256(mask, old_history));
+    // Bytes 0–7 of the history: pack 32 → 16 → 8 bits (values < 256, so nothing saturates).
+    const __m128i words = _mm_packs_epi32(_mm256_castsi256_si128(new_history), _mm256_extracti128_si256(new_history, 1));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(history + i), _mm_packus_epi16(words, words));
+  }
+  return i;
+}
+#endif
+
 }  // namespace
 
 void TemporalFilter::reset() { has_state_ = false; }
@@ -179,8 +272,11 @@ void TemporalFilter::apply_to(T* pixels, int width, int height, bool disparity) 
   T* last = last_vector.data();
   uint8_t* history = history_.data();
   size_t i = 0;
+#if HRCSENSE_FILTERS_X86
+  if (filters_detail::use_avx2()) i = temporal_avx2(pixels, last, history, n, phase_, params);
+#endif
 #if defined(__SSE2__)
-  i = temporal_sse2(pixels, last, history, n, phase_, params);
+  i += temporal_sse2(pixels + i, last + i, history + i, n - i, phase_, params);
 #endif
   for (; i < n; ++i) {
     const T current = pixels[i];

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — the simulator's ray caster: planes in one branch-free pass over the image, every
-// other shape only over the pixels its projected bounding box can cover.
+// hrcsense — the simulator's ray caster: planes by their envelope along each row (or in one
+// branch-free pass over the image for distorted cameras), every other shape only over the
+// pixels its projected bounding box can cover.
 
 #include "sim_raycast.hpp"
 
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace hrcsense::sim_detail {
 namespace {
@@ -81,16 +83,62 @@ void cast(const PixelRect& r, const SimRays& rays, const Eigen::Matrix3f& R, uin
   }
 }
 
+/// A box for a pinhole camera: hit_box over the pixel rectangle, written branch-free along each
+/// row so that it vectorises. The ray of pixel u is d = R·(x_u, y, 1), summed in the same order
+/// as in cast(), so that the depths are the same to the bit.
+void cast_box_pinhole(const PixelRect& r, const SimRays& rays, const Eigen::Matrix3f& R, const Eigen::Vector3f& o,
+                      const Shape& box, uint16_t id, float* z_m, uint16_t* ids) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  const int width = rays.intrinsics.width;
+  const float* rx = rays.x.data();  // the same in every row
+  // The slabs relative to the camera centre, as hit_box computes them.
+  const float lx = box.min.x() - o.x(), ly = box.min.y() - o.y(), lz = box.min.z() - o.z();
+  const float hx = box.max.x() - o.x(), hy = box.max.y() - o.y(), hz = box.max.z() - o.z();
+  const float c0x = R(0, 0), c0y = R(1, 0), c0z = R(2, 0);
+  const int box_id = id;
+  for (int v = r.v0; v < r.v1; ++v) {
+    const size_t row = static_cast<size_t>(v) * width;
+    const float y = rays.y[row];
+    const float c1x = R(0, 1) * y, c1y = R(1, 1) * y, c1z = R(2, 1) * y;
+    const float c2x = R(0, 2), c2y = R(1, 2), c2z = R(2, 2);
+    float* z_row = z_m + row;
+    uint16_t* id_row = ids + row;
+    for (int u = r.u0; u < r.u1; ++u) {
+      const float x = rx[u];
+      const float ix = 1.0F / (c0x * x + c1x + c2x);
+      const float iy = 1.0F / (c0y * x + c1y + c2y);
+      const float iz = 1.0F / (c0z * x + c1z + c2z);
+      const float ax = lx * ix, bx = hx * ix;
+      const float ay = ly * iy, by = hy * iy;
+      const float az = lz * iz, bz = hz * iz;
+      // hit_box's swap, min and max, as selects in the same order (NaN behaves the same).
+      const float near_x = ax > bx ? bx : ax, far_x = ax > bx ? ax : bx;
+      const float near_y = ay > by ? by : ay, far_y = ay > by ? ay : by;
+      const float near_z = az > bz ? bz : az, far_z = az > bz ? az : bz;
+      float t_near = near_x > -kInf ? near_x : -kInf;
+      t_near = near_y > t_near ? near_y : t_near;
+      t_near = near_z > t_near ? near_z : t_near;
+      float t_far = far_x < kInf ? far_x : kInf;
+      t_far = far_y < t_far ? far_y : t_far;
+      t_far = far_z < t_far ? far_z : t_far;
+      const float t = t_near > 0.0F ? t_near : t_far;
+      const int take = (t_near <= t_far) & (t_far > 0.0F) & (t < z_row[u]);
+      z_row[u] = take ? t : z_row[u];
+      id_row[u] = static_cast<uint16_t>((box_id & -take) | (id_row[u] & ~-take));
+    }
+  }
+}
+
 /// A plane in the camera frame as inverse depth per ray: 1/Z = n·(x/z, y/z, 1) / (n·p).
 struct PlaneW {
   float wx, wy, wz;  ///< n / (n·p)
   uint16_t id;
 };
 
-/// Planes cast together, row by row (so that the row of the buffers stays in the L1 cache),
-/// kept as inverse depth in `w_best` (0: nothing in front) while the planes are cast: the
-/// nearest plane is the one with the largest positive 1/Z, so no division is needed until the
-/// end. Branch-free so that it vectorises.
+/// Any camera: planes cast together, row by row (so that the row of the buffers stays in the
+/// L1 cache), kept as inverse depth in `w_best` (to be 0: nothing in front) while the planes
+/// are cast: the nearest plane is the one with the largest positive 1/Z, so no division is
+/// needed until the end. Branch-free so that it vectorises.
 void cast_planes_w(const PlaneW* planes, size_t count, const SimRays& rays, float* w_best, uint16_t* ids) {
   const size_t width = static_cast<size_t>(rays.intrinsics.width);
   const size_t height = static_cast<size_t>(rays.intrinsics.height);
@@ -115,28 +163,107 @@ void cast_planes_w(const PlaneW* planes, size_t count, const SimRays& rays, floa
   }
 }
 
+/// Fills pixels [u0, u1) of a row with plane `p` (nullptr: nothing), Z = 1 / (1/Z); where
+/// rounding leaves 1/Z ≤ 0 beside the plane's horizon, nothing as cast_planes_w would have it.
+void fill_plane_span(const PlaneW* p, const float* rx, float y, size_t u0, size_t u1, float* z_row,
+                     uint16_t* id_row) {
+  if (p == nullptr) {
+    std::fill(z_row + u0, z_row + u1, kNoHit);
+    std::fill(id_row + u0, id_row + u1, uint16_t{0});
+    return;
+  }
+  // Copies, so that the stores below cannot alias them and the loop vectorises.
+  const float wx = p->wx;
+  const float wy = p->wy * y;
+  const float wz = p->wz;
+  const int id = p->id;
+  for (size_t u = u0; u < u1; ++u) {
+    const float w = wx * rx[u] + wy + wz;
+    z_row[u] = 1.0F / std::max(0.0F, w);  // +inf where w ≤ 0
+    id_row[u] = static_cast<uint16_t>(id & -static_cast<int>(w > 0.0F));
+  }
+}
+
+/// A pinhole camera: along a row y is fixed and x grows with u, so each plane's 1/Z is a line
+/// in x, and the nearest plane (the largest 1/Z) is their upper envelope: a few spans per row,
+/// found from the lines' crossings, each filled with one plane and one division per pixel.
+/// "Nothing" is the line 1/Z = 0, ahead of every plane on ties as in cast_planes_w. Near a
+/// crossing the two planes' depths agree to rounding, so either is right.
+void cast_planes_pinhole(const PlaneW* planes, size_t count, const SimRays& rays, float* z_m, uint16_t* ids) {
+  const size_t width = static_cast<size_t>(rays.intrinsics.width);
+  const size_t height = static_cast<size_t>(rays.intrinsics.height);
+  const float* rx = rays.x.data();  // the same in every row
+  for (size_t v = 0; v < height; ++v) {
+    const size_t row = v * width;
+    const float y = rays.y[row];
+    // Line k (k = 0: nothing, k ≥ 1: planes[k − 1]): 1/Z = slope[k]·x + offset[k].
+    const auto slope = [&](size_t k) { return k == 0 ? 0.0 : static_cast<double>(planes[k - 1].wx); };
+    const auto offset = [&](size_t k) {
+      return k == 0 ? 0.0 : static_cast<double>(planes[k - 1].wy) * y + planes[k - 1].wz;
+    };
+    // The winner at the row's first pixel, then from crossing to crossing: only a steeper
+    // line can overtake the current one as x grows, so this ends after at most count steps.
+    size_t current = 0;
+    const double x0 = rx[0];
+    for (size_t k = 1; k <= count; ++k) {
+      if (slope(k) * x0 + offset(k) > slope(current) * x0 + offset(current)) current = k;
+    }
+    size_t u = 0;
+    while (u < width) {
+      size_t next = 0;
+      double next_x = std::numeric_limits<double>::infinity();
+      for (size_t k = 1; k <= count + 1; ++k) {
+        const size_t line = k % (count + 1);  // planes, then nothing
+        const double rise = slope(line) - slope(current);
+        if (!(rise > 0.0)) continue;
+        const double x = (offset(current) - offset(line)) / rise;
+        if (x < next_x || (x == next_x && slope(line) > slope(next))) {
+          next_x = x;
+          next = line;
+        }
+      }
+      // The current line wins up to the last pixel at or before the crossing.
+      const size_t end = next_x == std::numeric_limits<double>::infinity()
+                             ? width
+                             : static_cast<size_t>(std::upper_bound(rx + u, rx + width, next_x,
+                                                                    [](double a, float b) { return a < b; }) -
+                                                   rx);
+      fill_plane_span(current == 0 ? nullptr : &planes[current - 1], rx, y, u, end, z_m + row, ids + row);
+      u = end;
+      current = next;
+    }
+  }
+}
+
 /// Ray from the camera centre against a capsule (camera frame). Exact like hit_capsule, with
 /// two shortcuts: the capsule lies inside the infinite cylinder around its axis, so a ray that
 /// misses the cylinder misses it; and when the ray enters the cylinder in front of the camera
 /// beside the segment, that entry is on the capsule and nothing of it can be nearer.
-inline float hit_capsule_fast(const Shape& c, const Eigen::Vector3f& ba, float baba, const Eigen::Vector3f& d) {
-  if (baba > 0.0F) {
-    const Eigen::Vector3f oa = -c.a;
-    const float bad = ba.dot(d);
-    const float baoa = ba.dot(oa);
-    const float a = baba * d.dot(d) - bad * bad;
-    const float half_b = baba * d.dot(oa) - baoa * bad;
-    const float cc = baba * oa.dot(oa) - baoa * baoa - c.radius_m * c.radius_m * baba;
-    const float h = half_b * half_b - a * cc;
-    if (!(h >= 0.0F)) return kNoHit;
-    if (a > 0.0F) {
-      const float t0 = (-half_b - std::sqrt(h)) / a;
-      const float foot = baoa + t0 * bad;
-      if (t0 > 0.0F && foot >= 0.0F && foot <= baba) return t0;
+struct CapsuleHit {
+  Shape c;  ///< the capsule in the camera frame
+  // What does not depend on the ray, computed once per capsule rather than per pixel.
+  Eigen::Vector3f ba = c.b - c.a;
+  Eigen::Vector3f oa = -c.a;
+  float baba = ba.dot(ba);
+  float baoa = ba.dot(oa);
+  float cc = baba * oa.dot(oa) - baoa * baoa - c.radius_m * c.radius_m * baba;
+
+  float operator()(const Eigen::Vector3f& d) const {
+    if (baba > 0.0F) {
+      const float bad = ba.dot(d);
+      const float a = baba * d.dot(d) - bad * bad;
+      const float half_b = baba * d.dot(oa) - baoa * bad;
+      const float h = half_b * half_b - a * cc;
+      if (!(h >= 0.0F)) return kNoHit;
+      if (a > 0.0F) {
+        const float t0 = (-half_b - std::sqrt(h)) / a;
+        const float foot = baoa + t0 * bad;
+        if (t0 > 0.0F && foot >= 0.0F && foot <= baba) return t0;
+      }
     }
+    return hit_capsule(c, Eigen::Vector3f::Zero(), d);
   }
-  return hit_capsule(c, Eigen::Vector3f::Zero(), d);
-}
+};
 
 /// Z-buffers a shape cast in the camera frame: the ray of pixel i is (x_i, y_i, 1).
 template <typename Hit>
@@ -181,29 +308,44 @@ void cast_shapes(const std::vector<Shape>& shapes_base, const std::vector<uint16
                  const PoseF& T_base_camera, float* z_m, uint16_t* ids) {
   const PoseF T_camera_base = T_base_camera.inverse();
   const Intrinsics& in = rays.intrinsics;
-  // Planes first, into the empty buffers, with z_m holding inverse depth meanwhile; in
-  // batches of a fixed size, so that casting does not allocate.
-  const size_t n = rays.x.size();
-  std::array<PlaneW, 8> batch{};
-  size_t count = 0;
-  bool any_plane = false;
-  for (size_t k = 0; k < shapes_base.size(); ++k) {
+  // Planes first: they initialise every pixel of both buffers.
+  const auto plane_w = [&](size_t k, PlaneW& out) {
     const Shape& s = shapes_base[k];
-    if (s.type != Shape::Type::plane) continue;
+    if (s.type != Shape::Type::plane) return false;
     const Eigen::Vector3f n_camera = T_camera_base.R * s.normal;
     const float num = n_camera.dot(T_camera_base.apply(s.point));
-    if (num == 0.0F) continue;  // through the camera centre: seen edge-on, never hit
+    if (num == 0.0F) return false;  // through the camera centre: seen edge-on, never hit
     const Eigen::Vector3f w = n_camera / num;
-    if (!any_plane) std::fill(z_m, z_m + n, 0.0F);
-    any_plane = true;
-    batch[count++] = {w.x(), w.y(), w.z(), shape_ids[k]};
-    if (count == batch.size()) {
-      cast_planes_w(batch.data(), count, rays, z_m, ids);
-      count = 0;
-    }
+    out = {w.x(), w.y(), w.z(), shape_ids[k]};
+    return true;
+  };
+  // Fixed-size batches, so that casting does not allocate.
+  std::array<PlaneW, 16> batch{};
+  size_t count = 0;
+  size_t total = 0;
+  for (size_t k = 0; k < shapes_base.size(); ++k) {
+    PlaneW p{};
+    if (!plane_w(k, p)) continue;
+    if (count < batch.size()) batch[count++] = p;
+    ++total;
   }
-  if (count > 0) cast_planes_w(batch.data(), count, rays, z_m, ids);
-  if (any_plane) {
+  // The row paths need x to grow along a row, as it does for every real camera (fx > 0).
+  const bool pinhole = is_pinhole(in) && in.fx > 0.0F;
+  if (pinhole && total <= batch.size()) {
+    cast_planes_pinhole(batch.data(), count, rays, z_m, ids);
+  } else {
+    const size_t n = rays.x.size();
+    std::fill(z_m, z_m + n, 0.0F);  // inverse depth meanwhile
+    std::fill(ids, ids + n, uint16_t{0});
+    count = 0;
+    for (size_t k = 0; k < shapes_base.size(); ++k) {
+      if (!plane_w(k, batch[count])) continue;
+      if (++count == batch.size()) {
+        cast_planes_w(batch.data(), count, rays, z_m, ids);
+        count = 0;
+      }
+    }
+    if (count > 0) cast_planes_w(batch.data(), count, rays, z_m, ids);
     for (size_t i = 0; i < n; ++i) {
       // 1 / +0 = +inf = kNoHit where no plane is in front (w = 0). max rather than a select,
       // which GCC would keep as a branch; this loop should vectorise.
@@ -229,19 +371,20 @@ void cast_shapes(const std::vector<Shape>& shapes_base, const std::vector<uint16
       case Shape::Type::plane:
         break;
       case Shape::Type::box:
-        cast(r, rays, T_base_camera.R, id, [&](const Eigen::Vector3f& d) { return hit_box(s, origin_base, d); }, z_m,
-             ids);
+        if (pinhole) {
+          cast_box_pinhole(r, rays, T_base_camera.R, origin_base, s, id, z_m, ids);
+        } else {
+          cast(r, rays, T_base_camera.R, id, [&](const Eigen::Vector3f& d) { return hit_box(s, origin_base, d); }, z_m,
+               ids);
+        }
         break;
       case Shape::Type::sphere:
         cast_camera(r, rays, id, [&](const Eigen::Vector3f& d) { return hit_sphere(c.point, c.radius_m, zero, d); },
                     z_m, ids);
         break;
-      case Shape::Type::capsule: {
-        const Eigen::Vector3f ba = c.b - c.a;
-        const float baba = ba.dot(ba);
-        cast_camera(r, rays, id, [&](const Eigen::Vector3f& d) { return hit_capsule_fast(c, ba, baba, d); }, z_m, ids);
+      case Shape::Type::capsule:
+        cast_camera(r, rays, id, CapsuleHit{c}, z_m, ids);
         break;
-      }
     }
   }
 }

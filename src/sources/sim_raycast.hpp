@@ -26,9 +26,10 @@ struct PoseF {
 /// Fills `rays` from deproject() at unit depth, unless they are already for `in`.
 void ensure_rays(SimRays& rays, const Intrinsics& in);
 
-/// Z-buffers every shape of `shapes_base` (base frame) into `z_m` (Z per pixel, to be
-/// initialised to kNoHit) and `ids` (shape_ids[k] where shape k is nearest, to be initialised
-/// to 0), seen by the camera whose rays are `rays` and whose pose is `T_base_camera`.
+/// Z-buffers every shape of `shapes_base` (base frame) into `z_m` (Z per pixel, kNoHit where
+/// nothing is hit) and `ids` (shape_ids[k] where shape k is nearest, 0 where nothing is hit),
+/// seen by the camera whose rays are `rays` and whose pose is `T_base_camera`. Writes every
+/// pixel of both buffers (rays.x.size() of each); their previous contents do not matter.
 void cast_shapes(const std::vector<Shape>& shapes_base, const std::vector<uint16_t>& shape_ids, const SimRays& rays,
                  const PoseF& T_base_camera, float* z_m, uint16_t* ids);
 

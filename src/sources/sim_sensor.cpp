@@ -8,7 +8,9 @@
 #include "sim_noise.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace hrcsense::sim_detail {
@@ -47,27 +49,47 @@ void mark_hidden(const SimParams& p, float max_disparity_px, int width, int heig
   // A step smaller than this is rounding, not occlusion: x_r grows by (1 − ∂d/∂u) per column,
   // which is > 0 for every surface the right imager sees at more than grazing incidence.
   constexpr float kEpsPx = 1e-3F;
-  // Branch-free, and several rows at once so that their running minima (a serial chain per
-  // row) overlap in the pipeline.
+  // The running minimum of x_r from the right is a serial chain per row: four rows at once so
+  // that their chains overlap in the pipeline, over chunks of columns whose minima are kept so
+  // that the tests then run along the row, branch-free, and vectorise. Misses (d = 0, x_r = u)
+  // may join the minimum: x_r of a miss right of a hit exceeds the hit's own, so it never
+  // makes the hit look shadowed.
   constexpr int kRows = 4;
+  constexpr int kChunk = 256;
   const float band_limit = p.left_band ? -0.5F : -std::numeric_limits<float>::infinity();
   const float shadow_eps = p.occlusion_shadows ? kEpsPx : std::numeric_limits<float>::infinity();
+  std::array<float, kRows * kChunk> min_right{};  // per row of the group and column of the chunk
   for (int v0 = 0; v0 < height; v0 += kRows) {
     const int rows = std::min(kRows, height - v0);
-    float min_right_xr[kRows];
-    for (float& m : min_right_xr) m = std::numeric_limits<float>::infinity();
-    for (int u = width - 1; u >= 0; --u) {
+    std::array<const float*, kRows> d_row{};
+    for (int k = 0; k < kRows; ++k) {
+      // A short last group repeats its last row, so that the chain loop has a fixed count.
+      d_row[k] = disparity_px + static_cast<size_t>(v0 + std::min(k, rows - 1)) * width;
+    }
+    std::array<float, kRows> running{};
+    running.fill(std::numeric_limits<float>::infinity());
+    for (int end = width; end > 0; end -= kChunk) {
+      const int begin = std::max(0, end - kChunk);
+      for (int u = end - 1; u >= begin; --u) {
+        const auto column = static_cast<float>(u);
+        for (int k = 0; k < kRows; ++k) {
+          min_right[static_cast<size_t>(k * kChunk + (u - begin))] = running[k];
+          running[k] = std::min(running[k], column - d_row[k][u]);
+        }
+      }
       for (int k = 0; k < rows; ++k) {
-        const size_t i = static_cast<size_t>(v0 + k) * width + u;
-        const float d = disparity_px[i];
-        const bool hit = d > 0.0F;
-        const float xr = static_cast<float>(u) - d;
-        const bool outside = xr < band_limit;
-        const bool shadowed = xr > min_right_xr[k] + shadow_eps;
-        const bool too_near = d > max_disparity_px;
-        hidden[i] = hit && (outside || shadowed || too_near) ? 1 : 0;
-        const float m = xr < min_right_xr[k] ? xr : min_right_xr[k];
-        min_right_xr[k] = hit ? m : min_right_xr[k];
+        const float* d = d_row[k];
+        const float* m = min_right.data() + static_cast<size_t>(k * kChunk);  // column begin + j at m[j]
+        uint8_t* out = hidden + static_cast<size_t>(v0 + k) * width;
+        for (int u = begin; u < end; ++u) {
+          const float xr = static_cast<float>(u) - d[u];
+          // Bitwise, not ||: short-circuits would be branches.
+          const int hit = d[u] > 0.0F;
+          const int outside = xr < band_limit;
+          const int shadowed = xr > m[u - begin] + shadow_eps;
+          const int too_near = d[u] > max_disparity_px;
+          out[u] = static_cast<uint8_t>(hit & (outside | shadowed | too_near));
+        }
       }
     }
   }
@@ -134,12 +156,9 @@ inline ptrdiff_t edge_neighbour(const float* d, int u, int v, int width, int hei
   return j;
 }
 
-/// Whether a material patch drops this pixel (fixed per seed; patches of cell × cell pixels).
-inline bool material_drop(const SimParams& p, uint8_t material, int u, int v, int width, uint64_t seed) {
-  const int cell = std::max(1, p.material_cell_px);
-  const uint64_t cells_x = static_cast<uint64_t>((width + cell - 1) / cell);
-  const uint64_t c = static_cast<uint64_t>(v / cell) * cells_x + static_cast<uint64_t>(u / cell);
-  const uint64_t h = mix64(seed + c * kGolden);
+/// Whether a material patch drops a pixel of `material` (bits) in the patch whose hash is `h`
+/// (fixed per seed; patches of cell × cell pixels).
+inline bool material_drop(const SimParams& p, uint8_t material, uint64_t h) {
   return ((material & kDarkBit) != 0 && unit24(h, 0) < p.dark_dropout) ||
          ((material & kShinyBit) != 0 && unit24(h, 20) < p.shiny_dropout) ||
          ((material & kLowTextureBit) != 0 && unit24(h, 40) < p.low_texture_dropout);
@@ -221,8 +240,16 @@ void apply_edges(const SimParams& p, int width, int height, const float* d_true,
       steps[width - 1] = 1;
     }
     for (int u = 0; u < width; ++u) {
+      if (!border_row) {
+        // Eight screened pixels at a time: most words of the screen are all zero.
+        for (uint64_t word = 0; u + 8 <= width; u += 8) {
+          std::memcpy(&word, steps + u, 8);
+          if (word != 0) break;
+        }
+        if (u == width) break;
+        if (steps[u] == 0) continue;
+      }
       const size_t i = row + u;
-      if (!border_row && steps[u] == 0) continue;
       if (hidden[i] != 0 || !(d_true[i] > 0.0F)) continue;
       const ptrdiff_t j = edge_neighbour(d_true, u, v, width, height, i, p.edge_jump_px);
       if (j < 0) continue;
@@ -241,11 +268,24 @@ void apply_edges(const SimParams& p, int width, int height, const float* d_true,
 void apply_materials(const SimParams& p, int width, int height, const uint16_t* ids, const uint8_t* material_of_id,
                      uint16_t* raw) {
   const uint64_t material_seed = mix64(p.seed ^ kMaterialSalt);
+  const int cell = std::max(1, p.material_cell_px);
+  const uint64_t cells_x = static_cast<uint64_t>((width + cell - 1) / cell);
   for (int v = 0; v < height; ++v) {
+    const uint64_t row_cells = static_cast<uint64_t>(v / cell) * cells_x;
+    const size_t row = static_cast<size_t>(v) * width;
+    // Neighbouring pixels share a patch: hash each patch once per run of its pixels.
+    uint64_t hashed_cell = std::numeric_limits<uint64_t>::max();
+    uint64_t h = 0;
     for (int u = 0; u < width; ++u) {
-      const size_t i = static_cast<size_t>(v) * width + u;
+      const size_t i = row + u;
       const uint8_t material = material_of_id[ids[i]];
-      if (material != 0 && raw[i] != 0 && material_drop(p, material, u, v, width, material_seed)) raw[i] = 0;
+      if (material == 0 || raw[i] == 0) continue;
+      const uint64_t c = row_cells + static_cast<uint64_t>(u / cell);
+      if (c != hashed_cell) {
+        h = mix64(material_seed + c * kGolden);
+        hashed_cell = c;
+      }
+      if (material_drop(p, material, h)) raw[i] = 0;
     }
   }
 }

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -103,13 +104,44 @@ Contact analytic_contact(const SimScratch& scratch, const RobotModel& robot, con
   return best;
 }
 
+/// Labels from the cast's object ids; the z-buffer's misses (+inf) become the truth's 0.
+void fill_truth_labels(const SimScratch& scratch, GroundTruth& truth) {
+  const size_t n = truth.labels.size();
+  const uint16_t* ids = scratch.object_ids.data();
+  const uint16_t* label_of_id = scratch.label_of_id.data();
+  uint16_t* labels = truth.labels.data();
+  float* depth_m = truth.depth_m.data();
+  for (size_t i = 0; i < n; ++i) labels[i] = label_of_id[ids[i]];
+  // On the bits, because GCC keeps a float select as a branch (trapping math); this way the
+  // loop vectorises. Hits are finite and positive and stay as they are.
+  constexpr uint32_t kInfBits = 0x7F800000U;
+  for (size_t i = 0; i < n; ++i) {
+    uint32_t bits = 0;
+    std::memcpy(&bits, &depth_m[i], sizeof bits);
+    bits &= -static_cast<uint32_t>(bits != kInfBits);
+    std::memcpy(&depth_m[i], &bits, sizeof bits);
+  }
+}
+
 void fill_truth_contacts(const Simulator& sim, const PoseF& T_base_camera, GroundTruth& truth) {
   SimScratch& scratch = sim.scratch;
   scratch.points_base.clear();
   scratch.points_camera.clear();
-  for (size_t i = 0; i < truth.labels.size(); ++i) {
-    if (truth.labels[i] == kStaticLabel) continue;
-    const float z = truth.depth_m[i];
+  // Plain pointers: push_back below may write any memory as far as the compiler knows, which
+  // would reload the vectors' sizes and data for every pixel.
+  const size_t n = truth.labels.size();
+  const uint16_t* labels = truth.labels.data();
+  const float* depth_m = truth.depth_m.data();
+  static_assert(kStaticLabel == 0, "the scan below skips four static labels as one zero word");
+  for (size_t i = 0; i < n; ++i) {
+    // Most pixels are static: skip them four at a time.
+    for (uint64_t word = 0; i + 4 <= n; i += 4) {
+      std::memcpy(&word, labels + i, sizeof word);
+      if (word != 0) break;
+    }
+    if (i == n) break;
+    if (labels[i] == kStaticLabel) continue;
+    const float z = depth_m[i];
     const Eigen::Vector3f p_camera(z * scratch.rays.x[i], z * scratch.rays.y[i], z);
     const Eigen::Vector3f p_base = T_base_camera.apply(p_camera);
     scratch.points_camera.push_back(p_camera.x(), p_camera.y(), p_camera.z(), static_cast<uint32_t>(i));
@@ -144,8 +176,8 @@ void render_color(const Simulator& sim, const PoseF& T_base_camera_f, Frame& out
   T_base_color.t = T_base_camera_f.t - T_base_camera_f.R * params.color_translation_m;
   sim_detail::ensure_rays(scratch.color_rays, in);
   const size_t n = static_cast<size_t>(in.width) * in.height;
-  scratch.color_z_m.assign(n, kNoHit);
-  scratch.color_ids.assign(n, 0);
+  scratch.color_z_m.resize(n);
+  scratch.color_ids.resize(n);
   sim_detail::cast_shapes(scratch.shapes_base, scratch.shape_ids, scratch.color_rays, T_base_color,
                           scratch.color_z_m.data(), scratch.color_ids.data());
   if (!out.color) out.color.emplace();
@@ -199,17 +231,14 @@ void Simulator::render(int64_t index, Frame& out) const {
   if (!out.truth) out.truth.emplace();
   GroundTruth& truth = *out.truth;
   const size_t n = static_cast<size_t>(in.width) * in.height;
-  truth.depth_m.assign(n, kNoHit);
+  truth.depth_m.resize(n);
   truth.labels.resize(n);
-  scratch.object_ids.assign(n, 0);
+  scratch.object_ids.resize(n);
 
   sim_detail::cast_shapes(scratch.shapes_base, scratch.shape_ids, scratch.rays, T_base_camera_f, truth.depth_m.data(),
                           scratch.object_ids.data());
   sim_detail::write_sensor_depth(params, in.fx, index, truth.depth_m.data(), scratch, out.depth);
-  for (size_t i = 0; i < n; ++i) {
-    truth.labels[i] = scratch.label_of_id[scratch.object_ids[i]];
-    truth.depth_m[i] = truth.depth_m[i] < kNoHit ? truth.depth_m[i] : 0.0F;
-  }
+  fill_truth_labels(scratch, truth);
   fill_truth_contacts(*this, T_base_camera_f, truth);
   render_color(*this, T_base_camera_f, out);
 }

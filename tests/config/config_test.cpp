@@ -66,7 +66,7 @@ robot:
   padding_m: 0.05
   joints_rad: [0, 1, 2, 3, 4, 5]
   base_frame: base_link
-proximity: {backend: brute, octree: {height: 4}}
+proximity: {backend: brute, octree: {height: 6}}
 safety: {slow_distance_m: 1.5, stop_distance_m: 0.7, max_frame_age_s: 0.25}
 )");
   const Config c = load_config(path, {});
@@ -108,7 +108,7 @@ safety: {slow_distance_m: 1.5, stop_distance_m: 0.7, max_frame_age_s: 0.25}
   EXPECT_EQ(second.link, 1);
   EXPECT_EQ(c.robot_joints_rad, (std::vector<double>{0, 1, 2, 3, 4, 5}));
   EXPECT_EQ(c.robot_base_frame, "base_link");
-  EXPECT_EQ(c.proximity_octree_height, 4);
+  EXPECT_EQ(c.proximity_octree_height, 6);
   EXPECT_FLOAT_EQ(c.pipeline.safety.slow_distance_m, 1.5F);
   EXPECT_FLOAT_EQ(c.pipeline.safety.stop_distance_m, 0.7F);
   EXPECT_DOUBLE_EQ(c.pipeline.safety.max_frame_age_s, 0.25);

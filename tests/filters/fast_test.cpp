@@ -19,9 +19,11 @@
 namespace hrcsense {
 namespace {
 
-// Sizes around the widths of SSE2 vectors (4 floats, 8 uint16) and of the row strips.
-const std::vector<std::pair<int, int>> kSizes{{1, 1},  {2, 1},  {1, 9},  {3, 2},   {5, 8},   {8, 8},  {9, 16},
-                                              {15, 17}, {16, 7}, {17, 24}, {31, 33}, {64, 40}, {83, 19}};
+// Sizes around the widths of SSE2 and AVX2 vectors (4/8 floats, 8/16 uint16), of the row
+// strips and of hole filling's 64-pixel words and 2048-pixel segments (150, 2200 wide).
+const std::vector<std::pair<int, int>> kSizes{{1, 1},   {2, 1},   {1, 9},   {3, 2},   {5, 8},   {8, 8},
+                                              {9, 16},  {15, 17}, {16, 7},  {17, 24}, {31, 33}, {64, 40},
+                                              {83, 19}, {150, 6}, {2200, 3}};
 
 // A depth-like image: flat patches at several depths (edges between them), noise of a few
 // units, holes alone and in runs, and the values the SDK treats specially (1, values < δ).
@@ -56,6 +58,43 @@ DepthImage random_depth(std::mt19937& rng, int w, int h) {
   return d;
 }
 
+// Every test here runs twice: forced onto the portable (SSE2) loops, and with the best the CPU
+// has (AVX2 where present), so both paths are checked against the same references.
+class IsaTest : public ::testing::TestWithParam<FilterIsa> {
+ protected:
+  void SetUp() override { set_filter_isa(GetParam()); }
+  void TearDown() override { set_filter_isa(FilterIsa::best); }
+};
+using SpatialFast = IsaTest;
+using TemporalFast = IsaTest;
+using BlocksFast = IsaTest;
+using Properties = IsaTest;
+
+std::string isa_label(const ::testing::TestParamInfo<FilterIsa>& info) {
+  return info.param == FilterIsa::portable ? "portable" : "best";
+}
+
+const auto kBothIsas = ::testing::Values(FilterIsa::portable, FilterIsa::best);
+INSTANTIATE_TEST_SUITE_P(Isa, SpatialFast, kBothIsas, isa_label);
+INSTANTIATE_TEST_SUITE_P(Isa, TemporalFast, kBothIsas, isa_label);
+INSTANTIATE_TEST_SUITE_P(Isa, BlocksFast, kBothIsas, isa_label);
+INSTANTIATE_TEST_SUITE_P(Isa, Properties, kBothIsas, isa_label);
+
+// The hook really switches paths (else "both" would test one path twice).
+TEST(FilterIsaHook, PortableForcesTheBaselineAndBestTakesAvx2WhereTheCpuHasIt) {
+  set_filter_isa(FilterIsa::portable);
+  const std::string portable = filter_isa_name();
+  set_filter_isa(FilterIsa::best);
+  const std::string best = filter_isa_name();
+#if defined(__x86_64__)
+  EXPECT_EQ(portable, "sse2");
+  EXPECT_EQ(best, __builtin_cpu_supports("avx2") ? "avx2" : "sse2");
+#else
+  EXPECT_EQ(portable, "scalar");
+  EXPECT_EQ(best, "scalar");
+#endif
+}
+
 constexpr float kFactor = 669216.0F;  // 50 mm, fx 418.26, 1 mm units
 
 // Disparity from random depth, with a sprinkling of the floats the SDK's bit tests single out.
@@ -85,7 +124,7 @@ const SpatialParams kSpatialOptions[] = {{0.5F, 20, 2, 0}, {0.25F, 1, 1, 0}, {0.
                                          {0.5F, 20, 2, 2}, {0.33F, 30, 2, 3}, {0.6F, 20, 1, 4}, {0.5F, 45, 4, 5},
                                          {1.0F, 20, 2, 0}, {1.0F, 20, 2, 3}};
 
-TEST(SpatialFast, DepthEqualsTheReferenceOnEverySizeAndOption) {
+TEST_P(SpatialFast, DepthEqualsTheReferenceOnEverySizeAndOption) {
   std::mt19937 rng(101);
   for (const auto& [w, h] : kSizes) {
     for (const SpatialParams& q : kSpatialOptions) {
@@ -98,7 +137,7 @@ TEST(SpatialFast, DepthEqualsTheReferenceOnEverySizeAndOption) {
   }
 }
 
-TEST(SpatialFast, DisparityEqualsTheReferenceOnEverySizeAndOption) {
+TEST_P(SpatialFast, DisparityEqualsTheReferenceOnEverySizeAndOption) {
   std::mt19937 rng(103);
   for (const auto& [w, h] : kSizes) {
     for (const SpatialParams& q : kSpatialOptions) {
@@ -113,7 +152,7 @@ TEST(SpatialFast, DisparityEqualsTheReferenceOnEverySizeAndOption) {
   }
 }
 
-TEST(SpatialFast, AlphaOneWithoutHoleFillLeavesEverySizeUnchanged) {
+TEST_P(SpatialFast, AlphaOneWithoutHoleFillLeavesEverySizeUnchanged) {
   std::mt19937 rng(107);
   for (const auto& [w, h] : kSizes) {
     const DepthImage depth_in = random_depth(rng, w, h);
@@ -127,7 +166,7 @@ TEST(SpatialFast, AlphaOneWithoutHoleFillLeavesEverySizeUnchanged) {
   }
 }
 
-TEST(TemporalFast, EqualsTheReferenceOnEverySizePersistenceAndAlpha) {
+TEST_P(TemporalFast, EqualsTheReferenceOnEverySizePersistenceAndAlpha) {
   std::mt19937 rng(109);
   std::bernoulli_distribution burst(0.3);
   for (const auto& [w, h] : kSizes) {
@@ -164,7 +203,7 @@ TEST(TemporalFast, EqualsTheReferenceOnEverySizePersistenceAndAlpha) {
 }
 
 // The plain references of the stateless blocks.
-TEST(BlocksFast, ThresholdTransformsDecimationAndHoleFillingEqualTheReferences) {
+TEST_P(BlocksFast, ThresholdTransformsDecimationAndHoleFillingEqualTheReferences) {
   std::mt19937 rng(113);
   const ThresholdParams thresholds[] = {{0.1F, 4.0F}, {0.15F, 1.5F}, {0.0F, 16.0F}, {1.0F, 0.5F}, {0.8F, 0.8F}};
   for (const auto& [w, h] : kSizes) {
@@ -204,7 +243,7 @@ TEST(BlocksFast, ThresholdTransformsDecimationAndHoleFillingEqualTheReferences) 
 // Every block but threshold keeps valid pixels valid, except where the spec says otherwise
 // (spatial on depth, below). Decimation: an output pixel is valid when its block holds a valid
 // pixel; to_depth: on disparities that came from depth, where rounding gives the depth back.
-TEST(Properties, NoFilterButThresholdInvalidatesAValidPixel) {
+TEST_P(Properties, NoFilterButThresholdInvalidatesAValidPixel) {
   std::mt19937 rng(127);
   for (const auto& [w, h] : kSizes) {
     const DepthImage in = random_depth(rng, w, h);
@@ -289,7 +328,7 @@ Image unshifted(const Image& in, int k) {
   return out;
 }
 
-TEST(Properties, OutputDoesNotDependOnMemoryAlignment) {
+TEST_P(Properties, OutputDoesNotDependOnMemoryAlignment) {
   std::mt19937 rng(131);
   const SpatialParams spatial{0.45F, 25, 3, 0};
   for (const auto& [w, h] : {std::pair{29, 18}, std::pair{64, 17}}) {
@@ -340,26 +379,35 @@ TEST(Properties, OutputDoesNotDependOnMemoryAlignment) {
 }
 
 // Scratch buffers are reused between calls and sizes; they must carry nothing over.
-TEST(Properties, RunningTwiceWithResetStateGivesIdenticalOutput) {
+TEST_P(Properties, RunningTwiceWithResetStateGivesIdenticalOutput) {
   std::mt19937 rng(137);
   const DepthImage a = random_depth(rng, 83, 41);
   const DepthImage b = random_depth(rng, 120, 9);
   const SpatialParams q{0.5F, 20, 2, 3};
+  // One scratch through calls of different sizes, as the chain reuses it; nothing may leak
+  // from one call into the next, so the result also equals a fresh scratch's.
+  SpatialScratch scratch;
   DepthImage first = a;
-  spatial_filter(q, first);
+  spatial_filter(q, first, scratch);
   DepthImage other = b;
-  spatial_filter(q, other);
+  spatial_filter(q, other, scratch);
   DepthImage second = a;
-  spatial_filter(q, second);
+  spatial_filter(q, second, scratch);
   EXPECT_EQ(first.pixels, second.pixels);
+  DepthImage fresh = a;
+  spatial_filter(q, fresh);
+  EXPECT_EQ(fresh.pixels, second.pixels);
   DisparityImage d_first, d_other, d_second;
   depth_to_disparity(a, kFactor, d_first);
   depth_to_disparity(b, kFactor, d_other);
   d_second = d_first;
-  spatial_filter(q, d_first);
-  spatial_filter(q, d_other);
-  spatial_filter(q, d_second);
+  DisparityImage d_fresh = d_first;
+  spatial_filter(q, d_first, scratch);
+  spatial_filter(q, d_other, scratch);
+  spatial_filter(q, d_second, scratch);
+  spatial_filter(q, d_fresh);
   EXPECT_TRUE(same_bits(d_first.pixels, d_second.pixels));
+  EXPECT_TRUE(same_bits(d_fresh.pixels, d_second.pixels));
 
   TemporalFilter temporal;
   std::vector<std::vector<uint16_t>> outputs;
