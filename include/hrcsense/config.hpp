@@ -63,7 +63,7 @@ Config load_config(const std::string& path, const std::vector<std::string>& over
 RobotDescription load_robot_description(const std::string& path);
 
 /// The configured arm as a static simulator object named "robot": its rendering capsules
-/// (robot_render_capsules: link radius, no padding) in the robot.base_frame frame, so the
+/// (robot_render_capsules: the visual body, no padding) in the robot.base_frame frame, so the
 /// arm is part of the learnt background. Empty for robot.model points.
 std::optional<SceneObject> robot_scene_object(const Config& config);
 

@@ -45,12 +45,16 @@ struct LinkCapsule {
   double radius_m = 0.0;  ///< covers the real link; the search adds the padding
 };
 
-/// A 6-joint arm: kinematics and the capsules that cover its links.
+/// A 6-joint arm: kinematics, the capsules that cover its links (what the search uses, like a
+/// URDF's collision geometry) and optionally its own visible shape (like a URDF's visual).
 struct RobotDescription {
   std::string name;                                    ///< e.g. "ur5"
   std::array<DhRow, kJointCount> dh{};                 ///< joint 1 first
   std::array<JointLimit, kJointCount> limits{};        ///< joint 1 first
   std::array<std::vector<LinkCapsule>, kArmLinkCount> links;  ///< capsules per link, link frame
+  /// The real body per link, link frame, for rendering only (the simulator); it must lie inside
+  /// `links`. A link without visual shapes is drawn as its `links` capsules.
+  std::array<std::vector<LinkCapsule>, kArmLinkCount> visual;
   std::vector<LinkCapsule> tool;                       ///< in the flange frame; may be empty
   double padding_m = 0.0;  ///< default of robot.padding_m for this arm (added to every radius)
 };
@@ -103,8 +107,9 @@ void robot_capsules(const RobotDescription& description, const JointAngles& join
 RobotModel robot_capsules(const RobotDescription& description, const JointAngles& joints_rad, double padding_m,
                           BaseFrame frame);
 
-/// The arm's own geometry for rendering (the simulator): the same capsules with radius = link
-/// radius, no padding, so every rendered surface lies inside the searched capsules.
+/// The arm's own geometry for rendering (the simulator): each link's `visual` shapes, or its
+/// `links` capsules where it has none, and the tool's capsules; no padding. Capsule::link as in
+/// robot_capsules.
 RobotModel robot_render_capsules(const RobotDescription& description, const JointAngles& joints_rad,
                                  BaseFrame frame);
 

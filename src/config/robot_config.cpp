@@ -41,6 +41,18 @@ struct DescriptionReader : YamlTree {
     return out;
   }
 
+  // A map from link names (base, shoulder, ... wrist_3) to capsule lists; links may be left out.
+  std::array<std::vector<LinkCapsule>, kArmLinkCount> per_link(const YAML::Node& map, const std::string& key) const {
+    std::vector<std::string> link_names;
+    for (int link = 0; link < kArmLinkCount; ++link) link_names.push_back(link_name(link));
+    only_keys(map, key, link_names);
+    std::array<std::vector<LinkCapsule>, kArmLinkCount> out;
+    for (int link = 0; link < kArmLinkCount; ++link) {
+      out[static_cast<size_t>(link)] = capsules(child(map, link_name(link)), key + "." + link_name(link));
+    }
+    return out;
+  }
+
   void dh(const YAML::Node& node, RobotDescription& out) const {
     if (!node.IsSequence() || node.size() != kJointCount) {
       fail("dh", "expected a list of 6 rows {d_m, a_m, alpha_deg}, joint 1 first");
@@ -70,7 +82,7 @@ struct DescriptionReader : YamlTree {
   }
 
   RobotDescription description(const YAML::Node& map) const {
-    only_keys(map, "", {"name", "dh", "joint_limits_deg", "padding_m", "links", "tool"});
+    only_keys(map, "", {"name", "dh", "joint_limits_deg", "padding_m", "links", "visual", "tool"});
     RobotDescription out;
     const YAML::Node name = child(map, "name");
     if (name.IsDefined()) {
@@ -84,13 +96,9 @@ struct DescriptionReader : YamlTree {
       out.padding_m = number(padding, "padding_m");
       if (out.padding_m < 0.0) fail("padding_m", "expected a number >= 0");
     }
-    const YAML::Node links = required(map, "", "links");
-    std::vector<std::string> link_names;
-    for (int link = 0; link < kArmLinkCount; ++link) link_names.push_back(link_name(link));
-    only_keys(links, "links", link_names);
-    for (int link = 0; link < kArmLinkCount; ++link) {
-      out.links[static_cast<size_t>(link)] = capsules(child(links, link_name(link)), "links." + link_name(link));
-    }
+    out.links = per_link(required(map, "", "links"), "links");
+    const YAML::Node visual = child(map, "visual");
+    if (visual.IsDefined()) out.visual = per_link(visual, "visual");
     out.tool = capsules(child(map, "tool"), "tool");
     const std::string problem = description_problem(out);
     if (!problem.empty()) {
@@ -122,6 +130,14 @@ YAML::Node capsules_node(const std::vector<LinkCapsule>& capsules) {
     item["b_m"] = vec3_node(c.b_m);
     item["radius_m"] = double_text(c.radius_m);
     out.push_back(item);
+  }
+  return out;
+}
+
+YAML::Node per_link_node(const std::array<std::vector<LinkCapsule>, kArmLinkCount>& per_link) {
+  YAML::Node out(YAML::NodeType::Map);
+  for (int link = 0; link < kArmLinkCount; ++link) {
+    out[link_name(link)] = capsules_node(per_link[static_cast<size_t>(link)]);
   }
   return out;
 }
@@ -187,11 +203,8 @@ YAML::Node robot_description_node(const RobotDescription& description) {
   out["dh"] = dh;
   out["joint_limits_deg"] = limits;
   out["padding_m"] = double_text(description.padding_m);
-  YAML::Node links(YAML::NodeType::Map);
-  for (int link = 0; link < kArmLinkCount; ++link) {
-    links[link_name(link)] = capsules_node(description.links[static_cast<size_t>(link)]);
-  }
-  out["links"] = links;
+  out["links"] = per_link_node(description.links);
+  out["visual"] = per_link_node(description.visual);
   out["tool"] = capsules_node(description.tool);
   return out;
 }
@@ -200,6 +213,7 @@ void read_robot(KeyReader& r, Config& c) {
   // Every key is read unconditionally first: known_keys() learns the schema from these reads.
   r.choice("robot.model", c.robot_model, {"points", "ur5", "ur5e", "ur10e", "custom"});
   const YAML::Node description = r.raw("robot.description");
+  const YAML::Node tool = r.raw("robot.tool");
   // Default: the 2020 thesis's robot point (-0.5, 0.5, 0.5) m, given there with y up.
   std::vector<Eigen::Vector3f> points_base{Eigen::Vector3f(-0.5F, -0.5F, 0.5F)};
   r.vec3_list("robot.points_base", points_base);
@@ -209,6 +223,7 @@ void read_robot(KeyReader& r, Config& c) {
 
   if (c.robot_model == "points") {
     if (description.IsDefined()) r.fail("robot.description", "is only read with robot.model custom");
+    if (tool.IsDefined()) r.fail("robot.tool", "is only read with an arm (robot.model ur5, ur5e, ur10e or custom)");
     r.number("robot.padding_m", c.robot_padding_m, Bound::non_negative);
     // Without a robot every distance would be "infinite" and every verdict run: refuse.
     if (points_base.empty()) r.fail("robot.points_base", "expected at least one point [x, y, z] for robot.model points");
@@ -217,7 +232,13 @@ void read_robot(KeyReader& r, Config& c) {
     return;
   }
 
-  const RobotDescription arm = arm_description(r, c.robot_model, description);
+  RobotDescription arm = arm_description(r, c.robot_model, description);
+  if (tool.IsDefined()) {
+    // A gripper on a built-in arm without copying its description; replaces the description's tool.
+    const std::string prefix = "robot.";
+    arm.tool = DescriptionReader{{r.where(), prefix}}.capsules(tool, "tool");
+    r.set_effective("robot.tool", capsules_node(arm.tool));
+  }
   c.robot_padding_m = arm.padding_m;  // the arm's own padding is the default
   r.number("robot.padding_m", c.robot_padding_m, Bound::non_negative);
   // No default pose: a wrong pose would put the arm where it is not, which is not fail-safe.

@@ -81,6 +81,11 @@ std::string description_problem(const RobotDescription& description) {
       if (!problem.empty()) return problem;
     }
     count += capsules.size();
+    const std::vector<LinkCapsule>& visual = description.visual[static_cast<size_t>(link)];
+    for (size_t i = 0; i < visual.size(); ++i) {
+      const std::string problem = capsule_problem(visual[i], "visual." + link_name(link) + "[" + std::to_string(i) + "]");
+      if (!problem.empty()) return problem;
+    }
   }
   for (size_t i = 0; i < description.tool.size(); ++i) {
     const std::string problem = capsule_problem(description.tool[i], "tool[" + std::to_string(i) + "]");
@@ -146,9 +151,21 @@ RobotModel robot_capsules(const RobotDescription& description, const JointAngles
 
 RobotModel robot_render_capsules(const RobotDescription& description, const JointAngles& joints_rad,
                                  BaseFrame frame) {
-  // The link radius is the real arm's envelope; the search adds padding on top, so the
-  // rendered surface can never poke out of a searched capsule.
-  return robot_capsules(description, joints_rad, 0.0, frame);
+  // No padding: the visual shapes are the real arm, which the searched capsules (link radius
+  // plus padding) must contain.
+  const LinkFrames frames = forward_kinematics(description, joints_rad);
+  const Pose T_out_base_link = T_frame_base_link(frame);
+  RobotModel out;
+  for (int link = 0; link < kArmLinkCount; ++link) {
+    const size_t i = static_cast<size_t>(link);
+    const std::vector<LinkCapsule>& shapes = description.visual[i].empty() ? description.links[i] : description.visual[i];
+    for (const LinkCapsule& shape : shapes) {
+      out.capsules.push_back(moved(shape, T_out_base_link * frames.T_base_link_link[i], 0.0, link));
+    }
+  }
+  const Pose T_frame_flange = T_out_base_link * frames.T_base_link_link[kArmLinkCount - 1];
+  for (const LinkCapsule& capsule : description.tool) out.capsules.push_back(moved(capsule, T_frame_flange, 0.0, kToolLink));
+  return out;
 }
 
 RobotModel robot_points(const std::vector<Eigen::Vector3f>& points_base, double padding_m) {

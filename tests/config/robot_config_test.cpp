@@ -81,6 +81,16 @@ TEST(RobotConfig, PointsModelIsTheThesisPoint) {
   EXPECT_EQ(c.pipeline.robot.capsules[0].radius_m, 0.0F);
 }
 
+void expect_same_capsules(const std::vector<LinkCapsule>& file, const std::vector<LinkCapsule>& builtin,
+                          const std::string& name) {
+  ASSERT_EQ(file.size(), builtin.size()) << name;
+  for (size_t i = 0; i < file.size(); ++i) {
+    EXPECT_LT((file[i].a_m - builtin[i].a_m).norm(), 1e-12) << name << "[" << i << "].a_m";
+    EXPECT_LT((file[i].b_m - builtin[i].b_m).norm(), 1e-12) << name << "[" << i << "].b_m";
+    EXPECT_NEAR(file[i].radius_m, builtin[i].radius_m, 1e-12) << name << "[" << i << "].radius_m";
+  }
+}
+
 TEST(RobotConfig, ShippedDescriptionFilesEqualTheBuiltins) {
   for (const std::string& name : builtin_robot_names()) {
     const std::string path = robots_dir() + name + ".yaml";
@@ -96,17 +106,29 @@ TEST(RobotConfig, ShippedDescriptionFilesEqualTheBuiltins) {
       EXPECT_NEAR(file.limits[j].max_rad, builtin.limits[j].max_rad, 1e-12) << path;
     }
     for (size_t link = 0; link < kArmLinkCount; ++link) {
-      ASSERT_EQ(file.links[link].size(), builtin.links[link].size()) << path << " " << link_name(static_cast<int>(link));
-      for (size_t i = 0; i < file.links[link].size(); ++i) {
-        EXPECT_LT((file.links[link][i].a_m - builtin.links[link][i].a_m).norm(), 1e-12)
-            << path << " " << link_name(static_cast<int>(link)) << "[" << i << "].a_m";
-        EXPECT_LT((file.links[link][i].b_m - builtin.links[link][i].b_m).norm(), 1e-12)
-            << path << " " << link_name(static_cast<int>(link)) << "[" << i << "].b_m";
-        EXPECT_NEAR(file.links[link][i].radius_m, builtin.links[link][i].radius_m, 1e-12);
-      }
+      const std::string label = path + " " + link_name(static_cast<int>(link));
+      expect_same_capsules(file.links[link], builtin.links[link], label);
+      expect_same_capsules(file.visual[link], builtin.visual[link], label + " (visual)");
     }
     EXPECT_TRUE(file.tool.empty());
   }
+}
+
+TEST(RobotConfig, ToolKeyPutsAGripperOnABuiltinArm) {
+  // A 15 cm gripper of radius 4 cm: at q = 0 the flange's z points along −y of base_link from
+  // the flange at (a2 + a3, −(d4 + d6), d1 − d5), so the tool ends 0.15 m further along −y.
+  const Config c = load_config("", {"robot.model=ur5", kZeroPose, "robot.base_frame=base_link",
+                                    "robot.tool=[{a_m: [0, 0, 0], b_m: [0, 0, 0.15], radius_m: 0.04}]"});
+  ASSERT_EQ(c.pipeline.robot.capsules.size(), 9U);
+  const Capsule& tool = c.pipeline.robot.capsules.back();
+  EXPECT_EQ(tool.link, kToolLink);
+  EXPECT_LT((tool.a - Eigen::Vector3f(-0.81725F, -0.19145F, -0.005491F)).norm(), 1e-6F);
+  EXPECT_LT((tool.b - Eigen::Vector3f(-0.81725F, -0.34145F, -0.005491F)).norm(), 1e-6F);
+  EXPECT_FLOAT_EQ(tool.radius_m, 0.04F);
+  EXPECT_EQ(robot_scene_object(c)->shapes.size(), 9U);  // the tool is rendered too
+  expect_config_error("", {"robot.model=ur5", kZeroPose, "robot.tool=[{a_m: [0, 0, 0], b_m: [0, 0, 1], radius_m: -1}]"},
+                      {"'robot.tool[0].radius_m'", ">= 0"});
+  expect_config_error("", {"robot.tool=[]"}, {"'robot.tool'", "only read with an arm"});
 }
 
 TEST(RobotConfig, CustomArmFromAFileOrInline) {
@@ -184,24 +206,27 @@ double segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, cons
   return (p - (a + t * ab)).norm();
 }
 
-TEST(RobotSceneObject, IsTheArmWithoutPadding) {
+TEST(RobotSceneObject, IsTheArmsVisualBodyWithoutPadding) {
   EXPECT_FALSE(robot_scene_object(load_config("", {})).has_value());  // points: nothing to render
   const Config c = load_config("", {"robot.model=ur5", "robot.joints_rad=[0.2, -1.2, 1.1, -0.4, 0.6, 0]",
                                     "robot.padding_m=0.04"});
   const std::optional<SceneObject> arm = robot_scene_object(c);
   ASSERT_TRUE(arm.has_value());
   EXPECT_TRUE(arm->is_static);  // learnt as background
-  ASSERT_EQ(arm->shapes.size(), c.pipeline.robot.capsules.size());
+  // The UR5's visual radii of docs/ROBOT.md (base, shoulder, upper arm, elbow, forearm, wrists),
+  // not the searched capsules' (collision radius + 0.04 m padding).
+  const std::vector<float> expected_radii_m{0.0745F, 0.06F, 0.05F, 0.055F, 0.038F, 0.04F, 0.04F, 0.04F};
+  ASSERT_EQ(arm->shapes.size(), expected_radii_m.size());
   for (size_t i = 0; i < arm->shapes.size(); ++i) {
     EXPECT_EQ(arm->shapes[i].type, Shape::Type::capsule);
-    EXPECT_EQ(arm->shapes[i].a, c.pipeline.robot.capsules[i].a);
-    EXPECT_FLOAT_EQ(arm->shapes[i].radius_m + 0.04F, c.pipeline.robot.capsules[i].radius_m);
+    EXPECT_FLOAT_EQ(arm->shapes[i].radius_m, expected_radii_m[i]) << i;
+    EXPECT_LT(arm->shapes[i].radius_m, c.pipeline.robot.capsules[i].radius_m - 0.04F) << i;
   }
 }
 
 // Renders the configured arm alone (noise-free) and checks every pixel that hit something:
-// it lies on the rendered surface (the union of the unpadded capsules) and so inside the
-// searched, padded ones. Counts the pixels per link (the nearest capsule's link).
+// it lies on the rendered surface (the union of the visual capsules) and inside the searched
+// capsules without their padding. Counts the pixels per link (the nearest capsule's link).
 void expect_rendered_inside(const Config& c, double padding_m, std::vector<int>& seen_per_link) {
   Simulator sim = make_simulator(c);
   sim.scene.objects.clear();
@@ -209,6 +234,9 @@ void expect_rendered_inside(const Config& c, double padding_m, std::vector<int>&
   Frame frame;
   sim.render(0, frame);
   ASSERT_TRUE(frame.truth.has_value());
+  JointAngles joints_rad{};
+  for (size_t j = 0; j < kJointCount; ++j) joints_rad[j] = c.robot_joints_rad[j];
+  const RobotModel rendered = robot_render_capsules(*c.robot_arm, joints_rad, c.robot_frame);
   size_t seen = 0;
   for (int v = 0; v < frame.intrinsics.height; ++v) {
     for (int u = 0; u < frame.intrinsics.width; ++u) {
@@ -218,19 +246,24 @@ void expect_rendered_inside(const Config& c, double padding_m, std::vector<int>&
           deproject(frame.intrinsics, Eigen::Vector2f(static_cast<float>(u), static_cast<float>(v)), z_m);
       ASSERT_TRUE(p_camera.has_value());
       const Eigen::Vector3d p_base = c.pipeline.T_base_camera * p_camera->cast<double>();
-      double to_rendered_m = 1e9;  // signed distance to the union of the rendered capsules
-      double to_searched_m = 1e9;  // signed distance to the union of the searched capsules
+      double to_rendered_m = 1e9;  // signed distance to the union of the rendered (visual) capsules
       int link = -1;
-      for (const Capsule& capsule : c.pipeline.robot.capsules) {
-        const double axis_m = segment_distance(p_base, capsule.a.cast<double>(), capsule.b.cast<double>());
-        to_searched_m = std::min(to_searched_m, axis_m - capsule.radius_m);
-        if (axis_m - (capsule.radius_m - padding_m) < to_rendered_m) {
-          to_rendered_m = axis_m - (capsule.radius_m - padding_m);
+      for (const Capsule& capsule : rendered.capsules) {
+        const double to_capsule_m =
+            segment_distance(p_base, capsule.a.cast<double>(), capsule.b.cast<double>()) - capsule.radius_m;
+        if (to_capsule_m < to_rendered_m) {
+          to_rendered_m = to_capsule_m;
           link = capsule.link;
         }
       }
+      double to_bare_m = 1e9;  // signed distance to the union of the searched capsules without padding
+      for (const Capsule& capsule : c.pipeline.robot.capsules) {
+        const double axis_m = segment_distance(p_base, capsule.a.cast<double>(), capsule.b.cast<double>());
+        to_bare_m = std::min(to_bare_m, axis_m - (capsule.radius_m - padding_m));
+      }
       EXPECT_LT(std::abs(to_rendered_m), 1e-3) << "pixel " << u << "," << v << " at " << p_base.transpose();
-      EXPECT_LT(to_searched_m, 0.0) << "pixel " << u << "," << v << " at " << p_base.transpose();
+      // Inside the collision capsules even before the padding: the padding is all margin.
+      EXPECT_LT(to_bare_m, 0.0) << "pixel " << u << "," << v << " at " << p_base.transpose();
       ++seen;
       ++seen_per_link[static_cast<size_t>(link)];
     }
@@ -238,7 +271,7 @@ void expect_rendered_inside(const Config& c, double padding_m, std::vector<int>&
   EXPECT_GT(seen, 1000U);  // the arm is in view
 }
 
-TEST(RobotSceneObject, RenderedArmLiesInsideTheSearchedCapsules) {
+TEST(RobotSceneObject, RenderedArmLiesInsideTheUnpaddedSearchedCapsules) {
   // A UR5 lying along +x of `base` (q = 0 but wrist 2 at 90°, so wrist 3 points along +x),
   // seen from two cameras 1.4-1.5 m away so that every moving link shows somewhere.
   const std::vector<std::string> arm{"robot.model=ur5", "robot.joints_rad=[0, 0, 0, 0, 1.5707963267948966, 0]",

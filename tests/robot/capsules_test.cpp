@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
+#include <string>
 
 namespace hrcsense {
 namespace {
@@ -131,18 +133,54 @@ TEST(RobotCapsules, ReusesTheCallersBuffer) {
   EXPECT_EQ(model.capsules.size(), 8U);
 }
 
-TEST(RobotRenderCapsules, LieInsideTheSearchedCapsules) {
-  const JointAngles q{0.5, -1.0, 1.5, -0.5, -1.0, 0.3};
-  const RobotModel render = robot_render_capsules(builtin_robot("ur5"), q, BaseFrame::base);
-  const RobotModel searched = robot_capsules(builtin_robot("ur5"), q, 0.03, BaseFrame::base);
-  ASSERT_EQ(render.capsules.size(), searched.capsules.size());
-  for (size_t i = 0; i < render.capsules.size(); ++i) {
-    // Same axis, smaller radius: every rendered surface point is inside the searched capsule.
-    EXPECT_EQ(render.capsules[i].a, searched.capsules[i].a);
-    EXPECT_EQ(render.capsules[i].b, searched.capsules[i].b);
-    EXPECT_FLOAT_EQ(render.capsules[i].radius_m + 0.03F, searched.capsules[i].radius_m);
-    EXPECT_GT(render.capsules[i].radius_m, 0.0F);  // a real body, not a line
+// Signed distance from p to the union of the capsules (negative inside), in double.
+double to_union_m(const Eigen::Vector3d& p, const RobotModel& model) {
+  double best = 1e9;
+  for (const Capsule& c : model.capsules) {
+    const Eigen::Vector3d a = c.a.cast<double>();
+    const Eigen::Vector3d ab = c.b.cast<double>() - a;
+    const double t = ab.squaredNorm() > 0.0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+    best = std::min(best, (p - (a + t * ab)).norm() - c.radius_m);
   }
+  return best;
+}
+
+// Points on the surface of every rendered (visual) capsule: random points of its axis pushed
+// out by its radius in a random direction. Each must lie inside the searched capsules with no
+// padding at all: the collision model covers the real arm by itself, the padding is margin.
+TEST(RobotRenderCapsules, VisualBodyLiesInsideTheUnpaddedCapsules) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  for (const std::string& name : builtin_robot_names()) {
+    for (int pose = 0; pose < 20; ++pose) {
+      const JointAngles q = random_joints(rng);
+      const RobotModel visual = robot_render_capsules(builtin_robot(name), q, BaseFrame::base);
+      const RobotModel bare = robot_capsules(builtin_robot(name), q, 0.0, BaseFrame::base);
+      ASSERT_EQ(visual.capsules.size(), 8U) << name;
+      for (const Capsule& c : visual.capsules) {
+        for (int k = 0; k < 200; ++k) {
+          const Eigen::Vector3d on_axis = c.a.cast<double>() + unit(rng) * (c.b - c.a).cast<double>();
+          const Eigen::Vector3d direction = Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+          const Eigen::Vector3d p = on_axis + c.radius_m * direction;
+          EXPECT_LE(to_union_m(p, bare), 1e-6) << name << " link " << c.link << " at " << p.transpose();
+        }
+      }
+    }
+  }
+}
+
+TEST(RobotRenderCapsules, ALinkWithoutVisualShapesIsDrawnAsItsCapsules) {
+  RobotDescription arm = builtin_robot("ur5");
+  arm.visual[2].clear();  // the upper arm
+  arm.tool.push_back(LinkCapsule{Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.15), 0.04});
+  const JointAngles q{0.5, -1.0, 1.5, -0.5, -1.0, 0.3};
+  const RobotModel rendered = robot_render_capsules(arm, q, BaseFrame::base);
+  const RobotModel searched = robot_capsules(arm, q, 0.03, BaseFrame::base);
+  EXPECT_FLOAT_EQ(first_of(rendered, 2).radius_m, 0.06F);  // the upper arm capsule's own radius
+  EXPECT_EQ(first_of(rendered, 2).a, first_of(searched, 2).a);
+  EXPECT_FLOAT_EQ(first_of(rendered, 1).radius_m, 0.06F);  // shoulder: its visual housing (capsule 0.065)
+  EXPECT_FLOAT_EQ(last_of(rendered, kToolLink).radius_m, 0.04F);  // the tool, unpadded
 }
 
 TEST(RobotPoints, AreZeroLengthCapsulesWithThePaddingAsRadius) {
