@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tests of the `hrcsense` executable: exit codes, one-line errors, JSON Lines from `run`, `info`.
+#include "../support/run_cli.hpp"
 #include "../support/sanitized.hpp"
 #include "hrcsense/camera.hpp"
 
@@ -41,6 +42,22 @@ std::string read_text(const fs::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   return text.str();
+}
+
+// The lines of a `run` output without what depends on the machine or the build (timings, wall
+// time, frame rate, commit), so that two runs compare line by line.
+std::vector<json> results_without_timings(const fs::path& jsonl) {
+  std::vector<json> lines;
+  std::istringstream in(read_text(jsonl));
+  for (std::string line; std::getline(in, line);) {
+    json result = json::parse(line);
+    for (const char* key : {"commit", "latency_us", "timings_us", "wall_s", "fps", "latency_p50_us",
+                            "latency_p99_us"}) {
+      result.erase(key);
+    }
+    lines.push_back(std::move(result));
+  }
+  return lines;
 }
 
 // Runs the CLI in its own temporary folder, capturing stdout and stderr.
@@ -192,6 +209,36 @@ TEST_F(Cli, RunWritesHeaderFramesAndSummaryWithTheBindingNames) {
   EXPECT_EQ(summary["frames_in"], 130);
   EXPECT_EQ(summary["frames_processed"], 130);
   EXPECT_EQ(summary["frames_dropped"], 0);  // unpaced: every frame is processed
+}
+
+// Frame i depends only on the configuration, the seed and i (docs/SIMULATOR.md), so two
+// processes given the same seed write the same results; another seed gives other depth.
+TEST_F(Cli, SameSeedSameResultsInSeparateProcessesOtherSeedOtherDepth) {
+  const auto run_with_seed = [this](int seed, const std::string& name) {
+    const fs::path out = dir_ / name;
+    const hrcsense::test::CliResult result = hrcsense::test::cli(
+        "run " + thesis_box("--frames 110 --set background.frames=20 --set source.seed=" + std::to_string(seed) +
+                            " --out '" + out.string() + "'"));
+    EXPECT_EQ(result.exit_code, 0) << result.out;
+    return results_without_timings(out);
+  };
+  const std::vector<json> first = run_with_seed(7, "first.jsonl");
+  const std::vector<json> second = run_with_seed(7, "second.jsonl");
+  const std::vector<json> other = run_with_seed(8, "other.jsonl");
+  ASSERT_EQ(first.size(), 1U + 110U + 1U + 1U);  // header, frames, the end-of-run stop, summary
+  ASSERT_EQ(second.size(), first.size());
+  ASSERT_EQ(other.size(), first.size());
+  for (size_t i = 0; i < first.size(); ++i) EXPECT_EQ(first[i], second[i]) << "line " << i;
+  // What was compared depends on the rendered depth: invalid pixels in every frame, and by
+  // frame 109 the box (it enters at 100) has a distance.
+  size_t other_invalid = 0;
+  for (size_t i = 1; i <= 110; ++i) {
+    ASSERT_EQ(first[i]["type"], "frame");
+    EXPECT_GT(first[i]["invalid_pixels"].get<int64_t>(), 0) << "line " << i;
+    other_invalid += first[i]["invalid_pixels"] != other[i]["invalid_pixels"] ? 1U : 0U;
+  }
+  EXPECT_FALSE(first[110]["distance_m"].is_null());
+  EXPECT_GT(other_invalid, 0U) << "seed 8 gives the same invalid pixels as seed 7 in every frame";
 }
 
 TEST_F(Cli, LearntBackgroundIsSavedThenLoaded) {

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-// The chain: block names, presets, order checks, the depth-domain fallback without a baseline,
+// The chain: block names, presets (every field), order checks, the depth-domain fallback without a baseline,
 // decimated intrinsics, and repeatability after a reset.
 #include "hrcsense/filters.hpp"
+#include "preset_expectations.hpp"
 
 #include <gtest/gtest.h>
 
@@ -35,15 +36,31 @@ TEST(FilterChain, NamesRoundTrip) {
 
 TEST(FilterChain, Presets) {
   EXPECT_TRUE(filter_preset("none")->order.empty());
-  const FilterChainParams sdk = *filter_preset("sdk");
-  EXPECT_EQ(sdk.order.size(), 6U);
-  EXPECT_EQ(sdk.decimation.magnitude, 2);
-  EXPECT_EQ(sdk.threshold.min_m, 0.1F);
-  const FilterChainParams thesis = *filter_preset("thesis");
-  EXPECT_EQ(thesis.spatial.alpha, 0.4F);
-  EXPECT_EQ(thesis.temporal.persistence, 3);
+  EXPECT_STREQ(filter_domain(*filter_preset("none"), 50.0F), "none");
   EXPECT_FALSE(filter_preset("fast"));
   for (const char* name : {"none", "sdk", "thesis"}) EXPECT_EQ(check_filter_order(filter_preset(name)->order), "");
+}
+
+TEST(FilterChain, SdkPresetHasEveryViewerDefault) { test::expect_sdk_preset(*filter_preset("sdk")); }
+
+TEST(FilterChain, ThesisPresetHasEveryThesisSetting) { test::expect_thesis_preset(*filter_preset("thesis")); }
+
+// The presets as they run: sdk decimates ×2 (fx halved), thesis keeps the source's intrinsics.
+TEST(FilterChain, PresetsIntrinsics) {
+  Intrinsics source;
+  source.width = 848;
+  source.height = 480;
+  source.fx = source.fy = 418.0F;
+  source.ppx = 424.0F;
+  source.ppy = 240.0F;
+  const Intrinsics sdk = filtered_intrinsics(*filter_preset("sdk"), source);
+  EXPECT_EQ(sdk.width, 424);  // 848 / 2, already a multiple of 4
+  EXPECT_EQ(sdk.height, 240);
+  EXPECT_EQ(sdk.fx, 209.0F);
+  EXPECT_EQ(sdk.ppx, 212.0F);
+  const Intrinsics thesis = filtered_intrinsics(*filter_preset("thesis"), source);
+  EXPECT_EQ(thesis.width, 848);
+  EXPECT_EQ(thesis.fx, 418.0F);
 }
 
 TEST(FilterChain, OrderChecks) {

@@ -2,61 +2,33 @@
 // The fast (strip-interleaved, SIMD) filters against the plain references of reference.hpp,
 // bit for bit, on random images of many sizes (every width modulo the SIMD and strip widths)
 // and every option set; and the properties of issue 4: no filter but threshold turns a valid
-// pixel invalid, the result does not depend on where the data sits in memory, and a filter run
-// twice on the same input with reset state gives the same output.
+// pixel invalid, the result does not depend on where the data sits in memory (rows shifted
+// across the lanes here; every block with the buffer's base address moved in alignment_test.cpp),
+// and a filter run twice on the same input with reset state gives the same output.
 #include "hrcsense/filters.hpp"
+#include "random_images.hpp"
 #include "reference.hpp"
 
 #include <gtest/gtest.h>
 
-#include <cmath>
-#include <cstring>
-#include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hrcsense {
 namespace {
+
+using test::kFactor;
+using test::random_depth;
+using test::random_disparity;
+using test::same_bits;
 
 // Sizes around the widths of SSE2 and AVX2 vectors (4/8 floats, 8/16 uint16), of the row
 // strips and of hole filling's 64-pixel words and 2048-pixel segments (150, 2200 wide).
 const std::vector<std::pair<int, int>> kSizes{{1, 1},   {2, 1},   {1, 9},   {3, 2},   {5, 8},   {8, 8},
                                               {9, 16},  {15, 17}, {16, 7},  {17, 24}, {31, 33}, {64, 40},
                                               {83, 19}, {150, 6}, {2200, 3}};
-
-// A depth-like image: flat patches at several depths (edges between them), noise of a few
-// units, holes alone and in runs, and the values the SDK treats specially (1, values < δ).
-DepthImage random_depth(std::mt19937& rng, int w, int h) {
-  std::uniform_int_distribution<int> base(0, 3);
-  std::uniform_int_distribution<int> noise(-12, 12);
-  std::uniform_int_distribution<int> kind(0, 99);
-  DepthImage d;
-  d.resize(w, h);
-  const int bases[4] = {800, 1000, 1030, 2500};
-  int run = 0;
-  for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      const int k = kind(rng);
-      uint16_t value = static_cast<uint16_t>(bases[(u / 5 + v / 4 + base(rng) / 3) % 4] + noise(rng));
-      if (run > 0) {
-        value = 0;
-        --run;
-      } else if (k < 8) {
-        value = 0;
-      } else if (k < 11) {
-        run = k;  // a run of holes
-        value = 0;
-      } else if (k < 12) {
-        value = 1;
-      } else if (k < 13) {
-        value = static_cast<uint16_t>(2 + k % 9);  // below δ: the top→bottom pass blends it with 0
-      }
-      d.pixels[static_cast<size_t>(v) * w + u] = value;
-    }
-  }
-  return d;
-}
 
 // Every test here runs twice: forced onto the portable (SSE2) loops, and with the best the CPU
 // has (AVX2 where present), so both paths are checked against the same references.
@@ -93,25 +65,6 @@ TEST(FilterIsaHook, PortableForcesTheBaselineAndBestTakesAvx2WhereTheCpuHasIt) {
   EXPECT_EQ(portable, "scalar");
   EXPECT_EQ(best, "scalar");
 #endif
-}
-
-constexpr float kFactor = 669216.0F;  // 50 mm, fx 418.26, 1 mm units
-
-// Disparity from random depth, with a sprinkling of the floats the SDK's bit tests single out.
-DisparityImage random_disparity(std::mt19937& rng, int w, int h, bool special) {
-  DisparityImage d;
-  depth_to_disparity(random_depth(rng, w, h), kFactor, d);
-  if (special) {
-    const float values[] = {-0.0F, -5.0F, 1e-41F, std::numeric_limits<float>::infinity(),
-                            std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::quiet_NaN()};
-    std::uniform_int_distribution<size_t> where(0, d.pixels.size() - 1);
-    for (const float value : values) d.pixels[where(rng)] = value;
-  }
-  return d;
-}
-
-bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
 }
 
 std::string describe(const SpatialParams& q, int w, int h) {
@@ -304,8 +257,8 @@ TEST_P(Properties, NoFilterButThresholdInvalidatesAValidPixel) {
   }
 }
 
-// The image moved by k elements in memory: k empty columns on the left shift every row's data
-// across the SIMD lanes and strip blocks. Empty columns are inert in every block (without hole
+// Each row's data moved by k elements within the image: k empty columns on the left shift every
+// row across the SIMD lanes and strip blocks (the base address itself: alignment_test.cpp). Empty columns are inert in every block (without hole
 // filling, which would fill them), so the rest of the output must not change.
 template <typename Image>
 Image shifted(const Image& in, int k) {

@@ -3,6 +3,7 @@
 // with the SDK's ranges, and the chain's per-block timings in Pipeline::process.
 #include "hrcsense/config.hpp"
 #include "hrcsense/pipeline.hpp"
+#include "preset_expectations.hpp"
 
 #include <gtest/gtest.h>
 
@@ -32,22 +33,23 @@ void expect_error(const std::vector<std::string>& sets, const std::vector<std::s
 
 TEST(FiltersConfig, Presets) {
   EXPECT_TRUE(order_of({"filters.preset=none"}).empty());
-  const std::vector<FilterBlock> sdk{B::threshold, B::decimation, B::to_disparity, B::spatial, B::temporal, B::to_depth};
-  EXPECT_EQ(order_of({"filters.preset=sdk"}), sdk);
-  // No preset named: the RealSense Viewer's defaults (issue 4), with the SDK's option defaults.
+  expect_error({"filters.preset=fast"}, {"filters.preset", "none, sdk, thesis"});
+}
+
+// No preset named: the RealSense Viewer's defaults (issue 4), every field as filters.preset=sdk.
+TEST(FiltersConfig, SdkPresetAndTheDefaultHaveEveryViewerDefault) {
+  const Config sdk = load_config("", {"filters.preset=sdk"});
+  EXPECT_EQ(sdk.filters_preset, "sdk");
+  test::expect_sdk_preset(sdk.pipeline.filters);
   const Config defaults = load_config("", {});
   EXPECT_EQ(defaults.filters_preset, "sdk");
-  EXPECT_EQ(defaults.pipeline.filters.order, sdk);
-  EXPECT_EQ(defaults.pipeline.filters.decimation.magnitude, 2);
-  EXPECT_EQ(defaults.pipeline.filters.threshold.min_m, 0.1F);
-  EXPECT_EQ(defaults.pipeline.filters.threshold.max_m, 4.0F);
-  EXPECT_EQ(defaults.pipeline.filters.spatial.alpha, 0.5F);
-  EXPECT_EQ(defaults.pipeline.filters.temporal.persistence, 3);
+  test::expect_sdk_preset(defaults.pipeline.filters);
+}
+
+TEST(FiltersConfig, ThesisPresetHasEveryThesisSetting) {
   const Config thesis = load_config("", {"filters.preset=thesis"});
-  EXPECT_EQ(thesis.pipeline.filters.order, (std::vector<FilterBlock>{B::to_disparity, B::spatial, B::temporal, B::to_depth}));
-  EXPECT_EQ(thesis.pipeline.filters.spatial.alpha, 0.4F);
-  EXPECT_EQ(thesis.pipeline.filters.temporal.persistence, 3);
-  expect_error({"filters.preset=fast"}, {"filters.preset", "none, sdk, thesis"});
+  EXPECT_EQ(thesis.filters_preset, "thesis");
+  test::expect_thesis_preset(thesis.pipeline.filters);
 }
 
 TEST(FiltersConfig, OrderAndEnabled) {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Spatial filter: hand-worked rows in both domains (spec §5), edge preservation, iterations,
-// hole filling, properties, and equality with the plain reference in reference.hpp.
+// hole filling (every holes_fill mode 1–5, hand-worked), properties, and equality with the
+// plain reference in reference.hpp.
 #include "hrcsense/filters.hpp"
 #include "reference.hpp"
 
@@ -8,6 +9,7 @@
 
 #include <cstring>
 #include <random>
+#include <utility>
 #include <vector>
 
 namespace hrcsense {
@@ -108,6 +110,96 @@ TEST(SpatialDisparity, LastColumnTakesTheNextRowsFirstPixelAsTheSdk) {
   // L→R fills column 1; R→L: row 0's last column copies row 1's first pixel (50),
   // row 1's last column has no right neighbour and stays empty.
   EXPECT_EQ(d.pixels, (std::vector<float>{100.0F, 100.0F, 50.0F, 50.0F, 50.0F, 0.0F}));
+}
+
+// A row written as runs of (value, count), so that long rows of holes read at a glance.
+template <typename T>
+std::vector<T> runs(const std::vector<std::pair<T, int>>& parts) {
+  std::vector<T> row;
+  for (const auto& [value, count] : parts) row.insert(row.end(), static_cast<size_t>(count), value);
+  return row;
+}
+
+// holes_fill 3–5 (radius 8, 16, 255) on a hole run between 1000 mm (left) and 1500 mm (right):
+// the two sides differ by 500 > δ, so no blend crosses the run; blends among equal values
+// give the value back (0.5·x + 0.5·x + 0.5 truncates to x), and the two identical rows leave
+// the vertical passes nothing to change. Only the fill moves values.
+using DepthRuns = std::vector<std::pair<uint16_t, int>>;
+using FloatRuns = std::vector<std::pair<float, int>>;
+
+TEST(SpatialDepth, HoleFillModeThreeRadiusEightFillsSevenFromEachSide) {
+  // 20 holes in columns 1..20, W = 23.
+  DepthImage once = two_rows(runs<uint16_t>(DepthRuns{{1000, 1}, {0, 20}, {1500, 2}}));
+  spatial_filter(SpatialParams{0.5F, 20, 1, 3}, once);
+  // L→R: the counter reaches 1..7 < 8 in columns 1..7 (filled with 1000); at column 8 it is
+  // 8, not < 8, so 8 stays 0, and 9..21 see an invalid left neighbour (nothing happens).
+  // R→L (counter reset): column 21 = 1500 is valid; columns 20..14 get counts 1..7 and take
+  // 1500; 13 reaches 8 and stays 0; 12..8 see an invalid right neighbour.
+  // Left: 8 × 1000 (columns 0..7), 6 holes (8..13), 9 × 1500 (14..22).
+  const std::vector<uint16_t> expected = runs<uint16_t>(DepthRuns{{1000, 8}, {0, 6}, {1500, 9}});
+  EXPECT_EQ(first_row(once.pixels, 23), expected);
+  EXPECT_EQ(std::vector<uint16_t>(once.pixels.begin() + 23, once.pixels.end()), expected);  // second row alike
+  // Magnitude 2: the second iteration's L→R starts from column 7 (1000) and fills 8..13 with
+  // counts 1..6 < 8; column 14 (1500) is valid, 500 > δ apart, kept. The depth path fills in
+  // every iteration, so the run closes.
+  DepthImage twice = two_rows(runs<uint16_t>(DepthRuns{{1000, 1}, {0, 20}, {1500, 2}}));
+  spatial_filter(SpatialParams{0.5F, 20, 2, 3}, twice);
+  EXPECT_EQ(first_row(twice.pixels, 23), runs<uint16_t>(DepthRuns{{1000, 14}, {1500, 9}}));
+}
+
+TEST(SpatialDisparity, HoleFillModeThreeFillsSevenFromEachSideOnceAfterTheIterations) {
+  // The same row in disparity units: 100 left, 150 right (50 apart, an edge at δ 20).
+  for (const int magnitude : {1, 2}) {
+    DisparityImage d = two_float_rows(runs<float>(FloatRuns{{100.0F, 1}, {0.0F, 20}, {150.0F, 2}}));
+    spatial_filter(SpatialParams{0.5F, 20, magnitude, 3}, d);
+    // The smoothing passes change nothing (edges, holes, equal values: 0.5·150 + 0.5·150 is
+    // exactly 150). Then one fill: L→R counts 1..7 < 8 over columns 1..7 (copy 100), 8..20
+    // count on without filling; columns 21, 22 are data. R→L: columns 20..14 count 1..7 (copy
+    // 150), 13..8 count 8..13. Column 22 holds data, so the SDK's next-row quirk never shows.
+    // Unlike the depth path, a second iteration does not fill further: the fill runs once.
+    EXPECT_EQ(first_row(d.pixels, 23), runs<float>(FloatRuns{{100.0F, 8}, {0.0F, 6}, {150.0F, 9}}))
+        << "magnitude " << magnitude;
+  }
+}
+
+TEST(SpatialDepth, HoleFillModeFourRadiusSixteenFillsFifteenFromEachSide) {
+  // 40 holes in columns 1..40, W = 43.
+  DepthImage d = two_rows(runs<uint16_t>(DepthRuns{{1000, 1}, {0, 40}, {1500, 2}}));
+  spatial_filter(SpatialParams{0.5F, 20, 1, 4}, d);
+  // L→R: counts 1..15 < 16 fill columns 1..15 with 1000; 16 stays 0 (count 16).
+  // R→L: counts 1..15 fill columns 40..26 with 1500; 25 stays 0. Left: 16..25, 10 holes.
+  EXPECT_EQ(first_row(d.pixels, 43), runs<uint16_t>(DepthRuns{{1000, 16}, {0, 10}, {1500, 17}}));
+}
+
+TEST(SpatialDisparity, HoleFillModeFourFillsFifteenFromEachSide) {
+  DisparityImage d = two_float_rows(runs<float>(FloatRuns{{100.0F, 1}, {0.0F, 40}, {150.0F, 2}}));
+  spatial_filter(SpatialParams{0.5F, 20, 1, 4}, d);
+  // As the depth path with one iteration: columns 1..15 ← 100, 40..26 ← 150, 16..25 stay 0.
+  EXPECT_EQ(first_row(d.pixels, 43), runs<float>(FloatRuns{{100.0F, 16}, {0.0F, 10}, {150.0F, 17}}));
+}
+
+TEST(SpatialDepth, HoleFillModeFiveRadius255FillsUpTo254FromEachSide) {
+  // The 40-hole run of mode 4: counts 1..40 < 255, so L→R alone fills all of it with the
+  // left value; column 41 (1500) is then valid next to 1000, 500 > δ, kept. R→L finds no hole.
+  DepthImage d = two_rows(runs<uint16_t>(DepthRuns{{1000, 1}, {0, 40}, {1500, 2}}));
+  spatial_filter(SpatialParams{0.5F, 20, 1, 5}, d);
+  EXPECT_EQ(first_row(d.pixels, 43), runs<uint16_t>(DepthRuns{{1000, 41}, {1500, 2}}));
+  // "Unlimited" is 254: 600 holes in columns 1..600 (W = 603). L→R fills 1..254 (counts up to
+  // 254 < 255), 255 stays 0; R→L fills 600..347 with 1500, 346 stays 0: holes 255..346 (92) stay.
+  DepthImage wide = two_rows(runs<uint16_t>(DepthRuns{{1000, 1}, {0, 600}, {1500, 2}}));
+  spatial_filter(SpatialParams{0.5F, 20, 1, 5}, wide);
+  EXPECT_EQ(first_row(wide.pixels, 603), runs<uint16_t>(DepthRuns{{1000, 255}, {0, 92}, {1500, 256}}));
+}
+
+TEST(SpatialDisparity, HoleFillModeFiveFillsUpTo254FromEachSide) {
+  DisparityImage d = two_float_rows(runs<float>(FloatRuns{{100.0F, 1}, {0.0F, 40}, {150.0F, 2}}));
+  spatial_filter(SpatialParams{0.5F, 20, 1, 5}, d);
+  // L→R: counts 1..40 < 255 copy 100 into all 40; R→L then finds no +0.0 pixel.
+  EXPECT_EQ(first_row(d.pixels, 43), runs<float>(FloatRuns{{100.0F, 41}, {150.0F, 2}}));
+  DisparityImage wide = two_float_rows(runs<float>(FloatRuns{{100.0F, 1}, {0.0F, 600}, {150.0F, 2}}));
+  spatial_filter(SpatialParams{0.5F, 20, 1, 5}, wide);
+  // Columns 1..254 ← 100, 600..347 ← 150, 255..346 stay 0 (as the depth path).
+  EXPECT_EQ(first_row(wide.pixels, 603), runs<float>(FloatRuns{{100.0F, 255}, {0.0F, 92}, {150.0F, 256}}));
 }
 
 // Two flat-ish halves a step apart: nothing crosses a step larger than δ.

@@ -229,6 +229,44 @@ TEST(Scenes, SensorKeysAndMaterialsAreRead) {
             std::string::npos);
 }
 
+// cell-ur5: a D435 at its best depth mode, 848x480 (depth and colour), over a UR5 given by
+// `robot.model: ur5`, searched as capsules and rendered as a static object.
+TEST(Scenes, CellUr5IsAUr5CellSeenAt848x480) {
+  const Config config = load_config(scene_path("cell-ur5.yaml"), {"sim.noise=false"});
+  const Simulator sim = make_simulator(config);
+  Frame f;
+  sim.render(0, f);
+  EXPECT_EQ(f.depth.width, 848);
+  EXPECT_EQ(f.depth.height, 480);
+  EXPECT_NEAR(f.intrinsics.fx, 418.265F, 1e-3F);  // the D435i's 848x480 depth intrinsics
+  ASSERT_TRUE(f.color);
+  EXPECT_EQ(f.color->width, 848);
+  EXPECT_EQ(f.color->height, 480);
+  EXPECT_EQ(config.robot_model, "ur5");
+  EXPECT_GT(sim.robot.capsules.size(), 1U) << "an arm of capsules, not one point";
+  const auto robot = std::find_if(sim.scene.objects.begin(), sim.scene.objects.end(),
+                                  [](const SceneObject& o) { return o.name == "robot"; });
+  ASSERT_NE(robot, sim.scene.objects.end());
+  EXPECT_TRUE(robot->is_static);
+  EXPECT_GT(robot->shapes.size(), 1U);
+}
+
+// clutter: several people at once and the surfaces a D435 loses depth on.
+TEST(Scenes, ClutterHasThreeWalkingPeopleADarkAndAShinyObject) {
+  const Simulator sim = make_simulator(load_config(scene_path("clutter.yaml"), {}));
+  size_t people = 0;
+  bool dark = false;
+  bool shiny = false;
+  for (const SceneObject& o : sim.scene.objects) {
+    people += !o.is_static && !o.path.empty() && o.name.rfind("person", 0) == 0 ? 1U : 0U;
+    dark = dark || o.material.dark;
+    shiny = shiny || o.material.shiny;
+  }
+  EXPECT_GE(people, 3U);
+  EXPECT_TRUE(dark) << "no object with material: [dark]";
+  EXPECT_TRUE(shiny) << "no object with material: [shiny]";
+}
+
 /// Valid share of a real D435 depth frame (the Depth Quality Tool's fill rate, whole image).
 double real_fill_rate(const std::string& file) {
   DepthImage depth;

@@ -25,21 +25,7 @@ SceneObject colored(Shape shape, bool is_static, std::optional<Rgb> color) {
   return o;
 }
 
-Shape wall_at(float z_m) {
-  Shape s;
-  s.type = Shape::Type::plane;
-  s.point = {0, 0, z_m};
-  s.normal = {0, 0, -1};
-  return s;
-}
-
-Shape ball(const Eigen::Vector3f& centre, float radius_m) {
-  Shape s;
-  s.type = Shape::Type::sphere;
-  s.point = centre;
-  s.radius_m = radius_m;
-  return s;
-}
+Shape wall_at(float z_m) { return Shape::plane({0, 0, z_m}, {0, 0, -1}); }
 
 Rgb pixel(const ColorImage& image, size_t i) { return {image.rgb[3 * i], image.rgb[3 * i + 1], image.rgb[3 * i + 2]}; }
 
@@ -65,7 +51,7 @@ Simulator ball_scene() {
   Simulator sim;
   sim.params.noise = false;
   sim.scene.objects = {colored(wall_at(2.0F), true, kWallColor),
-                       colored(ball({0.1F, -0.05F, 1.0F}, 0.02F), false, kBallColor)};
+                       colored(Shape::sphere({0.1F, -0.05F, 1.0F}, 0.02F), false, kBallColor)};
   return sim;
 }
 
@@ -140,6 +126,38 @@ TEST(SimColor, APointLandsWhereTheExtrinsicsProjectIt) {
   EXPECT_NEAR(sum.y() / static_cast<double>(depth_count), 217.327, 0.25);
 }
 
+TEST(SimColor, DefaultExtrinsicsAreTheTestD435isAndTheIntrinsicsTheColourCameras) {
+  // docs/SIMULATOR.md: rotation identity, translation (15.08, 0.0046, 0.17) mm, the test D435i's.
+  const std::array<float, 3> t_m{0.01508F, 0.0000046F, 0.00017F};
+  const Eigen::Vector3f defaults_m[] = {SimParams{}.color_translation_m, load_config("", {}).sim.color_translation_m};
+  for (const Eigen::Vector3f& default_m : defaults_m) {
+    EXPECT_FLOAT_EQ(default_m.x(), t_m[0]);
+    EXPECT_FLOAT_EQ(default_m.y(), t_m[1]);
+    EXPECT_FLOAT_EQ(default_m.z(), t_m[2]);
+  }
+  const Simulator sim = ball_scene();  // the default extrinsics
+  Frame f;
+  sim.render(0, f);
+  ASSERT_TRUE(f.color && f.depth_to_color);
+  EXPECT_EQ(f.depth_to_color->rotation, (std::array<float, 9>{1, 0, 0, 0, 1, 0, 0, 0, 1}));
+  EXPECT_EQ(f.depth_to_color->translation_m, t_m);
+  // The colour camera has its own intrinsics, not the depth camera's (848x480 both).
+  EXPECT_NEAR(f.color_intrinsics.fx, 605.393F, 1e-3F);
+  EXPECT_NEAR(f.color_intrinsics.ppx, 428.480F, 1e-3F);
+  EXPECT_EQ(f.color_intrinsics.model, Distortion::inverse_brown_conrady);
+  EXPECT_NEAR(f.intrinsics.fx, 418.265F, 1e-3F);
+  EXPECT_NEAR(f.intrinsics.ppx, 424.158F, 1e-3F);
+  EXPECT_EQ(f.intrinsics.model, Distortion::brown_conrady);
+  // By hand: the ball's centre is (0.11508, −0.0499954, 1.00017) in the colour frame, so at
+  // u = 605.3933·0.11508/1.00017 + 428.48 = 498.137, v = 605.6133·(−0.0499954)/1.00017 + 241.10
+  // = 210.827; 9.1 px right of where it would be without the 15 mm.
+  size_t count = 0;
+  const Eigen::Vector2d c = centroid(*f.color, kBallColor, count);
+  ASSERT_GT(count, 0U);
+  EXPECT_NEAR(c.x(), 498.137, 0.25);
+  EXPECT_NEAR(c.y(), 210.827, 0.25);
+}
+
 TEST(SimColor, PixelsHaveTheirObjectsFlatColourAndDefaultsComeFromThePalette) {
   Simulator sim = ball_scene();
   Frame f;
@@ -158,7 +176,7 @@ TEST(SimColor, PixelsHaveTheirObjectsFlatColourAndDefaultsComeFromThePalette) {
   // Without a colour an object takes the palette's entry for its index; with nothing hit, black.
   sim.scene.objects[0].color_rgb.reset();
   sim.scene.objects[1].color_rgb.reset();
-  sim.scene.objects[0].shapes = {ball({-0.3F, 0.0F, 1.0F}, 0.05F)};
+  sim.scene.objects[0].shapes = {Shape::sphere({-0.3F, 0.0F, 1.0F}, 0.05F)};
   sim.render(0, f);
   size_t first = 0;
   size_t second = 0;

@@ -2,49 +2,19 @@
 // Tests of the simulated depth camera against hand-computed geometry and its noise model.
 
 #include "hrcsense/camera.hpp"
+#include "hrcsense/config.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/sim.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace hrcsense {
 namespace {
-
-Shape plane(const Eigen::Vector3f& point, const Eigen::Vector3f& normal) {
-  Shape s;
-  s.type = Shape::Type::plane;
-  s.point = point;
-  s.normal = normal;
-  return s;
-}
-
-Shape box(const Eigen::Vector3f& min, const Eigen::Vector3f& max) {
-  Shape s;
-  s.type = Shape::Type::box;
-  s.min = min;
-  s.max = max;
-  return s;
-}
-
-Shape sphere(const Eigen::Vector3f& centre, float radius_m) {
-  Shape s;
-  s.type = Shape::Type::sphere;
-  s.point = centre;
-  s.radius_m = radius_m;
-  return s;
-}
-
-Shape capsule(const Eigen::Vector3f& a, const Eigen::Vector3f& b, float radius_m) {
-  Shape s;
-  s.type = Shape::Type::capsule;
-  s.a = a;
-  s.b = b;
-  s.radius_m = radius_m;
-  return s;
-}
 
 SceneObject object(std::vector<Shape> shapes, bool is_static) {
   SceneObject o;
@@ -61,7 +31,7 @@ Simulator make_sim(bool noise) {
 }
 
 /// The wall z = z_m facing the camera at the origin.
-SceneObject wall(float z_m) { return object({plane({0, 0, z_m}, {0, 0, -1})}, true); }
+SceneObject wall(float z_m) { return object({Shape::plane({0, 0, z_m}, {0, 0, -1})}, true); }
 
 Capsule robot_point(const Eigen::Vector3f& p) { return Capsule{p, p, 0.0F, 0}; }
 
@@ -71,6 +41,65 @@ size_t count_label(const Frame& f, uint16_t label) {
   size_t n = 0;
   for (const uint16_t l : f.truth->labels) n += l == label ? 1 : 0;
   return n;
+}
+
+// The defaults table of docs/SIMULATOR.md ("The sensor model and its defaults"), number for
+// number: that table and this check change together, and neither changes to make a test pass.
+void expect_documented_defaults(const SimParams& p, const std::string& where) {
+  SCOPED_TRACE(where);
+  EXPECT_EQ(p.width, 848);  // the table's figures are for 848x480
+  EXPECT_EQ(p.height, 480);
+  EXPECT_TRUE(p.noise);
+  EXPECT_FLOAT_EQ(p.disparity_noise_px, 0.08F);
+  EXPECT_FLOAT_EQ(p.disparity_step_px, 1.0F / 32.0F);
+  EXPECT_FLOAT_EQ(p.depth_scale_m, 0.001F);  // depth rounded to 1 mm
+  EXPECT_FLOAT_EQ(p.baseline_mm, 49.864F);
+  EXPECT_TRUE(p.left_band);
+  EXPECT_TRUE(p.occlusion_shadows);
+  EXPECT_FLOAT_EQ(p.max_disparity_px, 110.0F);
+  EXPECT_FLOAT_EQ(p.min_range_m, 0.0F);
+  EXPECT_FLOAT_EQ(p.edge_jump_px, 1.5F);
+  EXPECT_FLOAT_EQ(p.edge_dropout, 0.25F);
+  EXPECT_FLOAT_EQ(p.flying_pixels, 0.15F);
+  EXPECT_FLOAT_EQ(p.dark_dropout, 0.6F);
+  EXPECT_FLOAT_EQ(p.shiny_dropout, 0.35F);
+  EXPECT_FLOAT_EQ(p.low_texture_dropout, 0.5F);
+  EXPECT_EQ(p.material_cell_px, 4);
+  EXPECT_FLOAT_EQ(p.speckle, 0.002F);
+  EXPECT_FLOAT_EQ(p.correlated_noise_px, 0.0F);  // off
+  EXPECT_EQ(p.correlated_cell_px, 32);
+}
+
+size_t valid_pixels(const Frame& f) {
+  const auto valid = [](uint16_t raw) { return raw != 0; };
+  return static_cast<size_t>(std::count_if(f.depth.pixels.begin(), f.depth.pixels.end(), valid));
+}
+
+TEST(Simulator, DefaultsAreTheOnesDocsSimulatorMdPins) {
+  expect_documented_defaults(SimParams{}, "SimParams{}");
+  expect_documented_defaults(load_config("", {}).sim, "sim.* keys of an empty configuration");
+  // What the table's numbers rest on: fx = 418.265 px at 848x480, B = 49.864 mm, s = 0.08 px.
+  EXPECT_NEAR(d435_depth_intrinsics(848, 480)->fx, 418.265F, 1e-3F);
+  EXPECT_FLOAT_EQ(kD435BaselineMm, 49.864F);
+  EXPECT_FLOAT_EQ(kD435SubpixelRmsPx, 0.08F);
+  // The minimum range fx·B/110 the table gives per resolution: a wall 3 % nearer has no depth
+  // at all, one 3 % farther has depth right of its left band.
+  struct Mode {
+    int width, height;
+    float min_range_m;
+  };
+  for (const Mode mode : {Mode{848, 480, 0.190F}, Mode{1280, 720, 0.286F}, Mode{424, 240, 0.095F}}) {
+    Simulator sim = make_sim(false);
+    sim.params.width = mode.width;
+    sim.params.height = mode.height;
+    Frame f;
+    sim.scene.objects = {wall(0.97F * mode.min_range_m)};
+    sim.render(0, f);
+    EXPECT_EQ(valid_pixels(f), 0U) << mode.width << "x" << mode.height;
+    sim.scene.objects = {wall(1.03F * mode.min_range_m)};
+    sim.render(0, f);
+    EXPECT_GT(valid_pixels(f), f.depth.pixels.size() / 2) << mode.width << "x" << mode.height;
+  }
 }
 
 TEST(Simulator, NoiseFreePlaneAtOneMetreReadsExactly1000) {
@@ -106,7 +135,7 @@ TEST(Simulator, RotatedCameraSeesWallAlongItsOpticalAxis) {
   Simulator sim = make_sim(false);
   sim.T_base_camera = Pose(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()));
   sim.T_base_camera.translation() = Eigen::Vector3d(-0.5, 0.3, 0.1);
-  sim.scene.objects.push_back(object({plane({1.5F, 0, 0}, {-1, 0, 0})}, true));
+  sim.scene.objects.push_back(object({Shape::plane({1.5F, 0, 0}, {-1, 0, 0})}, true));
   sim.params.left_band = false;  // every pixel, the left band included
   Frame f;
   sim.render(0, f);
@@ -117,7 +146,7 @@ TEST(Simulator, BoxVertexLandsWhereProjectionPredicts) {
   // Camera moved (rotation identity keeps the front face fronto-parallel, so its depth is exact).
   Simulator sim = make_sim(false);
   sim.T_base_camera.translation() = Eigen::Vector3d(0.1, -0.05, -0.3);
-  sim.scene.objects.push_back(object({box({0.2F, 0.1F, 1.2F}, {0.4F, 0.3F, 1.5F})}, false));
+  sim.scene.objects.push_back(object({Shape::box({0.2F, 0.1F, 1.2F}, {0.4F, 0.3F, 1.5F})}, false));
   Frame f;
   sim.render(0, f);
   // Front top left vertex in the camera frame: (0.1, 0.15, 1.5).
@@ -173,9 +202,9 @@ TEST(Simulator, TimestampsAreIndexOverFps) {
 TEST(Simulator, LabelsCountNonStaticObjectsInSceneOrder) {
   Simulator sim = make_sim(false);
   sim.scene.objects.push_back(wall(3.0F));
-  sim.scene.objects.push_back(object({sphere({-0.5F, 0, 2}, 0.2F)}, false));
-  sim.scene.objects.push_back(object({box({-0.1F, -0.1F, 2}, {0.1F, 0.1F, 2.2F})}, true));
-  sim.scene.objects.push_back(object({sphere({0.5F, 0, 2}, 0.2F)}, false));
+  sim.scene.objects.push_back(object({Shape::sphere({-0.5F, 0, 2}, 0.2F)}, false));
+  sim.scene.objects.push_back(object({Shape::box({-0.1F, -0.1F, 2}, {0.1F, 0.1F, 2.2F})}, true));
+  sim.scene.objects.push_back(object({Shape::sphere({0.5F, 0, 2}, 0.2F)}, false));
   Frame f;
   sim.render(0, f);
   const auto label_at = [&](float x, float y, float z) {
@@ -198,7 +227,7 @@ TEST(Simulator, WaypointPathInterpolatesAndHoldsAtTheEnds) {
   sim.params.fps = 10.0;
   const Eigen::Vector3f p(0.0F, 0.0F, 0.5F);
   sim.robot.capsules.push_back(robot_point(p));
-  SceneObject ball = object({sphere({-0.4F, 0.1F, 2.0F}, 0.1F)}, false);
+  SceneObject ball = object({Shape::sphere({-0.4F, 0.1F, 2.0F}, 0.1F)}, false);
   ball.path = {{1.0, {0, 0, 0}}, {2.0, {0.8F, 0, 0}}, {3.0, {0.8F, -0.2F, 0}}};
   sim.scene.objects.push_back(ball);
   const auto expect_centre = [&](int64_t index, const Eigen::Vector3f& centre) {
@@ -223,7 +252,7 @@ TEST(Simulator, WaypointPathInterpolatesAndHoldsAtTheEnds) {
 TEST(Simulator, ObjectsExistFromFirstToLastFrame) {
   Simulator sim = make_sim(false);
   sim.robot.capsules.push_back(robot_point({0, 0, 0.5F}));
-  SceneObject ball = object({sphere({0, 0, 2}, 0.2F)}, false);
+  SceneObject ball = object({Shape::sphere({0, 0, 2}, 0.2F)}, false);
   ball.first_frame = 5;
   ball.last_frame = 7;
   sim.scene.objects.push_back(ball);
@@ -247,7 +276,7 @@ TEST(Simulator, SphereContactMatchesAnalyticDistance) {
   const float r = 0.2F;
   sim.robot.capsules.push_back(robot_point(p));
   sim.scene.objects.push_back(wall(3.0F));
-  sim.scene.objects.push_back(object({sphere(c, r)}, false));
+  sim.scene.objects.push_back(object({Shape::sphere(c, r)}, false));
   Frame f;
   sim.render(0, f);
   const double expected_m = (c.cast<double>() - p.cast<double>()).norm() - r;
@@ -272,7 +301,7 @@ TEST(Simulator, AnalyticContactOfCapsulesAndBoxes) {
   Simulator sim = make_sim(false);
   sim.robot.capsules.push_back(Capsule{{0, -1, 1.5F}, {0, 1, 1.5F}, 0.05F, 3});
   // A horizontal capsule 0.5 m behind a vertical robot capsule: 0.5 − 0.1 − 0.05.
-  sim.scene.objects.push_back(object({capsule({-0.5F, 0, 2}, {0.5F, 0, 2}, 0.1F)}, false));
+  sim.scene.objects.push_back(object({Shape::capsule({-0.5F, 0, 2}, {0.5F, 0, 2}, 0.1F)}, false));
   Frame f;
   sim.render(0, f);
   ASSERT_TRUE(f.truth->analytic_contact.valid);
@@ -282,7 +311,7 @@ TEST(Simulator, AnalyticContactOfCapsulesAndBoxes) {
 
   // A box against a robot segment parallel to its top front edge (y = 0.1, z = 1.9).
   sim.robot.capsules = {Capsule{{-1, 0.5F, 1.5F}, {1, 0.5F, 1.5F}, 0.02F, 0}};
-  sim.scene.objects = {object({box({-0.1F, -0.1F, 1.9F}, {0.1F, 0.1F, 2.1F})}, false)};
+  sim.scene.objects = {object({Shape::box({-0.1F, -0.1F, 1.9F}, {0.1F, 0.1F, 2.1F})}, false)};
   sim.render(0, f);
   ASSERT_TRUE(f.truth->analytic_contact.valid);
   EXPECT_NEAR(f.truth->analytic_contact.distance_m, std::sqrt(0.32) - 0.02, 1e-5);
@@ -298,7 +327,7 @@ TEST(Simulator, RenderingAgainReusesBuffers) {
   Simulator sim = make_sim(true);
   sim.robot.capsules.push_back(robot_point({0, 0, 0.5F}));
   sim.scene.objects.push_back(wall(2.0F));
-  sim.scene.objects.push_back(object({sphere({0, 0, 1.5F}, 0.3F)}, false));
+  sim.scene.objects.push_back(object({Shape::sphere({0, 0, 1.5F}, 0.3F)}, false));
   Frame f;
   sim.render(0, f);
   const uint16_t* depth = f.depth.pixels.data();
