@@ -56,6 +56,22 @@ void cell_keys(const CellGrid& g, int height, const float* x, const float* y, co
   }
 }
 
+// Visits points [0, n) as kLanes slices in turn, point by point: visit(lane, i). Consecutive
+// visits then update the counters of different slices, which do not wait on each other, while
+// within a slice the order is kept (so sorts built on it are stable).
+template <typename Visit>
+void for_each_in_slices(size_t n, Visit&& visit) {
+  size_t begin[kLanes + 1];
+  for (size_t lane = 0; lane <= kLanes; ++lane) begin[lane] = lane * n / kLanes;
+  const size_t common = begin[1] - begin[0];  // the shortest slice: the first one
+  for (size_t j = 0; j < common; ++j) {
+    for (size_t lane = 0; lane < kLanes; ++lane) visit(lane, begin[lane] + j);
+  }
+  for (size_t lane = 0; lane < kLanes; ++lane) {
+    for (size_t i = begin[lane] + common; i < begin[lane + 1]; ++i) visit(lane, i);
+  }
+}
+
 CellGrid make_grid(const Box& box, int height) {
   CellGrid g;
   g.bounds = box;
@@ -139,21 +155,9 @@ void Octree::sort_by_counting(const float* x, const float* y, const float* z, si
   uint16_t* keys = cell_keys_.data();
   cell_keys(grid_, height_, x, y, z, n, keys);
 
-  size_t begin[kLanes + 1];
-  for (size_t lane = 0; lane <= kLanes; ++lane) begin[lane] = lane * n / kLanes;
-  const size_t common = begin[1] - begin[0];  // the shortest slice: the first one
   counts_.assign(kLanes * cells, 0U);
   uint32_t* counts = counts_.data();
-  // The slices one point at a time up to the shortest one's length, then their remaining points.
-  auto for_each_point = [&](auto&& visit) {
-    for (size_t j = 0; j < common; ++j) {
-      for (size_t lane = 0; lane < kLanes; ++lane) visit(counts + lane * cells, begin[lane] + j);
-    }
-    for (size_t lane = 0; lane < kLanes; ++lane) {
-      for (size_t i = begin[lane] + common; i < begin[lane + 1]; ++i) visit(counts + lane * cells, i);
-    }
-  };
-  for_each_point([keys](uint32_t* lane_counts, size_t i) { ++lane_counts[keys[i]]; });
+  for_each_in_slices(n, [=](size_t lane, size_t i) { ++counts[lane * cells + keys[i]]; });
   cell_first_.resize(cells + 1);
   uint32_t sum = 0;
   for (size_t morton = 0; morton < cells; ++morton) {
@@ -167,19 +171,22 @@ void Octree::sort_by_counting(const float* x, const float* y, const float* z, si
   }
   cell_first_[cells] = sum;
   uint32_t* order = order_.data();
-  for_each_point([keys, order](uint32_t* lane_counts, size_t i) {
-    order[lane_counts[keys[i]]++] = static_cast<uint32_t>(i);
-  });
+  for_each_in_slices(n, [=](size_t lane, size_t i) { order[counts[lane * cells + keys[i]]++] = static_cast<uint32_t>(i); });
 }
 
-// LSD radix sort of (Morton key, order) in passes of at most 12 bits; the last pass also moves
+// LSD radix sort of (Morton key, order) in passes of at most 12 bits (fewer for small clouds); the last pass also moves
 // the coordinates into sorted order, which saves a separate gather pass.
 void Octree::sort_by_radix(const float* x, const float* y, const float* z, size_t n) {
   keys_.resize(n);
   morton_keys(grid_, x, y, z, n, keys_.data());
   for (size_t i = 0; i < n; ++i) order_[i] = static_cast<uint32_t>(i);
+  // Digits of about log2(n) bits: one pass over 4096 counters costs more than two passes over
+  // 64 when there are only a hundred points.
   const int total_bits = 3 * height_;
-  const int passes = (total_bits + 11) / 12;
+  int log2_n = 0;
+  while ((size_t{1} << log2_n) < n) ++log2_n;
+  const int max_digit_bits = std::clamp(log2_n, 4, 12);
+  const int passes = (total_bits + max_digit_bits - 1) / max_digit_bits;
   const int digit_bits = (total_bits + passes - 1) / passes;
   const uint32_t digit_mask = (1U << digit_bits) - 1U;
   keys_scratch_.resize(n);
