@@ -72,7 +72,7 @@ void store_strip_sse2(const float* strip, int w, float* rows) {
 }
 
 // 8x8 blocks of uint16: three rounds of interleaving; the transpose is its own inverse.
-void transpose8x8(__m128i r[8]) {
+inline void transpose8x8(__m128i r[8]) {
   __m128i a[8], c[8];
   for (int i = 0; i < 8; i += 2) {
     a[i] = _mm_unpacklo_epi16(r[i], r[i + 1]);
