@@ -280,6 +280,43 @@ const BackendCase kBackends[] = {
 INSTANTIATE_TEST_SUITE_P(Proximity, Backends, ::testing::ValuesIn(kBackends),
                          [](const ::testing::TestParamInfo<BackendCase>& info) { return std::string(info.param.name); });
 
+// The second thread takes the upper half of clouds from 2^18 points on (src/proximity/brute.cpp),
+// sizes the random suite above never reaches. The same contact as one thread, bit for bit: a
+// minimum in either half, and an exact tie across the halves (the lower index wins).
+TEST(ProximitySearch, TwoThreadsSplitLargeCloudsWithTheSameContact) {
+  constexpr size_t kPoints = 300000;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> coord(-1.0F, 1.0F);
+  RobotModel robot;
+  for (int link = 0; link < 8; ++link) robot.capsules.push_back(random_capsule(rng, link % 4 == 0, link));
+  const Eigen::Vector3f near_point = robot.capsules[3].a + Eigen::Vector3f(0.0F, 0.0F, robot.capsules[3].radius_m + 0.01F);
+  ProximitySearch one(ProximityBackend::brute, {8, 1});
+  ProximitySearch two(ProximityBackend::brute, {8, 2});
+  for (const char* layout : {"random", "nearest in the lower half", "nearest in the upper half", "tie across the halves"}) {
+    PointCloud cloud;
+    for (size_t i = 0; i < kPoints; ++i) cloud.push_back(coord(rng), coord(rng), coord(rng) + 2.5F, static_cast<uint32_t>(i));
+    const std::string kind = layout;
+    auto place = [&](size_t i) {
+      cloud.x[i] = near_point.x();
+      cloud.y[i] = near_point.y();
+      cloud.z[i] = near_point.z();
+    };
+    if (kind == "nearest in the lower half" || kind == "tie across the halves") place(1000);
+    if (kind == "nearest in the upper half" || kind == "tie across the halves") place(kPoints - 1000);
+    const Contact a = one.closest(cloud, PointCloud{}, robot);
+    const Contact b = two.closest(cloud, PointCloud{}, robot);
+    ASSERT_TRUE(a.valid && b.valid) << kind;
+    EXPECT_EQ(a.distance_m, b.distance_m) << kind;
+    EXPECT_EQ(a.pixel, b.pixel) << kind;
+    EXPECT_EQ(a.robot_link, b.robot_link) << kind;
+    EXPECT_NEAR(b.distance_m, reference_contact(cloud, robot).distance, 1e-5) << kind;
+    const bool lower_wins = kind == "nearest in the lower half" || kind == "tie across the halves";
+    if (kind != "random") {
+      EXPECT_EQ(b.pixel, lower_wins ? 1000U : kPoints - 1000) << kind;
+    }
+  }
+}
+
 TEST(ProximitySearch, NamesRoundTrip) {
   for (const char* name : {"brute", "kdtree", "octree", "auto"}) {
     const std::optional<ProximityBackend> backend = parse_proximity_backend(name);
