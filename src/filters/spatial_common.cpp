@@ -21,20 +21,23 @@ void grow(std::vector<T>& buffer, size_t size) {
   if (buffer.size() < size) buffer.resize(size);
 }
 
+// Columns [u, w) one value at a time: what the vector loops leave over (all of them where the
+// build has no SSE2).
 template <typename T>
-void load_strip_plain(const T* rows, int w, T* strip) {
-  for (int u = 0; u < w; ++u)
+void load_columns(const T* rows, int u, int w, T* strip) {
+  for (; u < w; ++u)
     for (int g = 0; g < kStrip; ++g) strip[u * kStrip + g] = rows[static_cast<ptrdiff_t>(g) * w + u];
 }
 
 template <typename T>
-void store_strip_plain(const T* strip, int w, T* rows) {
-  for (int u = 0; u < w; ++u)
+void store_columns(const T* strip, int u, int w, T* rows) {
+  for (; u < w; ++u)
     for (int g = 0; g < kStrip; ++g) rows[static_cast<ptrdiff_t>(g) * w + u] = strip[u * kStrip + g];
 }
 
 #if defined(__SSE2__)
-void load_strip_sse2(const float* rows, int w, float* strip) {
+// Whole 4x4 (float) or 8x8 (uint16) blocks of columns; returns the first column left over.
+int load_blocks(const float* rows, int w, float* strip) {
   int u = 0;
   for (; u + 4 <= w; u += 4) {
     for (int g = 0; g < kStrip; g += 4) {
@@ -48,11 +51,10 @@ void load_strip_sse2(const float* rows, int w, float* strip) {
       _mm_storeu_ps(s + 3 * kStrip, d);
     }
   }
-  for (; u < w; ++u)
-    for (int g = 0; g < kStrip; ++g) strip[u * kStrip + g] = rows[static_cast<ptrdiff_t>(g) * w + u];
+  return u;
 }
 
-void store_strip_sse2(const float* strip, int w, float* rows) {
+int store_blocks(const float* strip, int w, float* rows) {
   int u = 0;
   for (; u + 4 <= w; u += 4) {
     for (int g = 0; g < kStrip; g += 4) {
@@ -67,8 +69,7 @@ void store_strip_sse2(const float* strip, int w, float* rows) {
       _mm_storeu_ps(r + 3 * w, d);
     }
   }
-  for (; u < w; ++u)
-    for (int g = 0; g < kStrip; ++g) rows[static_cast<ptrdiff_t>(g) * w + u] = strip[u * kStrip + g];
+  return u;
 }
 
 // 8x8 blocks of uint16: three rounds of interleaving; the transpose is its own inverse.
@@ -90,7 +91,7 @@ inline void transpose8x8(__m128i r[8]) {
   }
 }
 
-void load_strip_sse2(const uint16_t* rows, int w, uint16_t* strip) {
+int load_blocks(const uint16_t* rows, int w, uint16_t* strip) {
   static_assert(kStrip % 8 == 0, "strips of whole 8x8 blocks");
   int u = 0;
   for (; u + 8 <= w; u += 8) {
@@ -103,11 +104,10 @@ void load_strip_sse2(const uint16_t* rows, int w, uint16_t* strip) {
         _mm_storeu_si128(reinterpret_cast<__m128i*>(strip + static_cast<ptrdiff_t>(u + i) * kStrip + g), r[i]);
     }
   }
-  for (; u < w; ++u)
-    for (int g = 0; g < kStrip; ++g) strip[u * kStrip + g] = rows[static_cast<ptrdiff_t>(g) * w + u];
+  return u;
 }
 
-void store_strip_sse2(const uint16_t* strip, int w, uint16_t* rows) {
+int store_blocks(const uint16_t* strip, int w, uint16_t* rows) {
   int u = 0;
   for (; u + 8 <= w; u += 8) {
     for (int g = 0; g < kStrip; g += 8) {
@@ -119,9 +119,13 @@ void store_strip_sse2(const uint16_t* strip, int w, uint16_t* rows) {
         _mm_storeu_si128(reinterpret_cast<__m128i*>(rows + static_cast<ptrdiff_t>(g + i) * w + u), r[i]);
     }
   }
-  for (; u < w; ++u)
-    for (int g = 0; g < kStrip; ++g) rows[static_cast<ptrdiff_t>(g) * w + u] = strip[u * kStrip + g];
+  return u;
 }
+#else
+template <typename T>
+int load_blocks(const T*, int, T*) { return 0; }
+template <typename T>
+int store_blocks(const T*, int, T*) { return 0; }
 #endif
 
 }  // namespace
@@ -140,17 +144,18 @@ Scratch<float> disparity_scratch(SpatialScratch& s, int width) {
   return {s.disparity_strip.data(), s.disparity_line.data(), nullptr};
 }
 
-#if defined(__SSE2__)
-void load_strip(const float* rows, int w, float* strip) { load_strip_sse2(rows, w, strip); }
-void store_strip(const float* strip, int w, float* rows) { store_strip_sse2(strip, w, rows); }
-void load_strip(const uint16_t* rows, int w, uint16_t* strip) { load_strip_sse2(rows, w, strip); }
-void store_strip(const uint16_t* strip, int w, uint16_t* rows) { store_strip_sse2(strip, w, rows); }
-#else
-void load_strip(const float* rows, int w, float* strip) { load_strip_plain(rows, w, strip); }
-void store_strip(const float* strip, int w, float* rows) { store_strip_plain(strip, w, rows); }
-void load_strip(const uint16_t* rows, int w, uint16_t* strip) { load_strip_plain(rows, w, strip); }
-void store_strip(const uint16_t* strip, int w, uint16_t* rows) { store_strip_plain(strip, w, rows); }
-#endif
+void load_strip(const float* rows, int w, float* strip) {
+  load_columns(rows, load_blocks(rows, w, strip), w, strip);
+}
+void store_strip(const float* strip, int w, float* rows) {
+  store_columns(strip, store_blocks(strip, w, rows), w, rows);
+}
+void load_strip(const uint16_t* rows, int w, uint16_t* strip) {
+  load_columns(rows, load_blocks(rows, w, strip), w, strip);
+}
+void store_strip(const uint16_t* strip, int w, uint16_t* rows) {
+  store_columns(strip, store_blocks(strip, w, rows), w, rows);
+}
 
 }  // namespace filters_detail
 

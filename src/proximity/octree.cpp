@@ -174,7 +174,8 @@ void Octree::sort_by_counting(const float* x, const float* y, const float* z, si
   for_each_in_slices(n, [=](size_t lane, size_t i) { order[counts[lane * cells + keys[i]]++] = static_cast<uint32_t>(i); });
 }
 
-// LSD radix sort of (Morton key, order) in passes of at most 12 bits (fewer for small clouds); the last pass also moves
+// LSD radix sort of (Morton key, order) in passes of at most 12 bits (fewer for small clouds);
+// the last pass also moves
 // the coordinates into sorted order, which saves a separate gather pass.
 void Octree::sort_by_radix(const float* x, const float* y, const float* z, size_t n) {
   keys_.resize(n);

@@ -37,6 +37,15 @@ std::string capsule_problem(const LinkCapsule& capsule, const std::string& field
   return {};
 }
 
+// The first bad capsule of a list, named field[i], or "".
+std::string list_problem(const std::vector<LinkCapsule>& capsules, const std::string& field) {
+  for (size_t i = 0; i < capsules.size(); ++i) {
+    std::string problem = capsule_problem(capsules[i], field + "[" + std::to_string(i) + "]");
+    if (!problem.empty()) return problem;
+  }
+  return {};
+}
+
 Capsule moved(const LinkCapsule& capsule, const Pose& T_frame_link, double padding_m, int link) {
   Capsule out;
   out.a = (T_frame_link * capsule.a_m).cast<float>();
@@ -44,6 +53,29 @@ Capsule moved(const LinkCapsule& capsule, const Pose& T_frame_link, double paddi
   out.radius_m = static_cast<float>(capsule.radius_m + padding_m);
   out.link = link;
   return out;
+}
+
+enum class Geometry { collision, visual };
+
+// Every link's capsules (`visual`: its visual shapes where it has any) and the tool's, moved by
+// forward kinematics into `frame`, radius + padding_m. Reuses out's buffer.
+void place_capsules(const RobotDescription& description, const JointAngles& joints_rad, double padding_m,
+                    BaseFrame frame, Geometry geometry, RobotModel& out) {
+  const LinkFrames frames = forward_kinematics(description, joints_rad);
+  const Pose T_out_base_link = T_frame_base_link(frame);
+  out.capsules.clear();
+  for (int link = 0; link < kArmLinkCount; ++link) {
+    const size_t i = static_cast<size_t>(link);
+    const bool visual = geometry == Geometry::visual && !description.visual[i].empty();
+    const Pose T_frame_link = T_out_base_link * frames.T_base_link_link[i];
+    for (const LinkCapsule& capsule : visual ? description.visual[i] : description.links[i]) {
+      out.capsules.push_back(moved(capsule, T_frame_link, padding_m, link));
+    }
+  }
+  const Pose T_frame_flange = T_out_base_link * frames.T_base_link_link[kArmLinkCount - 1];
+  for (const LinkCapsule& capsule : description.tool) {
+    out.capsules.push_back(moved(capsule, T_frame_flange, padding_m, kToolLink));
+  }
 }
 
 }  // namespace
@@ -74,23 +106,14 @@ std::string description_problem(const RobotDescription& description) {
   }
   size_t count = description.tool.size();
   for (int link = 0; link < kArmLinkCount; ++link) {
-    const std::vector<LinkCapsule>& capsules = description.links[static_cast<size_t>(link)];
-    for (size_t i = 0; i < capsules.size(); ++i) {
-      const std::string problem =
-          capsule_problem(capsules[i], "links." + link_name(link) + "[" + std::to_string(i) + "]");
-      if (!problem.empty()) return problem;
-    }
-    count += capsules.size();
-    const std::vector<LinkCapsule>& visual = description.visual[static_cast<size_t>(link)];
-    for (size_t i = 0; i < visual.size(); ++i) {
-      const std::string problem = capsule_problem(visual[i], "visual." + link_name(link) + "[" + std::to_string(i) + "]");
-      if (!problem.empty()) return problem;
-    }
-  }
-  for (size_t i = 0; i < description.tool.size(); ++i) {
-    const std::string problem = capsule_problem(description.tool[i], "tool[" + std::to_string(i) + "]");
+    const size_t i = static_cast<size_t>(link);
+    std::string problem = list_problem(description.links[i], "links." + link_name(link));
+    if (problem.empty()) problem = list_problem(description.visual[i], "visual." + link_name(link));
     if (!problem.empty()) return problem;
+    count += description.links[i].size();
   }
+  const std::string problem = list_problem(description.tool, "tool");
+  if (!problem.empty()) return problem;
   // An arm without capsules would never be near anything: every verdict would be "run".
   if (count == 0) return "links: expected at least one capsule";
   if (!std::isfinite(description.padding_m) || description.padding_m < 0.0) {
@@ -127,19 +150,7 @@ LinkFrames forward_kinematics(const RobotDescription& description, const JointAn
 
 void robot_capsules(const RobotDescription& description, const JointAngles& joints_rad, double padding_m,
                     BaseFrame frame, RobotModel& out) {
-  const LinkFrames frames = forward_kinematics(description, joints_rad);
-  const Pose T_out_base_link = T_frame_base_link(frame);
-  out.capsules.clear();
-  for (int link = 0; link < kArmLinkCount; ++link) {
-    const Pose T_frame_link = T_out_base_link * frames.T_base_link_link[static_cast<size_t>(link)];
-    for (const LinkCapsule& capsule : description.links[static_cast<size_t>(link)]) {
-      out.capsules.push_back(moved(capsule, T_frame_link, padding_m, link));
-    }
-  }
-  const Pose T_frame_flange = T_out_base_link * frames.T_base_link_link[kArmLinkCount - 1];
-  for (const LinkCapsule& capsule : description.tool) {
-    out.capsules.push_back(moved(capsule, T_frame_flange, padding_m, kToolLink));
-  }
+  place_capsules(description, joints_rad, padding_m, frame, Geometry::collision, out);
 }
 
 RobotModel robot_capsules(const RobotDescription& description, const JointAngles& joints_rad, double padding_m,
@@ -153,19 +164,9 @@ RobotModel robot_render_capsules(const RobotDescription& description, const Join
                                  BaseFrame frame) {
   // No padding: the visual shapes are the real arm, which the searched capsules (link radius
   // plus padding) must contain.
-  const LinkFrames frames = forward_kinematics(description, joints_rad);
-  const Pose T_out_base_link = T_frame_base_link(frame);
-  RobotModel out;
-  for (int link = 0; link < kArmLinkCount; ++link) {
-    const size_t i = static_cast<size_t>(link);
-    const std::vector<LinkCapsule>& shapes = description.visual[i].empty() ? description.links[i] : description.visual[i];
-    for (const LinkCapsule& shape : shapes) {
-      out.capsules.push_back(moved(shape, T_out_base_link * frames.T_base_link_link[i], 0.0, link));
-    }
-  }
-  const Pose T_frame_flange = T_out_base_link * frames.T_base_link_link[kArmLinkCount - 1];
-  for (const LinkCapsule& capsule : description.tool) out.capsules.push_back(moved(capsule, T_frame_flange, 0.0, kToolLink));
-  return out;
+  RobotModel model;
+  place_capsules(description, joints_rad, 0.0, frame, Geometry::visual, model);
+  return model;
 }
 
 RobotModel robot_points(const std::vector<Eigen::Vector3f>& points_base, double padding_m) {
