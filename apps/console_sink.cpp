@@ -14,6 +14,9 @@ namespace {
 // Enough for one second at several thousand frames/s; beyond it the window's median is
 // taken over the first samples rather than growing the buffer on the frame path.
 constexpr size_t kWindowCapacity = 8192;
+// Timestamp warnings logged one by one; the rest only in the summary's counts, so that a
+// recording whose every stamp repeats cannot flood the log.
+constexpr int64_t kMaxTimestampWarnings = 10;
 
 }  // namespace
 
@@ -30,6 +33,10 @@ void ConsoleSink::header(const RunHeader& header) {
 }
 
 void ConsoleSink::frame(const FrameResult& result) {
+  if (result.timestamp_warning != nullptr && timestamp_warnings_++ < kMaxTimestampWarnings) {
+    spdlog::warn("frame {}: {} (timestamp_ns {}){}", result.frame, result.timestamp_warning, result.timestamp_ns,
+                 timestamp_warnings_ == kMaxTimestampWarnings ? "; further ones are counted in the summary only" : "");
+  }
   ++window_frames_;
   if (window_latency_us_.size() < kWindowCapacity) window_latency_us_.push_back(result.latency_us);
   const Clock::time_point now = Clock::now();
@@ -65,6 +72,11 @@ void ConsoleSink::summary(const RunSummary& s) {
     spdlog::info("summary: min distance {:.3f}m; end: {}", s.min_distance_m, s.end_reason);
   } else {
     spdlog::info("summary: no foreground seen; end: {}", s.end_reason);
+  }
+  const TimestampCounts& t = s.timestamps;
+  if (t.backwards + t.repeated + t.gaps + t.jumps > 0) {
+    spdlog::warn("summary: source timestamps out of order: {} backwards, {} repeated, {} gaps ({} frames skipped), "
+                 "{} jumps beyond max_frame_age_s", t.backwards, t.repeated, t.gaps, t.frames_skipped, t.jumps);
   }
 }
 

@@ -24,6 +24,7 @@ class ConsoleSink : public Sink {
   Clock::time_point window_start_;
   std::vector<double> window_latency_us_;  ///< latencies since the last line; capacity reused
   int64_t window_frames_ = 0;
+  int64_t timestamp_warnings_ = 0;  ///< out-of-order timestamps logged so far
 };
 
 }  // namespace hrcsense::app

@@ -14,13 +14,17 @@ namespace {
 
 using hrcsense::app::CommandArgs;
 
+constexpr int64_t kMaxFrames = 10'000'000'000;
+
 // The flags every subcommand shares (DESIGN.md "Names other tools rely on").
 void add_common_flags(CLI::App& command, CommandArgs& args) {
   command.add_option("--config", args.config_path, "YAML configuration file (docs/CONFIG.md)");
   command.add_option("--set", args.sets, "override a key, KEY=VALUE with VALUE in YAML (repeatable)")
       ->allow_extra_args(false);
-  command.add_option("--frames", args.frames, "stop after N source frames (default: the source's length)")
-      ->check(CLI::PositiveNumber);
+  // Bounded so that a typo cannot ask for absurd preallocations: 10^10 frames are three
+  // centuries at the D435's 90 frames/s.
+  command.add_option("--frames", args.frames, "stop after N source frames, 1 to 10^10 (default: the source's length)")
+      ->check(CLI::Range(int64_t{1}, kMaxFrames));
 }
 
 }  // namespace

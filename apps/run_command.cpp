@@ -21,12 +21,39 @@
 namespace hrcsense::app {
 namespace {
 
-// Set by SIGINT; the pipeline polls it and ends the run with a summary.
+// Set by SIGINT, SIGTERM (systemd's stop) or SIGHUP (the terminal closed); the pipeline polls
+// it and ends the run with a final stop line and a summary.
 std::atomic<bool> g_stop_requested{false};
+std::atomic<int> g_stop_signal{0};
 
-extern "C" void on_sigint(int /*signal*/) {
+extern "C" void on_stop_signal(int signal) {
   g_stop_requested.store(true);
-  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C kills, in case the run is stuck
+  g_stop_signal.store(signal);
+  std::signal(signal, SIG_DFL);  // a second one kills, in case the run is stuck
+}
+
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+// SIGPIPE is ignored for the whole run: a reader that goes away makes the write fail (EPIPE),
+// and the failed sink ends the run, instead of the signal killing it mid-line.
+void install_signal_handlers() {
+  g_stop_requested.store(false);
+  g_stop_signal.store(0);
+  for (int signal : kStopSignals) std::signal(signal, on_stop_signal);
+  std::signal(SIGPIPE, SIG_IGN);
+}
+
+void restore_signal_handlers() {
+  for (int signal : kStopSignals) std::signal(signal, SIG_DFL);
+}
+
+const char* signal_name(int signal) {
+  switch (signal) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    default: return "a signal";
+  }
 }
 
 // Loads background.path when it exists. Returns false when there is nothing to load.
@@ -107,17 +134,18 @@ int run_command(const CommandArgs& args) {
   options.pace = config.source.pace;
   options.max_frames = args.frames;
   options.stop_requested = &g_stop_requested;
-  g_stop_requested.store(false);
-  std::signal(SIGINT, on_sigint);
+  install_signal_handlers();
   const RunSummary summary = run_pipeline(*source, pipeline, sinks, options, header);
-  std::signal(SIGINT, SIG_DFL);
+  restore_signal_handlers();
+  if (g_stop_signal.load() != 0) spdlog::info("{} received: the run ended with a stop", signal_name(g_stop_signal.load()));
 
   if (!background_loaded) save_learnt_background(config, pipeline);
+  const std::string out_name = args.out.empty() ? "stdout" : args.out;
   out.flush();
-  if (!out) return report_error((args.out.empty() ? "stdout" : args.out) + ": write failed", kExitRuntime);
-  // The output ends with a stop line and a summary either way; the exit code tells scripts
-  // that the source failed (the run_pipeline's end_reason names the error).
-  if (summary.end_reason.rfind("source error", 0) == 0) return report_error(summary.end_reason, kExitRuntime);
+  if (!out) return report_error(out_name + ": write failed; the run ended there", kExitRuntime);
+  // The output ends with a stop line and a summary either way (when it can still be written);
+  // the exit code tells scripts that the source, the processing or the output failed.
+  if (!summary.error.empty()) return report_error(summary.error, kExitRuntime);
   return 0;
 }
 

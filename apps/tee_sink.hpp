@@ -5,6 +5,7 @@
 #include "hrcsense/pipeline.hpp"
 
 #include <initializer_list>
+#include <string>
 #include <vector>
 
 namespace hrcsense::app {
@@ -22,6 +23,19 @@ class TeeSink : public Sink {
   }
   void summary(const RunSummary& summary) override {
     for (Sink* sink : sinks_) sink->summary(summary);
+  }
+  /// Failed as soon as any sink failed: a result that cannot reach every consumer ends the run.
+  bool failed() const override {
+    for (Sink* sink : sinks_) {
+      if (sink->failed()) return true;
+    }
+    return false;
+  }
+  std::string failure() const override {
+    for (Sink* sink : sinks_) {
+      if (sink->failed()) return sink->failure();
+    }
+    return {};
   }
 
  private:

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 
 namespace hrcsense {
@@ -68,6 +69,15 @@ struct RunHeader {
   } filters;
 };
 
+/// Source timestamps out of order, counted over a run (each frame against the one before).
+struct TimestampCounts {
+  int64_t backwards = 0;       ///< a timestamp earlier than the previous frame's
+  int64_t repeated = 0;        ///< the same timestamp as the previous frame's
+  int64_t gaps = 0;            ///< steps of more than 1.5 nominal periods (up to max_frame_age_s)
+  int64_t frames_skipped = 0;  ///< frames missing in those gaps, at the nominal rate
+  int64_t jumps = 0;           ///< steps longer than safety.max_frame_age_s (paced waits are cut there)
+};
+
 /// Totals written once at the end.
 struct RunSummary {
   int64_t frames_in = 0;          ///< frames read from the source
@@ -80,6 +90,10 @@ struct RunSummary {
   double latency_p50_us = 0.0, latency_p99_us = 0.0;
   float min_distance_m = -1.0F;   ///< smallest distance seen; -1 if never any foreground
   std::string end_reason;         ///< "end of source", or the source's error
+  /// Why the run failed (source error, processing error, output failed); empty when it ended
+  /// normally (end of source, frame limit, stop requested). The app exits 1 when set.
+  std::string error;
+  TimestampCounts timestamps;     ///< source timestamps out of order
 };
 
 /// A consumer of results. The other virtual interface of hrcsense.
@@ -89,6 +103,10 @@ class Sink {
   virtual void header(const RunHeader& header) = 0;
   virtual void frame(const FrameResult& result) = 0;
   virtual void summary(const RunSummary& summary) = 0;
+  /// True once the sink can no longer deliver results (a closed pipe, a full disk); the run
+  /// then ends. failure() says why.
+  virtual bool failed() const { return false; }
+  virtual std::string failure() const { return {}; }
 };
 
 /// Single-slot, latest-value-wins mailbox between two threads. put() never blocks: a value
@@ -160,6 +178,12 @@ class Mailbox {
   int64_t dropped_ = 0;
 };
 
+/// A background loaded from a file contradicts the live scene (Pipeline::set_background).
+class BackgroundMismatch : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// Everything the processing path needs, already parsed (see config.hpp).
 struct PipelineParams {
   FilterChainParams filters;  ///< depth filters run before segmentation; empty order: none
@@ -181,7 +205,9 @@ class Pipeline {
   explicit Pipeline(PipelineParams params);
   /// The parameters the pipeline was built with (e.g. safety.max_frame_age_s for the watchdog).
   const PipelineParams& params() const { return params_; }
-  /// Uses a background learnt earlier instead of learning from the first frames.
+  /// Uses a background learnt earlier instead of learning from the first frames. The first
+  /// BackgroundCheck::frames frames are compared with it first (stops); when they contradict
+  /// it, process() throws BackgroundMismatch.
   void set_background(BackgroundModel model);
   bool background_ready() const { return learner_.ready() || preset_background_; }
   const BackgroundModel& background() const;
@@ -201,12 +227,16 @@ class Pipeline {
   FilterChain filters_;  ///< params_.filters; its temporal state spans frames
   ProximitySearch proximity_;  ///< params_.backend with its reusable search buffers
   Frame filtered_;       ///< the filtered copy of the current frame (buffers reused)
+  BackgroundCheck check_;  ///< of a loaded background against the first frames
+
+  bool enough_valid_depth(const Frame& frame, FrameResult& result) const;
+  bool background_checked(const Frame& frame, FrameResult& result);
 };
 
 struct RunOptions {
   bool pace = false;         ///< play at the source's timestamps; frames may then be dropped
   int64_t max_frames = -1;   ///< stop after this many source frames; -1: until the source ends
-  std::atomic<bool>* stop_requested = nullptr;  ///< set from outside (e.g. SIGINT) to end the run
+  std::atomic<bool>* stop_requested = nullptr;  ///< set from outside (SIGINT, SIGTERM, SIGHUP) to end the run
 };
 
 /// Runs capture, processing and output on three threads joined by mailboxes. Unpaced runs

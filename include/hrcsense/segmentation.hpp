@@ -58,6 +58,12 @@ struct BackgroundParams {
   float max_noise_per_z2 = 0.01F;
   /// Stereo noise model used for σ_model(z) (subpixel RMS in px; baseline from the frame).
   float subpixel_rms_px = 0.08F;
+  /// A background loaded from a file is compared with this many first frames before it is
+  /// trusted (BackgroundCheck); 0 trusts it at once (tests only).
+  int check_frames = 5;
+  /// The loaded background is refused when more than this share of the compared pixels are
+  /// measured farther than it (BackgroundCheck).
+  float check_max_farther_share = 0.05F;
 };
 
 /// Learns the background from consecutive frames. When the scene moved during a batch of
@@ -94,6 +100,32 @@ struct BackgroundLearner {
   std::vector<uint8_t> moving_, eroded_;
   std::vector<int32_t> fill_queue_;
   std::vector<uint16_t> fill_layer_;
+};
+
+/// Checks a background loaded from a file against the first frames of the live scene. A
+/// background nearer than the scene hides whatever stands in front of the true background, so
+/// the check counts reliable background pixels that the frames measure *farther* than the
+/// background by more than max(k_sigma · spread, min_margin_m): a person in the cell only makes
+/// pixels nearer, while a moved camera or another cell's file makes many farther.
+struct BackgroundCheck {
+  int frames = 5;                  ///< frames to compare before the background is trusted
+  float max_farther_share = 0.05F; ///< more of the compared pixels farther than this: mismatch
+  float k_sigma = 4.0F;            ///< as ForegroundParams::k_sigma
+  float min_margin_m = 0.02F;      ///< as ForegroundParams::min_margin_m
+  float min_valid_ratio = 0.5F;    ///< reliable pixels only, as BackgroundParams::min_valid_ratio
+
+  /// Compares one frame (same size as `model`); returns the number of frames seen so far.
+  int add(const BackgroundModel& model, const DepthImage& depth);
+  bool done() const { return seen_ >= frames; }
+  /// Share of compared pixels measured farther than the background, 0..1 (0 before any).
+  double farther_share() const { return compared_ > 0 ? static_cast<double>(farther_) / compared_ : 0.0; }
+  /// Whether the frames seen contradict the background (meaningful once done()).
+  bool mismatch() const { return farther_share() > max_farther_share; }
+
+ private:
+  int seen_ = 0;
+  int64_t compared_ = 0;
+  int64_t farther_ = 0;
 };
 
 /// Axis-aligned box in the base frame.

@@ -10,7 +10,8 @@
 
 namespace hrcsense {
 
-/// Writes one JSON object per line: a header, one line per frame, a summary.
+/// Writes one JSON object per line: a header, one line per frame, a summary; each line is
+/// flushed as soon as it is written.
 /// Field names are binding (DESIGN.md "Names other tools rely on").
 class JsonLinesSink : public Sink {
  public:
@@ -21,8 +22,13 @@ class JsonLinesSink : public Sink {
   void header(const RunHeader& header) override;
   void frame(const FrameResult& result) override;
   void summary(const RunSummary& summary) override;
+  /// The stream failed (e.g. EPIPE with SIGPIPE ignored, a full disk): the run should end.
+  bool failed() const override { return !out_; }
+  std::string failure() const override { return "write failed"; }
 
  private:
+  void write_line();  ///< writes line_ and flushes it
+
   std::ostream& out_;
   std::string backend_;
   std::string line_;  ///< reused per frame

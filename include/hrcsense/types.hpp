@@ -182,6 +182,9 @@ struct FrameResult {
   /// The proximity backend that searched this frame (static name, e.g. "octree" when `auto`
   /// picked it); null when no search ran.
   const char* backend = nullptr;
+  /// Static text when the frame's source timestamp was out of order (backwards, repeated, a
+  /// gap or a jump; RunSummary::timestamps counts them); null when in order.
+  const char* timestamp_warning = nullptr;
 };
 
 }  // namespace hrcsense

@@ -138,6 +138,12 @@ Pipeline::Pipeline(PipelineParams params)
 void Pipeline::set_background(BackgroundModel model) {
   preset_model_ = std::move(model);
   preset_background_ = true;
+  check_ = BackgroundCheck{};
+  check_.frames = params_.background.check_frames;
+  check_.max_farther_share = params_.background.check_max_farther_share;
+  check_.k_sigma = params_.foreground.k_sigma;
+  check_.min_margin_m = params_.foreground.min_margin_m;
+  check_.min_valid_ratio = params_.background.min_valid_ratio;
   extractor_.clear_background();  // its tables belong to the previous model
 }
 
@@ -152,11 +158,13 @@ void Pipeline::process(const Frame& source_frame, FrameResult& result) {
   result.invalid_pixels = count_invalid(source_frame.depth);
   if (result.invalid_pixels == source_frame.depth.pixels.size()) return finish_stop(result, "no valid depth", start);
   const Frame& frame = run_filters(filters_, source_frame, filtered_, result);
+  if (!enough_valid_depth(frame, result)) return finish(result, start);
   if (!background_ready()) {
     timed(result, "background", [&] { learn_background(learner_, frame, result.verdict); });
     return finish(result, start);
   }
   if (!same_size(background(), frame.depth)) return finish_stop(result, "background size mismatch", start);
+  if (!background_checked(frame, result)) return finish(result, start);
   if (params_.robot.capsules.empty()) return finish_stop(result, "no robot model", start);
   bool extracted = false;
   timed(result, "foreground", [&] {
@@ -167,10 +175,52 @@ void Pipeline::process(const Frame& source_frame, FrameResult& result) {
     result.contact = proximity_.closest(foreground_.points_base, foreground_.points_camera, params_.robot);
     result.backend = proximity_backend_name(proximity_.last_backend());
   });
-  timed(result, "safety", [&] { result.verdict = verdict_for_contact(params_.safety, result.contact); });
   result.foreground_points = foreground_.points_base.size();
+  timed(result, "safety", [&] {
+    result.verdict = verdict_for_contact(params_.safety, result.contact, result.foreground_points);
+  });
   result.valid = true;
   finish(result, start);
+}
+
+// The filtered frame must still see the cell: no valid pixel at all, or fewer than
+// safety.min_valid_share of them (a covered or blinded camera, a threshold that cuts the
+// scene away), is a stop, and such a frame is not learnt from either.
+bool Pipeline::enough_valid_depth(const Frame& frame, FrameResult& result) const {
+  const size_t pixels = frame.depth.pixels.size();
+  const size_t invalid = &frame.depth == &filtered_.depth ? count_invalid(frame.depth) : result.invalid_pixels;
+  const size_t valid = pixels - invalid;
+  if (valid == 0) {
+    set_stop(result.verdict, "no valid depth after filters");
+    return false;
+  }
+  const double share = static_cast<double>(valid) / static_cast<double>(pixels);
+  if (share >= params_.safety.min_valid_share) return true;
+  char text[96];
+  std::snprintf(text, sizeof text, "valid depth %.4f of pixels after filters, below min_valid_share %.4g", share,
+                static_cast<double>(params_.safety.min_valid_share));
+  set_stop(result.verdict, text);
+  return false;
+}
+
+// A background loaded from a file is compared with the first frames before it is trusted
+// (BackgroundCheck); those frames are stops. A mismatch ends the run with an error.
+bool Pipeline::background_checked(const Frame& frame, FrameResult& result) {
+  if (!preset_background_ || check_.done()) return true;
+  const int seen = check_.add(preset_model_, frame.depth);
+  if (check_.done() && check_.mismatch()) {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "the loaded background does not match the scene: %.1f %% of its reliable pixels are measured "
+                  "farther than it in the first %d frames (at most %.1f %% allowed); the camera moved or the file "
+                  "is another cell's: delete it to learn a new one",
+                  100.0 * check_.farther_share(), seen, 100.0 * static_cast<double>(check_.max_farther_share));
+    throw BackgroundMismatch(text);
+  }
+  char text[64];
+  std::snprintf(text, sizeof text, "checking loaded background (%d/%d frames)", seen, check_.frames);
+  set_stop(result.verdict, text);
+  return false;
 }
 
 }  // namespace hrcsense

@@ -25,6 +25,7 @@ double seconds_since(Clock::time_point since) {
 struct Captured {
   Frame frame;
   Clock::time_point captured_at{};
+  const char* timestamp_warning = nullptr;  ///< static text; null when the timestamp is in order
 };
 
 // Why capture ended: the reason of the final stop result and the summary's end_reason.
@@ -32,6 +33,8 @@ struct CaptureOutcome {
   int64_t frames_in = 0;
   std::string final_reason = "source ended";
   std::string end_reason = "end of source";
+  std::string error;  ///< the source's error; empty when it ended or was stopped
+  TimestampCounts timestamps;
 };
 
 // Latencies kept for the percentiles. Preallocated; beyond its capacity the oldest entries
@@ -57,25 +60,78 @@ struct LatencyLog {
   }
 };
 
-// When paced, frame i is due at its timestamp relative to the first frame; sources without
-// usable (increasing) timestamps fall back to the nominal rate.
-Clock::time_point due_time(Clock::time_point start, int64_t first_ns, const Frame& frame, int64_t n,
-                           double nominal_fps) {
-  double offset_s = static_cast<double>(frame.timestamp_ns - first_ns) * 1e-9;
-  if (n > 0 && offset_s <= 0.0 && nominal_fps > 0.0) offset_s = static_cast<double>(n) / nominal_fps;
-  return start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(offset_s));
+// Classifies a frame's timestamp against the previous frame's: backwards, repeated, or a
+// gap of more than 1.5 nominal periods (frames the source skipped); counts it and returns the
+// warning for the frame (static text), null when in order.
+const char* check_timestamp(int64_t previous_ns, int64_t timestamp_ns, double nominal_fps, double max_frame_age_s,
+                            TimestampCounts& counts) {
+  const int64_t delta_ns = timestamp_ns - previous_ns;
+  if (delta_ns < 0) {
+    ++counts.backwards;
+    return "timestamp went backwards";
+  }
+  if (delta_ns == 0) {
+    ++counts.repeated;
+    return "timestamp repeated";
+  }
+  const double delta_s = static_cast<double>(delta_ns) * 1e-9;
+  if (delta_s > max_frame_age_s) {
+    ++counts.jumps;
+    return "timestamp jumped by more than max_frame_age_s";
+  }
+  if (nominal_fps > 0.0 && delta_s * nominal_fps > 1.5) {
+    ++counts.gaps;
+    counts.frames_skipped += static_cast<int64_t>(delta_s * nominal_fps + 0.5) - 1;
+    return "timestamp gap: frames skipped";
+  }
+  return nullptr;
 }
+
+// Paces a source to its timestamps, frame to frame: each frame is due one timestamp step after
+// the previous one. A step that is not positive (repeated or backwards timestamps, sources
+// without timestamps) takes the nominal period; a step longer than max_frame_age_s (a jump in
+// the recording) is cut to max_frame_age_s, so a replay never sleeps for days.
+struct Pacer {
+  double nominal_fps = 30.0;
+  double max_step_s = 0.5;
+  bool started = false;
+  Clock::time_point due{};
+  int64_t last_ns = 0;
+
+  Clock::time_point next(int64_t timestamp_ns) {
+    if (!started) {
+      started = true;
+      due = Clock::now();
+    } else {
+      double step_s = static_cast<double>(timestamp_ns - last_ns) * 1e-9;
+      if (step_s <= 0.0) step_s = nominal_fps > 0.0 ? 1.0 / nominal_fps : 0.0;
+      step_s = std::min(step_s, max_step_s);
+      due += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(step_s));
+    }
+    last_ns = timestamp_ns;
+    return due;
+  }
+};
 
 bool stop_requested(const RunOptions& options) {
   return options.stop_requested != nullptr && options.stop_requested->load();
 }
 
+// Sleeps until `due` in short slices, so that a stop request (SIGINT, SIGTERM) ends the wait.
+void sleep_until_interruptible(Clock::time_point due, const RunOptions& options) {
+  constexpr auto kSlice = std::chrono::milliseconds(20);
+  for (Clock::time_point now = Clock::now(); now < due && !stop_requested(options); now = Clock::now()) {
+    std::this_thread::sleep_for(std::min<Clock::duration>(due - now, kSlice));
+  }
+}
+
 // Reads the source until it ends, fails, or the run is stopped; then closes `frames`.
-void capture_loop(Source& source, const RunOptions& options, Mailbox<Captured>& frames, CaptureOutcome& outcome) {
+void capture_loop(Source& source, const RunOptions& options, double max_frame_age_s, Mailbox<Captured>& frames,
+                  CaptureOutcome& outcome) {
   const double nominal_fps = source.info().nominal_fps;
   Captured slot;
-  Clock::time_point start{};
-  int64_t first_ns = 0;
+  Pacer pacer{nominal_fps, max_frame_age_s};
+  int64_t previous_ns = 0;
   for (int64_t n = 0;; ++n) {
     if (stop_requested(options)) {
       outcome.final_reason = outcome.end_reason = "stop requested";
@@ -95,17 +151,16 @@ void capture_loop(Source& source, const RunOptions& options, Mailbox<Captured>& 
     }
     if (status == Source::Status::end) break;  // the defaults say "source ended"
     if (status == Source::Status::error) {
-      outcome.final_reason = outcome.end_reason = "source error: " + (error.empty() ? std::string("unknown") : error);
+      outcome.error = "source error: " + (error.empty() ? std::string("unknown") : error);
+      outcome.final_reason = outcome.end_reason = outcome.error;
       break;
     }
     ++outcome.frames_in;
-    if (options.pace) {
-      if (n == 0) {
-        start = Clock::now();
-        first_ns = slot.frame.timestamp_ns;
-      }
-      std::this_thread::sleep_until(due_time(start, first_ns, slot.frame, n, nominal_fps));
-    }
+    slot.timestamp_warning =
+        n == 0 ? nullptr
+               : check_timestamp(previous_ns, slot.frame.timestamp_ns, nominal_fps, max_frame_age_s, outcome.timestamps);
+    previous_ns = slot.frame.timestamp_ns;
+    if (options.pace) sleep_until_interruptible(pacer.next(slot.frame.timestamp_ns), options);
     slot.captured_at = Clock::now();
     if (options.pace) {
       frames.put(slot);  // latest wins; a frame not yet taken is dropped and counted
@@ -132,19 +187,20 @@ void processing_loop(Pipeline& pipeline, const RunOptions& options, double max_f
   try {
     while (frames.take(in)) {
       pipeline.process(in.frame, result);
-      if (seconds_since(in.captured_at) > max_frame_age_s) result.verdict = stop_verdict("stale frame");
+      result.timestamp_warning = in.timestamp_warning;
+      if (!(seconds_since(in.captured_at) <= max_frame_age_s)) result.verdict = stop_verdict("stale frame");
       ++stats.processed;
       stats.latencies.add(result.latency_us);
       if (options.pace) {
         results.put(result);
       } else if (!results.put_wait(result)) {
-        break;
+        break;  // the output ended (its sink failed)
       }
     }
   } catch (const std::exception& e) {
     stats.error = std::string("processing error: ") + e.what();
-    frames.close();  // the capture thread must not wait for a consumer that is gone
   }
+  frames.close();  // the capture thread must not wait for a consumer that is gone
   results.close();
 }
 
@@ -162,6 +218,7 @@ void write_stop(Sink& sink, FrameResult& scratch, const FrameResult& last, const
   scratch.timings.clear();
   scratch.truth.reset();
   scratch.latency_us = 0.0;
+  scratch.timestamp_warning = nullptr;
   sink.frame(scratch);
 }
 
@@ -178,24 +235,36 @@ void tally(RunSummary& summary, const FrameResult& result) {
 }
 
 // Writes every result; when none arrives within max_frame_age_s, writes a watchdog stop.
-// Returns the last result written (for the final stop's frame index).
-FrameResult output_loop(Sink& sink, double max_frame_age_s, Mailbox<FrameResult>& results, RunSummary& summary) {
+// Ends early when the sink fails (a closed pipe, a full disk): closes `results` so that
+// processing and capture end too, and says why in `error`. Returns the last result written
+// (for the final stop's frame index).
+FrameResult output_loop(Sink& sink, double max_frame_age_s, Mailbox<FrameResult>& results, RunSummary& summary,
+                        std::string& error) {
   FrameResult result, last, watchdog;
   Clock::time_point last_arrival = Clock::now();
-  for (;;) {
-    if (results.take_for(result, max_frame_age_s)) {
-      sink.frame(result);
-      tally(summary, result);
-      last_arrival = Clock::now();
-      std::swap(last, result);
-      continue;
+  try {
+    for (;;) {
+      if (sink.failed()) {
+        error = "output failed: " + sink.failure();
+        break;
+      }
+      if (results.take_for(result, max_frame_age_s)) {
+        sink.frame(result);
+        tally(summary, result);
+        last_arrival = Clock::now();
+        std::swap(last, result);
+        continue;
+      }
+      if (results.closed()) break;
+      char reason[96];
+      std::snprintf(reason, sizeof reason, "no frame for %.3f s (max_frame_age_s %.3f)", seconds_since(last_arrival),
+                    max_frame_age_s);
+      write_stop(sink, watchdog, last, reason);
     }
-    if (results.closed()) break;
-    char reason[96];
-    std::snprintf(reason, sizeof reason, "no frame for %.3f s (max_frame_age_s %.3f)", seconds_since(last_arrival),
-                  max_frame_age_s);
-    write_stop(sink, watchdog, last, reason);
+  } catch (const std::exception& e) {
+    error = std::string("output error: ") + e.what();
   }
+  results.close();
   return last;
 }
 
@@ -206,34 +275,45 @@ RunSummary run_pipeline(Source& source, Pipeline& pipeline, Sink& sink, const Ru
   const Clock::time_point start = Clock::now();
   const double max_frame_age_s = pipeline.params().safety.max_frame_age_s;
   const int64_t expected = options.max_frames >= 0 ? options.max_frames : source.info().frame_count;
-  constexpr int64_t kDefaultLatencyCapacity = 1 << 20;
-  ProcessingStats stats{0, LatencyLog(static_cast<size_t>(expected > 0 ? expected : kDefaultLatencyCapacity)), {}};
+  // The latency log is a ring: a long or endless run keeps the most recent million frames.
+  constexpr int64_t kMaxLatencyCapacity = 1 << 20;
+  const int64_t capacity = expected > 0 ? std::min(expected, kMaxLatencyCapacity) : kMaxLatencyCapacity;
+  ProcessingStats stats{0, LatencyLog(static_cast<size_t>(capacity)), {}};
   Mailbox<Captured> frames;
   Mailbox<FrameResult> results;
   CaptureOutcome outcome;
   RunSummary summary;
+  std::string output_error;
 
   sink.header(header);
-  std::thread capture([&] { capture_loop(source, options, frames, outcome); });
+  std::thread capture([&] { capture_loop(source, options, max_frame_age_s, frames, outcome); });
   std::thread processing([&] { processing_loop(pipeline, options, max_frame_age_s, frames, results, stats); });
-  const FrameResult last = output_loop(sink, max_frame_age_s, results, summary);
+  const FrameResult last = output_loop(sink, max_frame_age_s, results, summary, output_error);
   processing.join();
   capture.join();
 
-  // Fail safe: whatever ended the run, the last word to the robot is a stop.
-  if (!stats.error.empty()) outcome.final_reason = outcome.end_reason = stats.error;
-  FrameResult scratch;
-  write_stop(sink, scratch, last, outcome.final_reason);
-
+  // The first failure is the run's error: the output's, else processing's, else the source's.
+  summary.error = !output_error.empty() ? output_error : !stats.error.empty() ? stats.error : outcome.error;
+  if (!summary.error.empty()) outcome.final_reason = outcome.end_reason = summary.error;
   summary.frames_in = outcome.frames_in;
   summary.frames_processed = stats.processed;
   summary.frames_dropped = frames.dropped() + results.dropped();
-  summary.wall_s = seconds_since(start);
-  summary.fps = summary.wall_s > 0.0 ? static_cast<double>(summary.frames_processed) / summary.wall_s : 0.0;
+  summary.timestamps = outcome.timestamps;
+  summary.end_reason = outcome.end_reason;
   summary.latency_p50_us = stats.latencies.percentile(0.50);
   summary.latency_p99_us = stats.latencies.percentile(0.99);
-  summary.end_reason = outcome.end_reason;
-  sink.summary(summary);
+  // Fail safe: whatever ended the run, the last word to the robot is a stop (a failed sink
+  // gets it too: it may still reach a file whose pipe reader left).
+  try {
+    FrameResult scratch;
+    write_stop(sink, scratch, last, outcome.final_reason);
+    summary.wall_s = seconds_since(start);
+    summary.fps = summary.wall_s > 0.0 ? static_cast<double>(summary.frames_processed) / summary.wall_s : 0.0;
+    sink.summary(summary);
+  } catch (const std::exception& e) {
+    if (summary.error.empty()) summary.error = std::string("output error: ") + e.what();
+  }
+  if (summary.error.empty() && sink.failed()) summary.error = "output failed: " + sink.failure();
   return summary;
 }
 

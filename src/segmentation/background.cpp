@@ -291,4 +291,21 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame) {
   return Status::ready;
 }
 
+int BackgroundCheck::add(const BackgroundModel& model, const DepthImage& depth) {
+  const size_t n = model.mean_m.size();
+  if (depth.pixels.size() != n) return ++seen_;  // the pipeline refuses a size mismatch itself
+  const float scale = depth.depth_scale_m;
+  for (size_t i = 0; i < n; ++i) {
+    const uint16_t raw = depth.pixels[i];
+    const float mean = model.mean_m[i];
+    if (raw == 0 || !(mean > 0.0F) || !(model.valid_ratio[i] >= min_valid_ratio)) continue;
+    const float z = static_cast<float>(raw) * scale;
+    const float margin = std::max(k_sigma * model.spread_m[i], min_margin_m);
+    ++compared_;
+    // NaN in a damaged model fails ">" and so is never a reason to trust it: count it as farther.
+    if (!(z - mean <= margin)) ++farther_;
+  }
+  return ++seen_;
+}
+
 }  // namespace hrcsense

@@ -246,14 +246,22 @@ TEST_F(Cli, LearntBackgroundIsSavedThenLoaded) {
   ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
   ASSERT_TRUE(fs::exists(dir_ / "bg" / "model.bin"));
 
-  // The second run starts with the saved model: its first frame is already valid.
-  outcome = run("run " + thesis_box("--frames 2 --set background.frames=10 --set background.path=bg/model.bin"));
+  // The second run starts with the saved model: it checks it against the first 5 frames
+  // (stops), and the 6th frame is already valid, long before 10 learning frames.
+  outcome = run("run " + thesis_box("--frames 7 --set background.frames=10 --set background.path=bg/model.bin"));
   ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
   std::istringstream in(outcome.out);
-  std::string header_line, first_frame_line;
-  std::getline(in, header_line);
-  std::getline(in, first_frame_line);
-  EXPECT_TRUE(json::parse(first_frame_line)["valid"].get<bool>()) << first_frame_line;
+  std::string line;
+  std::getline(in, line);  // header
+  for (int i = 0; i < 5; ++i) {
+    std::getline(in, line);
+    const json frame = json::parse(line);
+    EXPECT_FALSE(frame["valid"].get<bool>()) << line;
+    EXPECT_EQ(frame["verdict"], "stop") << line;
+    EXPECT_EQ(frame["verdict_reason"].get<std::string>().rfind("checking loaded background", 0), 0U) << line;
+  }
+  std::getline(in, line);
+  EXPECT_TRUE(json::parse(line)["valid"].get<bool>()) << line;
 
   // A model of another size does not fit the source.
   outcome = run("run " + thesis_box("--frames 2 --set background.path=bg/model.bin --set sim.width=640 "

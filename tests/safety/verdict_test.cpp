@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <string>
 
 namespace hrcsense {
@@ -25,43 +26,43 @@ SafetyParams params() {
 }
 
 TEST(Verdict, NoContactRuns) {
-  const Verdict v = verdict_for_contact(params(), Contact{});
+  const Verdict v = verdict_for_contact(params(), Contact{}, 0);
   EXPECT_EQ(v.state, VerdictState::run);
   EXPECT_EQ(v.speed_scale, 1.0F);
 }
 
 TEST(Verdict, ThresholdsAtAndAroundTheBoundaries) {
   const SafetyParams p = params();
-  EXPECT_EQ(verdict_for_contact(p, contact_at(5.0F)).state, VerdictState::run);
+  EXPECT_EQ(verdict_for_contact(p, contact_at(5.0F), 1).state, VerdictState::run);
   // At slow_distance_m: "at or beyond" runs.
-  EXPECT_EQ(verdict_for_contact(p, contact_at(1.2F)).state, VerdictState::run);
-  EXPECT_EQ(verdict_for_contact(p, contact_at(1.19F)).state, VerdictState::slow);
-  EXPECT_EQ(verdict_for_contact(p, contact_at(0.41F)).state, VerdictState::slow);
+  EXPECT_EQ(verdict_for_contact(p, contact_at(1.2F), 1).state, VerdictState::run);
+  EXPECT_EQ(verdict_for_contact(p, contact_at(1.19F), 1).state, VerdictState::slow);
+  EXPECT_EQ(verdict_for_contact(p, contact_at(0.41F), 1).state, VerdictState::slow);
   // At stop_distance_m: not below, so still slow (at speed 0).
-  const Verdict at_stop = verdict_for_contact(p, contact_at(0.4F));
+  const Verdict at_stop = verdict_for_contact(p, contact_at(0.4F), 1);
   EXPECT_EQ(at_stop.state, VerdictState::slow);
   EXPECT_EQ(at_stop.speed_scale, 0.0F);
-  EXPECT_EQ(verdict_for_contact(p, contact_at(0.39F)).state, VerdictState::stop);
-  EXPECT_EQ(verdict_for_contact(p, contact_at(0.0F)).state, VerdictState::stop);
+  EXPECT_EQ(verdict_for_contact(p, contact_at(0.39F), 1).state, VerdictState::stop);
+  EXPECT_EQ(verdict_for_contact(p, contact_at(0.0F), 1).state, VerdictState::stop);
 }
 
 TEST(Verdict, SpeedScaleIsLinearInTheSlowZone) {
   const SafetyParams p = params();
   // Span 0.8 m from 0.4 to 1.2: 0.6 m is a quarter of the way, 1.0 m three quarters.
-  EXPECT_NEAR(verdict_for_contact(p, contact_at(0.6F)).speed_scale, 0.25F, 1e-6F);
-  EXPECT_NEAR(verdict_for_contact(p, contact_at(0.8F)).speed_scale, 0.5F, 1e-6F);
-  EXPECT_NEAR(verdict_for_contact(p, contact_at(1.0F)).speed_scale, 0.75F, 1e-6F);
+  EXPECT_NEAR(verdict_for_contact(p, contact_at(0.6F), 1).speed_scale, 0.25F, 1e-6F);
+  EXPECT_NEAR(verdict_for_contact(p, contact_at(0.8F), 1).speed_scale, 0.5F, 1e-6F);
+  EXPECT_NEAR(verdict_for_contact(p, contact_at(1.0F), 1).speed_scale, 0.75F, 1e-6F);
   // Equal steps in distance give equal steps in speed.
-  const float s1 = verdict_for_contact(p, contact_at(0.5F)).speed_scale;
-  const float s2 = verdict_for_contact(p, contact_at(0.7F)).speed_scale;
-  const float s3 = verdict_for_contact(p, contact_at(0.9F)).speed_scale;
+  const float s1 = verdict_for_contact(p, contact_at(0.5F), 1).speed_scale;
+  const float s2 = verdict_for_contact(p, contact_at(0.7F), 1).speed_scale;
+  const float s3 = verdict_for_contact(p, contact_at(0.9F), 1).speed_scale;
   EXPECT_NEAR(s2 - s1, s3 - s2, 1e-6F);
-  EXPECT_EQ(verdict_for_contact(p, contact_at(1.5F)).speed_scale, 1.0F);
-  EXPECT_EQ(verdict_for_contact(p, contact_at(0.1F)).speed_scale, 0.0F);
+  EXPECT_EQ(verdict_for_contact(p, contact_at(1.5F), 1).speed_scale, 1.0F);
+  EXPECT_EQ(verdict_for_contact(p, contact_at(0.1F), 1).speed_scale, 0.0F);
 }
 
 TEST(Verdict, StopReasonsAreNeverEmpty) {
-  const Verdict close = verdict_for_contact(params(), contact_at(0.1F));
+  const Verdict close = verdict_for_contact(params(), contact_at(0.1F), 1);
   EXPECT_FALSE(close.reason.empty());
   const Verdict stale = stop_verdict("stale frame");
   EXPECT_EQ(stale.state, VerdictState::stop);
@@ -74,8 +75,45 @@ TEST(Verdict, EqualThresholdsHaveNoSlowZone) {
   SafetyParams p;
   p.slow_distance_m = 0.5F;
   p.stop_distance_m = 0.5F;
-  EXPECT_EQ(verdict_for_contact(p, contact_at(0.49F)).state, VerdictState::stop);
-  EXPECT_EQ(verdict_for_contact(p, contact_at(0.5F)).state, VerdictState::run);
+  EXPECT_EQ(verdict_for_contact(p, contact_at(0.49F), 1).state, VerdictState::stop);
+  EXPECT_EQ(verdict_for_contact(p, contact_at(0.5F), 1).state, VerdictState::run);
+}
+
+// R1 item 1: foreground that the search could not turn into a contact (non-finite points from
+// an overflowed pose, say) must never read as an empty cell.
+TEST(Verdict, ForegroundWithoutContactStops) {
+  const Verdict v = verdict_for_contact(params(), Contact{}, 86568);
+  EXPECT_EQ(v.state, VerdictState::stop);
+  EXPECT_EQ(v.speed_scale, 0.0F);
+  EXPECT_EQ(v.reason, "no contact");
+}
+
+// A NaN distance fails every "<" test; the verdict must still be stop, and so must a distance
+// or a point that is infinite or a negative distance.
+TEST(Verdict, NonFiniteContactStops) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  for (float d : {nan, inf, -inf, -0.1F}) {
+    EXPECT_EQ(verdict_for_contact(params(), contact_at(d), 1).state, VerdictState::stop) << d;
+  }
+  Contact far_but_broken = contact_at(5.0F);
+  far_but_broken.closest_base.x() = nan;
+  EXPECT_EQ(verdict_for_contact(params(), far_but_broken, 1).state, VerdictState::stop);
+  Contact robot_point_broken = contact_at(5.0F);
+  robot_point_broken.closest_robot_base.z() = inf;
+  EXPECT_EQ(verdict_for_contact(params(), robot_point_broken, 1).state, VerdictState::stop);
+}
+
+// R1 item 3: a point inside the robot's padded capsule is a stop, whatever the zones say
+// (even with both distances 0, which config refuses, the verdict stays stop).
+TEST(Verdict, InsideTheRobotAlwaysStops) {
+  SafetyParams zero;
+  zero.slow_distance_m = 0.0F;
+  zero.stop_distance_m = 0.0F;
+  Contact inside = contact_at(0.0F);
+  inside.inside = true;
+  EXPECT_EQ(verdict_for_contact(zero, inside, 1).state, VerdictState::stop);
+  EXPECT_EQ(verdict_for_contact(params(), inside, 1).reason, "inside robot");
 }
 
 TEST(Verdict, Names) {
