@@ -115,12 +115,15 @@ template <typename T>
 class Mailbox {
  public:
   /// Stores `value` (swapped in, so buffers circulate without allocation). Never blocks.
-  void put(T& value) {
+  /// False (value kept) once closed: the consumer is gone and the producer should end.
+  bool put(T& value) {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (closed_) return false;
     if (full_) ++dropped_;
     std::swap(slot_, value);
     full_ = true;
     ready_.notify_one();
+    return true;
   }
   /// Like put(), but first waits until the slot is empty, so nothing is dropped: for unpaced
   /// runs, where the producer must wait for the consumer. False (value kept) once closed.

@@ -162,11 +162,9 @@ void capture_loop(Source& source, const RunOptions& options, double max_frame_ag
     previous_ns = slot.frame.timestamp_ns;
     if (options.pace) sleep_until_interruptible(pacer.next(slot.frame.timestamp_ns), options);
     slot.captured_at = Clock::now();
-    if (options.pace) {
-      frames.put(slot);  // latest wins; a frame not yet taken is dropped and counted
-    } else if (!frames.put_wait(slot)) {
-      break;
-    }
+    // Paced: latest wins, a frame not yet taken is dropped and counted. Unpaced: wait for
+    // processing. Either fails once processing is gone.
+    if (!(options.pace ? frames.put(slot) : frames.put_wait(slot))) break;
   }
   frames.close();
 }
@@ -191,11 +189,7 @@ void processing_loop(Pipeline& pipeline, const RunOptions& options, double max_f
       if (!(seconds_since(in.captured_at) <= max_frame_age_s)) result.verdict = stop_verdict("stale frame");
       ++stats.processed;
       stats.latencies.add(result.latency_us);
-      if (options.pace) {
-        results.put(result);
-      } else if (!results.put_wait(result)) {
-        break;  // the output ended (its sink failed)
-      }
+      if (!(options.pace ? results.put(result) : results.put_wait(result))) break;  // the output ended
     }
   } catch (const std::exception& e) {
     stats.error = std::string("processing error: ") + e.what();

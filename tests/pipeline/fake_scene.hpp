@@ -72,6 +72,7 @@ struct Step {
   float object_m = 0.0F;   ///< see fill_frame
   double sleep_s = 0.0;    ///< before delivering
   bool fail = false;       ///< report an error instead of a frame
+  int64_t timestamp_ns = -1;  ///< >= 0: this timestamp instead of the index's 30 frames/s one
 };
 
 class FakeSource : public Source {
@@ -90,6 +91,7 @@ class FakeSource : public Source {
     if (step.sleep_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(step.sleep_s));
     if (step.fail) return Status::error;
     fill_frame(static_cast<int64_t>(next_), step.object_m, out);
+    if (step.timestamp_ns >= 0) out.timestamp_ns = step.timestamp_ns;
     ++next_;
     return Status::frame;
   }

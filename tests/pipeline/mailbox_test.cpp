@@ -115,5 +115,18 @@ TEST(Mailbox, PutWaitGivesUpWhenClosed) {
   EXPECT_EQ(out, 1);
 }
 
+// A paced producer must learn that its consumer is gone (a failed sink ended the output), or
+// it would go on reading the source into a mailbox nobody takes from.
+TEST(Mailbox, PutFailsOnceClosed) {
+  Mailbox<int> box;
+  box.close();
+  int value = 7;
+  EXPECT_FALSE(box.put(value));
+  EXPECT_EQ(value, 7);  // not stored
+  EXPECT_EQ(box.dropped(), 0);
+  int out = 0;
+  EXPECT_FALSE(box.take(out));
+}
+
 }  // namespace
 }  // namespace hrcsense
