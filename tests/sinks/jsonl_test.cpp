@@ -5,6 +5,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <fstream>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -181,8 +185,14 @@ TEST(JsonLinesSink, SummaryHasEveryRunSummaryField) {
   s.latency_p99_us = 1941.75;
   s.min_distance_m = 1.2196938F;
   s.end_reason = "end of source";
+  s.timestamps.backwards = 2;
+  s.timestamps.repeated = 3;
+  s.timestamps.gaps = 4;
+  s.timestamps.frames_skipped = 9;
+  s.timestamps.jumps = 1;
   sink.summary(s);
   s.min_distance_m = -1.0F;
+  s.error = "processing error: std::bad_alloc";
   sink.summary(s);
   const std::vector<json> lines = parse_lines(out.str());
   ASSERT_EQ(lines.size(), 2U);
@@ -201,7 +211,57 @@ TEST(JsonLinesSink, SummaryHasEveryRunSummaryField) {
   EXPECT_EQ(j["latency_p99_us"].get<double>(), 1941.75);
   EXPECT_EQ(j["min_distance_m"].get<float>(), 1.2196938F);
   EXPECT_EQ(j["end_reason"], "end of source");
+  EXPECT_TRUE(j["error"].is_null());  // the run ended normally
+  EXPECT_EQ(j["timestamps_backwards"], 2);
+  EXPECT_EQ(j["timestamps_repeated"], 3);
+  EXPECT_EQ(j["timestamp_gaps"], 4);
+  EXPECT_EQ(j["frames_skipped_source"], 9);
+  EXPECT_EQ(j["timestamp_jumps"], 1);
   EXPECT_TRUE(lines[1]["min_distance_m"].is_null());  // never any foreground
+  EXPECT_EQ(lines[1]["error"], "processing error: std::bad_alloc");
+}
+
+// R1 item 4: each line reaches the file descriptor when it is written, not when a buffer of
+// a few kilobytes fills: read back through a pipe right after each call, without closing.
+TEST(JsonLinesSink, EveryLineIsFlushedAtOnce) {
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  ASSERT_EQ(::fcntl(fds[0], F_SETFL, O_NONBLOCK), 0);
+  std::ofstream file("/dev/fd/" + std::to_string(fds[1]));
+  ASSERT_TRUE(file.is_open());
+  JsonLinesSink sink(file);
+  auto available = [&] {
+    std::string text;
+    char buffer[65536];
+    for (ssize_t n; (n = ::read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, static_cast<size_t>(n));
+    return text;
+  };
+  RunHeader header;
+  header.version = "test";
+  sink.header(header);
+  EXPECT_EQ(json::parse(available())["type"], "header");
+  FrameResult result;
+  result.verdict = stop_verdict("learning background (1/100 frames)");
+  sink.frame(result);
+  const std::string frame_line = available();
+  ASSERT_FALSE(frame_line.empty()) << "the frame line is still in the stream's buffer";
+  EXPECT_EQ(frame_line.back(), '\n');
+  EXPECT_EQ(json::parse(frame_line)["verdict"], "stop");
+  EXPECT_FALSE(sink.failed());
+  file.close();
+  ::close(fds[0]);
+  ::close(fds[1]);
+}
+
+// R1 item 5: a stream that fails (the reader left) makes the sink report it, so the run ends.
+TEST(JsonLinesSink, FailedStreamIsReported) {
+  std::ostringstream out;
+  JsonLinesSink sink(out);
+  EXPECT_FALSE(sink.failed());
+  out.setstate(std::ios::badbit);
+  sink.frame(FrameResult{});
+  EXPECT_TRUE(sink.failed());
+  EXPECT_EQ(sink.failure(), "write failed");
 }
 
 TEST(JsonLinesSink, NonFiniteNumbersBecomeNull) {
