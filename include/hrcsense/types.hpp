@@ -176,6 +176,9 @@ struct FrameResult {
   Contact contact;            ///< contact.valid false when there is no foreground
   size_t foreground_points = 0;
   size_t invalid_pixels = 0;  ///< raw zeros in the source frame, before any filter
+  /// Share of valid (non-zero) pixels in the filtered image, 0..1 (safety.min_valid_share);
+  /// 0 when the frame was not filtered (no valid depth at all, or no source frame).
+  float valid_share = 0.0F;
   std::vector<StageTiming> timings;
   std::optional<Contact> truth;  ///< simulated sources: ground-truth contact
   double latency_us = 0.0;       ///< from the frame entering processing to the result

@@ -61,6 +61,7 @@ void begin_result(const Frame& frame, FrameResult& result) {
   result.backend = nullptr;
   result.foreground_points = 0;
   result.invalid_pixels = 0;
+  result.valid_share = 0.0F;
   result.timings.clear();  // keeps its capacity: four stages after the first frame
   result.truth.reset();
   if (frame.truth) result.truth = frame.truth->contact;
@@ -195,6 +196,7 @@ bool Pipeline::enough_valid_depth(const Frame& frame, FrameResult& result) const
     return false;
   }
   const double share = static_cast<double>(valid) / static_cast<double>(pixels);
+  result.valid_share = static_cast<float>(share);
   if (share >= params_.safety.min_valid_share) return true;
   char text[96];
   std::snprintf(text, sizeof text, "valid depth %.4f of pixels after filters, below min_valid_share %.4g", share,

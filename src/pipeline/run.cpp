@@ -209,6 +209,7 @@ void write_stop(Sink& sink, FrameResult& scratch, const FrameResult& last, const
   scratch.contact = Contact{};
   scratch.foreground_points = 0;
   scratch.invalid_pixels = 0;
+  scratch.valid_share = 0.0F;
   scratch.timings.clear();
   scratch.truth.reset();
   scratch.latency_us = 0.0;

@@ -240,6 +240,7 @@ void JsonLinesSink::frame(const FrameResult& result) {
   m.text("backend", result.backend != nullptr ? result.backend : backend_.c_str());
   m.integer("foreground_points", static_cast<int64_t>(result.foreground_points));
   m.integer("invalid_pixels", static_cast<int64_t>(result.invalid_pixels));
+  m.number("valid_share", result.valid_share);
   m.number("latency_us", result.latency_us);
   m.open("timings_us");
   for (const StageTiming& timing : result.timings) m.number(timing.stage, timing.us);

@@ -104,6 +104,7 @@ TEST(Failsafe, TooFewValidPixelsIsStop) {
   pipeline.process(frame, result);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_NE(result.verdict.reason.find("min_valid_share"), std::string::npos) << result.verdict.reason;
+  EXPECT_FLOAT_EQ(result.valid_share, 1.0F / 4800.0F);
   EXPECT_FALSE(result.valid);
 
   fill_frame(4, 1.5F, frame);
@@ -112,6 +113,7 @@ TEST(Failsafe, TooFewValidPixelsIsStop) {
   }
   pipeline.process(frame, result);
   EXPECT_TRUE(result.valid) << result.verdict.reason;
+  EXPECT_FLOAT_EQ(result.valid_share, 1600.0F / 4800.0F);
   EXPECT_EQ(result.verdict.state, VerdictState::run);  // 1.5 m is beyond slow_distance_m 1.0 m
 }
 
