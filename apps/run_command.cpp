@@ -67,7 +67,7 @@ bool load_background_file(const Config& config, const SourceInfo& info, Pipeline
                   std::to_string(model.height) + " but the filtered source is " + std::to_string(filtered.width) +
                   "x" + std::to_string(filtered.height) + " (filters.preset " + config.filters_preset + ")");
   }
-  pipeline.set_background(std::move(model));
+  pipeline.set_background(std::move(model), "background.path '" + config.background_path + "'");
   return true;
 }
 

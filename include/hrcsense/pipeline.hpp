@@ -210,8 +210,8 @@ class Pipeline {
   const PipelineParams& params() const { return params_; }
   /// Uses a background learnt earlier instead of learning from the first frames. The first
   /// BackgroundCheck::frames frames are compared with it first (stops); when they contradict
-  /// it, process() throws BackgroundMismatch.
-  void set_background(BackgroundModel model);
+  /// it, process() throws BackgroundMismatch, naming `origin` (e.g. the file it came from).
+  void set_background(BackgroundModel model, std::string origin = "the loaded background");
   bool background_ready() const { return learner_.ready() || preset_background_; }
   const BackgroundModel& background() const;
   /// Processes one frame into `result`, reusing its buffers.
@@ -225,6 +225,7 @@ class Pipeline {
   BackgroundLearner learner_;
   bool preset_background_ = false;
   BackgroundModel preset_model_;
+  std::string preset_origin_;  ///< where preset_model_ came from, for the mismatch error
   ForegroundExtractor extractor_;
   Foreground foreground_;
   FilterChain filters_;  ///< params_.filters; its temporal state spans frames

@@ -136,8 +136,9 @@ Pipeline::Pipeline(PipelineParams params)
   filters_.params = params_.filters;
 }
 
-void Pipeline::set_background(BackgroundModel model) {
+void Pipeline::set_background(BackgroundModel model, std::string origin) {
   preset_model_ = std::move(model);
+  preset_origin_ = std::move(origin);
   preset_background_ = true;
   check_ = BackgroundCheck{};
   check_.frames = params_.background.check_frames;
@@ -213,11 +214,11 @@ bool Pipeline::background_checked(const Frame& frame, FrameResult& result) {
   if (check_.done() && check_.mismatch()) {
     char text[256];
     std::snprintf(text, sizeof text,
-                  "the loaded background does not match the scene: %.1f %% of its reliable pixels are measured "
-                  "farther than it in the first %d frames (at most %.1f %% allowed); the camera moved or the file "
-                  "is another cell's: delete it to learn a new one",
+                  ": does not match the scene: %.1f %% of its reliable pixels are measured farther than it in "
+                  "the first %d frames (at most %.1f %% allowed); the camera moved or the file is another "
+                  "cell's: delete it to learn a new one",
                   100.0 * check_.farther_share(), seen, 100.0 * static_cast<double>(check_.max_farther_share));
-    throw BackgroundMismatch(text);
+    throw BackgroundMismatch(preset_origin_ + text);
   }
   char text[64];
   std::snprintf(text, sizeof text, "checking loaded background (%d/%d frames)", seen, check_.frames);

@@ -192,7 +192,7 @@ void processing_loop(Pipeline& pipeline, const RunOptions& options, double max_f
       if (!(options.pace ? results.put(result) : results.put_wait(result))) break;  // the output ended
     }
   } catch (const std::exception& e) {
-    stats.error = std::string("processing error: ") + e.what();
+    stats.error = "processing error at frame " + std::to_string(in.frame.index) + ": " + e.what();
   }
   frames.close();  // the capture thread must not wait for a consumer that is gone
   results.close();

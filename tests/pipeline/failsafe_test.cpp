@@ -327,7 +327,8 @@ TEST(Failsafe, ProcessingErrorIsTheRunsError) {
   CollectingSink sink;
   RunHeader header;
   const RunSummary summary = run_pipeline(source, pipeline, sink, RunOptions{}, header);
-  EXPECT_EQ(summary.error.rfind("processing error: the loaded background does not match", 0), 0U) << summary.error;
+  EXPECT_EQ(summary.error.rfind("processing error at frame 0: the loaded background: does not match", 0), 0U)
+      << summary.error;
   EXPECT_EQ(summary.end_reason, summary.error);
   EXPECT_EQ(sink.results.back().verdict.state, VerdictState::stop);
   EXPECT_EQ(sink.results.back().verdict.reason, summary.error);
