@@ -212,7 +212,7 @@ TEST_F(FailsafeCli, RotationThatOverflowsFloatIsAConfigError) {
 // frame may say run; frame 190, with the person 0.29 m from the robot, is a stop.
 TEST_F(FailsafeCli, ThresholdThatEmptiesTheFramesNeverRuns) {
   const Outcome outcome = run("run --config '" + config("walk.yaml") + "' --set filters.threshold.max=0.5" +
-                              (hrcsense::test::kSanitized ? " --frames 200" : ""));
+                              (hrcsense::test::kSanitized ? " --frames 200 --set sim.width=424 --set sim.height=240" : ""));
   ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
   int frames = 0;
   for (const json& line : json_lines(outcome.out)) {
@@ -229,13 +229,15 @@ TEST_F(FailsafeCli, ThresholdThatEmptiesTheFramesNeverRuns) {
 // Item 3: with the padding the person reaches inside the capsules; every such frame is
 // a stop, and a stop distance of 0 is refused.
 TEST_F(FailsafeCli, InsideTheRobotIsAlwaysStop) {
+  const std::string smaller = hrcsense::test::kSanitized ? " --set sim.width=424 --set sim.height=240" : "";
   Outcome outcome = run("run --config '" + config("walk.yaml") +
                         "' --set safety.stop_distance_m=0 --set safety.slow_distance_m=0 --set robot.padding_m=0.35");
   EXPECT_EQ(outcome.exit_code, 2);
   EXPECT_NE(outcome.err.find("safety.stop_distance_m"), std::string::npos) << outcome.err;
 
   outcome = run("run --config '" + config("walk.yaml") +
-                "' --set safety.stop_distance_m=0.001 --set safety.slow_distance_m=0.001 --set robot.padding_m=0.35");
+                "' --set safety.stop_distance_m=0.001 --set safety.slow_distance_m=0.001 --set robot.padding_m=0.35" +
+                smaller);
   ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
   int inside = 0;
   for (const json& line : json_lines(outcome.out)) {
