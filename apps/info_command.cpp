@@ -5,6 +5,7 @@
 
 #include "hrcsense/camera.hpp"
 #include "hrcsense/config.hpp"
+#include "hrcsense/io.hpp"
 #include "hrcsense/recordings.hpp"
 
 #include <algorithm>
@@ -124,6 +125,11 @@ int info_command(const CommandArgs& args) {
     // A path that is not there is a mistake on the command line, not damaged data.
     if (!std::filesystem::exists(args.input)) {
       return report_error(args.input + ": no such recording (expected a .bag file or a folder)", kExitUsage);
+    }
+    // A FIFO or a device would block the reader forever: refuse it before opening.
+    if (!std::filesystem::is_directory(args.input) && !not_regular_file(args.input).empty()) {
+      return report_error(args.input + ": " + not_regular_file(args.input) + " (expected a .bag file or a folder)",
+                          kExitUsage);
     }
     return print_recording(args.input);
   }

@@ -68,12 +68,14 @@ struct RecordingParams {
 class FolderSource : public Source {
  public:
   /// Lists the frames and reads the intrinsics; throws IoError naming the file when the folder,
-  /// its frame list or its intrinsics are missing or unreadable.
+  /// its frame list or its intrinsics are missing, unreadable or not regular files (a FIFO would
+  /// block), or when the list's first frame line is already malformed (naming file and line).
   explicit FolderSource(RecordingParams params);
   SourceInfo info() const override;
   /// A PNG that cannot be read, or whose size or bit depth differs from the intrinsics, is an
   /// error naming the file and frame; every later call repeats it. So is a damaged colour image
-  /// (when decoded), or a JPEG in a build without libturbojpeg.
+  /// (when decoded), or a JPEG in a build without libturbojpeg, and a malformed line of
+  /// frames.txt / depth.txt: the frames listed before it play, then the error names file:line.
   Status next(Frame& out) override;
   std::string error() const override { return error_; }
 
@@ -97,6 +99,7 @@ class FolderSource : public Source {
   Intrinsics color_intrinsics_;                 ///< width 0 until an image gives the size; fx 0: unknown
   std::optional<Extrinsics> depth_to_color_;
   int64_t played_ = 0;
+  std::string list_error_;  ///< the list's first malformed line, reported after the frames before it
   std::string error_;
 };
 

@@ -90,6 +90,7 @@ std::string size_text(uint32_t width, uint32_t height) {
 
 /// Reads the whole file after checking that its length matches the header's size fields.
 std::vector<uint8_t> read_checked_bytes(const std::string& path, uint32_t& width, uint32_t& height) {
+  require_regular_file(path, "background file");  // opening a FIFO would block forever
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) {
     fail(path, std::string("cannot open background file: ") + std::strerror(errno));

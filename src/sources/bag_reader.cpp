@@ -95,6 +95,7 @@ struct BagReader::Record {
 };
 
 BagReader::BagReader(std::string path, BagLimits limits) : path_(std::move(path)), limits_(limits) {
+  require_regular_file(path_, "recording");  // fopen() of a FIFO would block forever
   file_.reset(std::fopen(path_.c_str(), "rb"));
   if (!file_) throw IoError(path_ + ": cannot open");
   if (fseeko(file_.get(), 0, SEEK_END) != 0) fail(0, "cannot seek");

@@ -6,8 +6,6 @@
 #include "hrcsense/io.hpp"
 #include "hrcsense/recordings.hpp"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
@@ -32,6 +30,7 @@ constexpr int64_t kMaxDepthPixels = int64_t{1} << 25;
 constexpr int64_t kMaxColorOffsetNs = 20'000'000;
 
 std::string read_text(const std::string& path) {
+  require_regular_file(path, "");  // a FIFO would block the open below forever
   std::ifstream file(path, std::ios::binary);
   if (!file) throw IoError(path + ": cannot open");
   std::ostringstream text;
@@ -57,12 +56,34 @@ bool parse_seconds_ns(const std::string& text, int64_t& out_ns) {
   return true;
 }
 
-/// Reads a list file: one frame per non-comment line; the path is in column `path_column`,
-/// a time in seconds in column `time_column` (-1: none), and, where a line has it, a colour
-/// image in column `color_column` (-1: none; `colors` gets "" for lines without one).
-void read_list(const std::string& list_path, const fs::path& folder, int path_column, int time_column,
-               std::vector<std::string>& files, std::vector<int64_t>& stamps_ns, int color_column = -1,
-               std::vector<std::string>* colors = nullptr) {
+/// Where a list file keeps what (column numbers from 0; -1: not in this list).
+struct ListColumns {
+  int path = 1;
+  int time = -1;   ///< time in seconds, "1305031102.175304"
+  int color = -1;  ///< colour image, where a line has it
+  int index = -1;  ///< the frame's number: digits only
+};
+
+/// A line for an error message: at most 60 characters, control bytes shown as '?'.
+std::string quoted_line(const std::string& line) {
+  std::string out = line.substr(0, 60);
+  for (char& ch : out) {
+    if (std::iscntrl(static_cast<unsigned char>(ch)) != 0) ch = '?';
+  }
+  return "'" + out + (line.size() > 60 ? "...'" : "'");
+}
+
+bool all_digits(const std::string& text) {
+  return !text.empty() && text.size() <= 18 &&
+         std::all_of(text.begin(), text.end(), [](char ch) { return ch >= '0' && ch <= '9'; });
+}
+
+/// Reads a list file: one frame per non-comment line. Stops at the first malformed line and
+/// returns "<file>:<line>: <problem>, got '<line>'" (the lines before it are kept, so that the
+/// good frames still play); "" when every line is good.
+std::string read_list(const std::string& list_path, const fs::path& folder, const ListColumns& c,
+                      std::vector<std::string>& files, std::vector<int64_t>& stamps_ns,
+                      std::vector<std::string>* colors = nullptr) {
   std::istringstream lines(read_text(list_path));
   std::string line;
   for (int line_no = 1; std::getline(lines, line); ++line_no) {
@@ -70,117 +91,45 @@ void read_list(const std::string& list_path, const fs::path& folder, int path_co
     std::istringstream words(line);
     std::vector<std::string> columns;
     for (std::string word; words >> word;) columns.push_back(word);
-    const int needed = std::max(path_column, time_column);
+    const auto column = [&](int i) { return columns[static_cast<size_t>(i)]; };
+    const std::string at = list_path + ":" + std::to_string(line_no) + ": ";
+    const int needed = std::max({c.path, c.time, c.index});
     if (static_cast<int>(columns.size()) <= needed) {
-      throw IoError(list_path + ":" + std::to_string(line_no) + ": expected at least " + std::to_string(needed + 1) +
-                    " columns");
+      return at + "expected at least " + std::to_string(needed + 1) + " columns, got " + quoted_line(line);
     }
-    files.push_back((folder / columns[static_cast<size_t>(path_column)]).string());
+    if (c.index >= 0 && !all_digits(column(c.index))) {
+      return at + "expected a frame number in column " + std::to_string(c.index + 1) + ", got " + quoted_line(line);
+    }
+    int64_t ns = 0;
+    // Digits only, at most 10 before the point: no NaN, infinity, sign or exponent gets through.
+    if (c.time >= 0 && !parse_seconds_ns(column(c.time), ns)) {
+      return at + "bad timestamp '" + column(c.time).substr(0, 40) +
+             "' (expected seconds like 1305031102.175304, before the year 2262), got " + quoted_line(line);
+    }
+    if (c.time >= 0) stamps_ns.push_back(ns);
+    files.push_back((folder / column(c.path)).string());
     if (colors != nullptr) {
-      const bool has = color_column >= 0 && static_cast<int>(columns.size()) > color_column;
-      colors->push_back(has ? (folder / columns[static_cast<size_t>(color_column)]).string() : std::string());
-    }
-    if (time_column >= 0) {
-      int64_t ns = 0;
-      if (!parse_seconds_ns(columns[static_cast<size_t>(time_column)], ns)) {
-        throw IoError(list_path + ":" + std::to_string(line_no) + ": bad timestamp '" +
-                      columns[static_cast<size_t>(time_column)] + "'");
-      }
-      stamps_ns.push_back(ns);
+      const bool has = c.color >= 0 && static_cast<int>(columns.size()) > c.color;
+      colors->push_back(has ? (folder / column(c.color)).string() : std::string());
     }
   }
-}
-
-float json_number(const nlohmann::json& node, const std::string& what) {
-  if (!node.is_number()) throw IoError(what + ": expected a number");
-  return node.get<float>();
-}
-
-/// A 3x3 matrix given as rows, or an error naming the field.
-void check_3x3(const nlohmann::json& m, const std::string& what) {
-  if (!m.is_array() || m.size() != 3 || !m[0].is_array() || m[0].size() != 3 || !m[1].is_array() ||
-      m[1].size() != 3 || !m[2].is_array() || m[2].size() != 3) {
-    throw IoError(what + ": expected a 3x3 matrix");
-  }
-}
-
-/// The colour camera of the datasets' form (`rgb_K`, `depth_to_rgb_R`, `depth_to_rgb_T_m`),
-/// where the file has it; the colour image size comes from the images.
-void color_calibration_from_dataset_json(const nlohmann::json& doc, const std::string& path, bool one_based,
-                                         Intrinsics& color, std::optional<Extrinsics>& depth_to_color) {
-  if (doc.contains("rgb_K")) {
-    const nlohmann::json& k = doc.at("rgb_K");
-    check_3x3(k, path + ": rgb_K");
-    color.fx = json_number(k[0][0], path + ": rgb_K[0][0]");
-    color.ppx = json_number(k[0][2], path + ": rgb_K[0][2]") - (one_based ? 1.0F : 0.0F);
-    color.fy = json_number(k[1][1], path + ": rgb_K[1][1]");
-    color.ppy = json_number(k[1][2], path + ": rgb_K[1][2]") - (one_based ? 1.0F : 0.0F);
-  }
-  if (doc.contains("depth_to_rgb_R") && doc.contains("depth_to_rgb_T_m")) {
-    const nlohmann::json& r = doc.at("depth_to_rgb_R");
-    const nlohmann::json& t = doc.at("depth_to_rgb_T_m");
-    check_3x3(r, path + ": depth_to_rgb_R");
-    if (!t.is_array() || t.size() != 3) throw IoError(path + ": depth_to_rgb_T_m: expected 3 numbers");
-    Extrinsics e;
-    for (size_t i = 0; i < 3; ++i) {
-      e.translation_m[i] = json_number(t[i], path + ": depth_to_rgb_T_m");
-      // P_rgb = R·P_depth + T; the SDK's layout is column-major.
-      for (size_t j = 0; j < 3; ++j) e.rotation[3 * j + i] = json_number(r[i][j], path + ": depth_to_rgb_R");
-    }
-    depth_to_color = e;
-  }
-}
-
-/// The datasets' form: {"width", "height", "depth_K", "depth_units_m", "pixel_convention"}.
-Intrinsics intrinsics_from_dataset_json(const nlohmann::json& doc, const std::string& path, float& scale_m) {
-  // .at() and contains(), never operator[] on a const document: a missing key must be an
-  // error, not a read past the end of the object (found by fuzz/folder_fuzz.cpp).
-  const nlohmann::json& k = doc.at("depth_K");
-  check_3x3(k, path + ": depth_K");
-  Intrinsics in;
-  if (!doc.contains("width") || !doc.contains("height") || !doc.at("width").is_number_integer() ||
-      !doc.at("height").is_number_integer()) {
-    throw IoError(path + ": width, height: expected integers");
-  }
-  in.width = doc.at("width").get<int>();
-  in.height = doc.at("height").get<int>();
-  in.fx = json_number(k[0][0], path + ": depth_K[0][0]");
-  in.ppx = json_number(k[0][2], path + ": depth_K[0][2]");
-  in.fy = json_number(k[1][1], path + ": depth_K[1][1]");
-  in.ppy = json_number(k[1][2], path + ": depth_K[1][2]");
-  // MATLAB calibrations put the first pixel's centre at 1; hrcsense (like the SDK) at 0.
-  const std::string convention = doc.value("pixel_convention", std::string("0-based"));
-  if (convention.rfind("1-based", 0) == 0) {
-    in.ppx -= 1.0F;
-    in.ppy -= 1.0F;
-  }
-  if (doc.contains("depth_units_m")) scale_m = json_number(doc.at("depth_units_m"), path + ": depth_units_m");
-  return in;
+  return {};
 }
 
 Intrinsics read_intrinsics_file(const std::string& path, float& scale_m, Intrinsics& color,
                                  std::optional<Extrinsics>& depth_to_color) {
-  if (!fs::is_regular_file(path)) throw IoError(path + ": intrinsics file missing (every depth folder needs one)");
-  const std::string text = read_text(path);
-  Intrinsics in;
-  try {
-    const nlohmann::json doc = nlohmann::json::parse(text);
-    in = doc.contains("depth_K") ? intrinsics_from_dataset_json(doc, path, scale_m) : intrinsics_from_json(text, path);
-    if (doc.is_object() && doc.contains("depth_K")) {
-      const bool one_based = doc.value("pixel_convention", std::string("0-based")).rfind("1-based", 0) == 0;
-      color_calibration_from_dataset_json(doc, path, one_based, color, depth_to_color);
-    }
-  } catch (const nlohmann::json::exception& e) {
-    throw IoError(path + ": " + e.what());
-  }
+  if (!fs::exists(fs::symlink_status(path))) throw IoError(path + ": intrinsics file missing (every depth folder needs one)");
+  FolderCalibration calibration = folder_calibration_from_json(read_text(path), path);
   // The pixel count is bounded too: the depth PNGs are checked against this size before their
   // pixels are allocated, so the file's numbers bound every depth buffer (64 MiB at most).
-  if (in.width <= 0 || in.height <= 0 || in.width > 16384 || in.height > 16384 ||
-      static_cast<int64_t>(in.width) * in.height > kMaxDepthPixels || !(in.fx > 0.0F) || !(in.fy > 0.0F)) {
+  const Intrinsics& in = calibration.depth;
+  if (static_cast<int64_t>(in.width) * in.height > kMaxDepthPixels) {
     throw IoError(path + ": implausible intrinsics (size " + std::to_string(in.width) + "x" + std::to_string(in.height) +
-                  ", fx and fy must be positive)");
+                  ", more than 32 Mpx)");
   }
-  if (!(scale_m > 0.0F)) throw IoError(path + ": depth_units_m must be positive");
+  if (calibration.depth_units_m > 0.0F) scale_m = calibration.depth_units_m;
+  color = calibration.color;
+  depth_to_color = calibration.depth_to_color;
   return in;
 }
 
@@ -219,7 +168,7 @@ std::vector<std::string> colors_beside(const fs::path& folder, const std::vector
     std::string found;
     for (const char* ext : {".png", ".jpg", ".jpeg"}) {
       const fs::path candidate = folder / "rgb" / (fs::path(depth).stem().string() + ext);
-      if (fs::is_regular_file(candidate)) {
+      if (fs::exists(fs::symlink_status(candidate))) {
         found = candidate.string();
         break;
       }
@@ -245,19 +194,25 @@ void read_color_image(const std::string& path, ColorImage& out) {
 FolderSource::FolderSource(RecordingParams params) : params_(std::move(params)) {
   const fs::path folder(params_.path);
   if (!fs::is_directory(folder)) throw IoError(params_.path + ": not a folder");
-  if (fs::is_regular_file(folder / "depth.txt")) {
+  // Found by name; read_text then refuses a list that is a FIFO, a device or a folder rather
+  // than passing over it to another layout.
+  const auto present = [&folder](const char* name) { return fs::exists(fs::symlink_status(folder / name)); };
+  if (present("depth.txt")) {
     layout_ = "tum";
     depth_scale_m_ = kTumDepthScaleM;
-    read_list((folder / "depth.txt").string(), folder, 1, 0, files_, stamps_ns_);
-    if (fs::is_regular_file(folder / "rgb.txt")) {
+    list_error_ = read_list((folder / "depth.txt").string(), folder, ListColumns{1, 0}, files_, stamps_ns_);
+    if (present("rgb.txt")) {
       std::vector<std::string> rgb_files;
       std::vector<int64_t> rgb_ns;
-      read_list((folder / "rgb.txt").string(), folder, 1, 0, rgb_files, rgb_ns);
+      // Colour only: a bad line there is an error at once (it would pair the wrong images).
+      const std::string problem = read_list((folder / "rgb.txt").string(), folder, ListColumns{1, 0}, rgb_files, rgb_ns);
+      if (!problem.empty()) throw IoError(problem);
       color_files_ = associate_colors(stamps_ns_, std::move(rgb_files), std::move(rgb_ns));
     }
-  } else if (fs::is_regular_file(folder / "frames.txt")) {
+  } else if (present("frames.txt")) {
     layout_ = "ist";
-    read_list((folder / "frames.txt").string(), folder, 1, -1, files_, stamps_ns_, 2, &color_files_);
+    list_error_ =
+        read_list((folder / "frames.txt").string(), folder, ListColumns{1, -1, 2, 0}, files_, stamps_ns_, &color_files_);
     if (std::all_of(color_files_.begin(), color_files_.end(), [](const std::string& f) { return f.empty(); })) {
       color_files_.clear();
     }
@@ -271,7 +226,8 @@ FolderSource::FolderSource(RecordingParams params) : params_(std::move(params)) 
   } else {
     throw IoError(params_.path + ": no depth.txt, frames.txt or depth/ folder: not a depth recording");
   }
-  if (files_.empty()) throw IoError(params_.path + ": no depth frames listed");
+  // A list whose first frame line is already malformed has nothing to play: say which line.
+  if (files_.empty()) throw IoError(list_error_.empty() ? params_.path + ": no depth frames listed" : list_error_);
   intrinsics_ = read_intrinsics_file((folder / "intrinsics.json").string(), depth_scale_m_, color_intrinsics_,
                                      depth_to_color_);
 }
@@ -290,13 +246,18 @@ SourceInfo FolderSource::info() const {
 Source::Status FolderSource::next(Frame& out) {
   if (!error_.empty()) return Status::error;
   const auto count = static_cast<int64_t>(files_.size());
-  if (!params_.loop && played_ >= count) return Status::end;
+  // After the good frames, a malformed list line is the damage (no second lap over it).
+  if (played_ >= count && (!params_.loop || !list_error_.empty())) {
+    if (list_error_.empty()) return Status::end;
+    error_ = "frame " + std::to_string(played_) + ": " + list_error_;
+    return Status::error;
+  }
   const int64_t lap = played_ / count;
   const auto i = static_cast<size_t>(played_ % count);
   const std::string& file = files_[i];
   try {
     // A list may name anything; a device or a pipe would block or never end.
-    if (!fs::is_regular_file(file)) throw IoError(file + ": missing or not a regular file");
+    require_regular_file(file, "depth image");
     read_depth_png(file, out.depth, intrinsics_.width, intrinsics_.height);
   } catch (const IoError& e) {
     error_ = "frame " + std::to_string(played_) + ": " + e.what();
@@ -329,7 +290,7 @@ Source::Status FolderSource::next(Frame& out) {
   } else {
     if (!out.color) out.color.emplace();
     try {
-      if (!fs::is_regular_file(color_file)) throw IoError(color_file + ": missing or not a regular file");
+      require_regular_file(color_file, "colour image");
       read_color_image(color_file, *out.color);
     } catch (const IoError& e) {
       error_ = "frame " + std::to_string(played_) + ": colour: " + e.what();

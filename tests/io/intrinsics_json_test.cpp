@@ -56,7 +56,7 @@ TEST(IntrinsicsJson, RoundTripIsBitExactForEveryModel) {
        {Distortion::none, Distortion::modified_brown_conrady, Distortion::inverse_brown_conrady,
         Distortion::ftheta, Distortion::brown_conrady, Distortion::kannala_brandt4}) {
     Intrinsics in = sample(model);
-    in.fx = 1.0F / 3.0F;  // no short decimal: exercises the float round trip
+    in.fx = 1000.0F / 3.0F;  // no short decimal: exercises the float round trip
     const Intrinsics back = intrinsics_from_json(intrinsics_to_json(in), "round trip");
     EXPECT_EQ(back.width, in.width);
     EXPECT_EQ(back.height, in.height);
