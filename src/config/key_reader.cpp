@@ -30,16 +30,54 @@ std::string describe(const YAML::Node& node) {
   return "nothing";
 }
 
-const char* bound_text(Bound bound) {
+// "a number > 0", "a number in [0, 60]", ...; `float_range` adds a float's limit when there is
+// no smaller maximum.
+std::string bound_text(Bound bound, double max, bool float_range) {
+  const bool has_max = max < (float_range ? static_cast<double>(std::numeric_limits<float>::max())
+                                          : std::numeric_limits<double>::max());
+  const std::string limit = has_max ? double_text(max) : std::string();
   switch (bound) {
-    case Bound::non_negative: return "a number >= 0";
-    case Bound::positive: return "a number > 0";
+    case Bound::non_negative:
+      if (has_max) return "a number >= 0 and <= " + limit;
+      return float_range ? "a number >= 0 within a float's range (<= 3.4e38)" : "a number >= 0";
+    case Bound::positive:
+      if (has_max) return "a number > 0 and <= " + limit;
+      return float_range ? "a number > 0 within a float's range (<= 3.4e38)" : "a number > 0";
     case Bound::any: break;
   }
-  return "a number";
+  if (has_max) return "a number <= " + limit;
+  return float_range ? "a number within a float's range (|x| <= 3.4e38)" : "a finite number";
+}
+
+bool within(double value, Bound bound, double max) {
+  return !(bound == Bound::non_negative && value < 0.0) && !(bound == Bound::positive && value <= 0.0) &&
+         value <= max;
 }
 
 }  // namespace
+
+std::string leading_zero_problem(const std::string& scalar) {
+  const size_t sign = !scalar.empty() && (scalar[0] == '-' || scalar[0] == '+') ? 1 : 0;
+  size_t end = sign;
+  while (end < scalar.size() && scalar[end] >= '0' && scalar[end] <= '9') ++end;
+  const std::string digits = scalar.substr(sign, end - sign);
+  const bool rest_is_exponent = end == scalar.size() || scalar[end] == 'e' || scalar[end] == 'E';
+  if (digits.size() < 2 || digits[0] != '0' || !rest_is_exponent) return {};
+  const size_t first = digits.find_first_not_of('0');
+  const std::string decimal =
+      scalar.substr(0, sign) + (first == std::string::npos ? "0" : digits.substr(first)) + scalar.substr(end);
+  std::string octal;
+  if (end == scalar.size() && digits.find_first_of("89") == std::string::npos) {
+    octal = ", or " + scalar.substr(0, sign) + std::to_string(std::strtoll(digits.c_str(), nullptr, 8)) +
+            " if the octal value was meant";
+  }
+  return "'" + scalar + "' has a leading zero, which YAML 1.1 reads as octal and YAML 1.2 as decimal; write " +
+         decimal + octal;
+}
+
+bool fits_float(double value) {
+  return std::isfinite(value) && std::fabs(value) <= static_cast<double>(std::numeric_limits<float>::max());
+}
 
 void fail(const std::string& where, const std::string& key, const std::string& what) {
   throw ConfigError(where + ": key '" + key + "': " + what);
@@ -116,11 +154,25 @@ void KeyReader::set_effective(const std::string& key, const YAML::Node& value) {
 YAML::Node KeyReader::raw(const std::string& key) { return lookup(key); }
 
 double KeyReader::scalar_number(const std::string& key, const YAML::Node& node) const {
+  const std::string zero = node.IsScalar() ? leading_zero_problem(node.Scalar()) : std::string();
+  if (!zero.empty()) fail(key, zero);
   double value = 0.0;
   if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value)) {
     fail(key, "expected a number, got " + describe(node));
   }
   return value;
+}
+
+float KeyReader::scalar_float(const std::string& key, const YAML::Node& node, float max_abs) const {
+  const double value = scalar_number(key, node);
+  if (!fits_float(value) || std::fabs(value) > static_cast<double>(max_abs)) {
+    const bool limited = max_abs < std::numeric_limits<float>::max();
+    fail(key, "expected numbers " +
+                  (limited ? "in [-" + float_text(max_abs) + ", " + float_text(max_abs) + "]"
+                           : std::string("within a float's range (|x| <= 3.4e38)")) +
+                  ", got " + describe(node));
+  }
+  return static_cast<float>(value);
 }
 
 void KeyReader::text(const std::string& key, std::string& value) {
@@ -154,6 +206,8 @@ void KeyReader::flag(const std::string& key, bool& value) {
 void KeyReader::integer(const std::string& key, int64_t& value, int64_t min, int64_t max) {
   const YAML::Node node = lookup(key);
   if (node.IsDefined()) {
+    const std::string zero = node.IsScalar() ? leading_zero_problem(node.Scalar()) : std::string();
+    if (!zero.empty()) fail(key, zero);
     const std::string expected =
         "an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
     int64_t read = 0;
@@ -178,33 +232,50 @@ void KeyReader::integer(const std::string& key, uint64_t& value) {
   value = static_cast<uint64_t>(wide);
 }
 
-void KeyReader::number(const std::string& key, double& value, Bound bound) {
+void KeyReader::number(const std::string& key, double& value, Bound bound, double max) {
   const YAML::Node node = lookup(key);
   if (node.IsDefined()) {
-    double read = 0.0;
-    const bool ok = node.IsScalar() && YAML::convert<double>::decode(node, read) && std::isfinite(read) &&
-                    !(bound == Bound::non_negative && read < 0.0) &&
-                    !(bound == Bound::positive && read <= 0.0);
-    if (!ok) fail(key, std::string("expected ") + bound_text(bound) + ", got " + describe(node));
+    const double read = scalar_number(key, node);
+    if (!within(read, bound, max)) fail(key, "expected " + bound_text(bound, max, false) + ", got " + describe(node));
     value = read;
   }
   set_effective(key, YAML::Node(double_text(value)));
 }
 
-void KeyReader::number(const std::string& key, float& value, Bound bound) {
-  double wide = value;
-  number(key, wide, bound);
-  value = static_cast<float>(wide);
+void KeyReader::number(const std::string& key, float& value, Bound bound, float max) {
+  const YAML::Node node = lookup(key);
+  if (node.IsDefined()) {
+    const double read = scalar_number(key, node);
+    // Checked again as the float it becomes: 1e-46 > 0, but it becomes the float 0.
+    const float narrow = fits_float(read) ? static_cast<float>(read) : 0.0F;
+    if (!fits_float(read) || !within(static_cast<double>(narrow), bound, static_cast<double>(max))) {
+      fail(key, "expected " + bound_text(bound, static_cast<double>(max), true) + ", got " + describe(node));
+    }
+    value = narrow;
+  }
   set_effective(key, YAML::Node(float_text(value)));
 }
 
-void KeyReader::vec3(const std::string& key, Eigen::Vector3f& value) {
+void KeyReader::number_in(const std::string& key, double& value, double min, double max, const std::string& unit) {
+  const YAML::Node node = lookup(key);
+  if (node.IsDefined()) {
+    const double read = scalar_number(key, node);
+    if (!(read >= min && read <= max)) {
+      fail(key, "expected a number in [" + double_text(min) + ", " + double_text(max) + "]" + unit + ", got " +
+                    describe(node));
+    }
+    value = read;
+  }
+  set_effective(key, YAML::Node(double_text(value)));
+}
+
+void KeyReader::vec3(const std::string& key, Eigen::Vector3f& value, float max_abs) {
   const YAML::Node node = lookup(key);
   if (node.IsDefined()) {
     if (!node.IsSequence() || node.size() != 3) {
       fail(key, "expected a list of 3 numbers [x, y, z], got " + describe(node));
     }
-    for (size_t i = 0; i < 3; ++i) value[static_cast<int>(i)] = static_cast<float>(scalar_number(key, node[i]));
+    for (size_t i = 0; i < 3; ++i) value[static_cast<int>(i)] = scalar_float(key, node[i], max_abs);
   }
   YAML::Node out(YAML::NodeType::Sequence);
   out.SetStyle(YAML::EmitterStyle::Flow);
@@ -212,7 +283,7 @@ void KeyReader::vec3(const std::string& key, Eigen::Vector3f& value) {
   set_effective(key, out);
 }
 
-void KeyReader::vec3_list(const std::string& key, std::vector<Eigen::Vector3f>& value) {
+void KeyReader::vec3_list(const std::string& key, std::vector<Eigen::Vector3f>& value, float max_abs) {
   const YAML::Node node = lookup(key);
   if (node.IsDefined()) {
     if (!node.IsSequence()) fail(key, "expected a list of [x, y, z] lists, got " + describe(node));
@@ -221,9 +292,8 @@ void KeyReader::vec3_list(const std::string& key, std::vector<Eigen::Vector3f>& 
       if (!item.IsSequence() || item.size() != 3) {
         fail(key, "expected a list of [x, y, z] lists, got an item that is " + describe(item));
       }
-      value.emplace_back(static_cast<float>(scalar_number(key, item[0])),
-                         static_cast<float>(scalar_number(key, item[1])),
-                         static_cast<float>(scalar_number(key, item[2])));
+      value.emplace_back(scalar_float(key, item[0], max_abs), scalar_float(key, item[1], max_abs),
+                         scalar_float(key, item[2], max_abs));
     }
   }
   YAML::Node out(YAML::NodeType::Sequence);

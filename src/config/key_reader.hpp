@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <limits>
 #include <set>
 #include <string>
 #include <vector>
@@ -31,6 +32,21 @@ std::string float_text(float value);
 /// Same for double.
 std::string double_text(double value);
 
+/// "" for a number written plainly; for one with a leading zero ("017", "-00", "08e1") the
+/// message why it is refused: YAML 1.1 reads 017 as octal (15), YAML 1.2 as decimal (17), and
+/// yaml-cpp itself does both (15 for an integer key, 17 for a real one). Plain 0, 0.5 and 00.5
+/// (the same in both) pass.
+std::string leading_zero_problem(const std::string& scalar);
+
+/// True when `value` is finite and within a float's range, so that the cast to float is defined
+/// and gives a finite number (a double beyond FLT_MAX would become inf).
+bool fits_float(double value);
+
+/// Positions in the base frame (camera, robot points and capsules) lie within a kilometre of
+/// the origin: a cell is metres across, and squared distances (1e6 m²) stay far from a float's
+/// range.
+inline constexpr float kMaxCoordinateM = 1000.0F;
+
 /// Lower bound a number must respect.
 enum class Bound { any, non_negative, positive };
 
@@ -49,13 +65,21 @@ class KeyReader {
   void integer(const std::string& key, int64_t& value, int64_t min, int64_t max);
   void integer(const std::string& key, int& value, int min, int max);
   void integer(const std::string& key, uint64_t& value);
-  void number(const std::string& key, double& value, Bound bound);
-  void number(const std::string& key, float& value, Bound bound);
-  /// A list of exactly three numbers [x, y, z].
-  void vec3(const std::string& key, Eigen::Vector3f& value);
-  /// A list of [x, y, z] lists.
-  void vec3_list(const std::string& key, std::vector<Eigen::Vector3f>& value);
-  /// A list of numbers; `size` > 0 demands exactly that many (an empty list is always allowed).
+  /// A finite number respecting `bound` and at most `max`.
+  void number(const std::string& key, double& value, Bound bound,
+              double max = std::numeric_limits<double>::max());
+  /// The same, checked as the float it becomes (1e39 would become inf, 1e-46 a zero that
+  /// slipped past "> 0"); `max` defaults to a float's largest.
+  void number(const std::string& key, float& value, Bound bound, float max = std::numeric_limits<float>::max());
+  /// A finite number in [min, max]; `unit` follows the range in the message (" s").
+  void number_in(const std::string& key, double& value, double min, double max, const std::string& unit);
+  /// A list of exactly three numbers [x, y, z], each a float with |x| <= max_abs.
+  void vec3(const std::string& key, Eigen::Vector3f& value, float max_abs = std::numeric_limits<float>::max());
+  /// A list of [x, y, z] lists, each number a float with |x| <= max_abs.
+  void vec3_list(const std::string& key, std::vector<Eigen::Vector3f>& value,
+                 float max_abs = std::numeric_limits<float>::max());
+  /// A list of finite numbers; `size` > 0 demands exactly that many (an empty list is always
+  /// allowed).
   void number_list(const std::string& key, std::vector<double>& value, size_t size);
   /// A structured value parsed by the caller: records the key and returns its node
   /// (undefined when absent). The caller records the effective value with `set_effective`.
@@ -72,6 +96,7 @@ class KeyReader {
  private:
   YAML::Node lookup(const std::string& key);
   double scalar_number(const std::string& key, const YAML::Node& node) const;
+  float scalar_float(const std::string& key, const YAML::Node& node, float max_abs) const;
 
   YAML::Node root_;
   YAML::Node effective_;

@@ -17,8 +17,19 @@ namespace {
 using config_detail::Bound;
 using config_detail::KeyReader;
 
-constexpr int64_t kMaxCount = std::numeric_limits<int64_t>::max();
 constexpr double kPi = 3.14159265358979323846;
+using config_detail::kMaxCoordinateM;
+/// Simulated frames: a year at 30 frames/s; with sim.fps >= 1 every timestamp (index · 1e9 /
+/// fps ns) stays below 1e18, inside int64.
+constexpr int64_t kMaxSimFrames = 1'000'000'000;
+/// Stereo baselines: 0 (unknown) or 1 mm to 1 m (the D435's is 50 mm, the D455's 95 mm).
+constexpr float kMinBaselineMm = 1.0F;
+constexpr float kMaxBaselineMm = 1000.0F;
+/// The watchdog (safety.max_frame_age_s): at least 1 ms (below that it fires between any
+/// camera's frames and floods the output) and at most 60 s (a watchdog that waits longer is no
+/// watchdog; larger values once overflowed a clock conversion).
+constexpr double kMinFrameAgeS = 0.001;
+constexpr double kMaxFrameAgeS = 60.0;
 
 Pose pose_from_rpy(const Eigen::Vector3f& translation_m, const Eigen::Vector3f& rpy_deg) {
   const Eigen::Vector3d rpy_rad = rpy_deg.cast<double>() * (kPi / 180.0);
@@ -44,7 +55,12 @@ void read_source_and_sim(KeyReader& r, Config& c) {
   r.flag("source.pace", c.source.pace);
   r.flag("source.loop", c.source.loop);
   r.integer("source.seed", c.source.seed);
-  r.number("source.stereo_baseline_mm", c.source.stereo_baseline_mm, Bound::non_negative);
+  r.number("source.stereo_baseline_mm", c.source.stereo_baseline_mm, Bound::non_negative, kMaxBaselineMm);
+  // A baseline of 1e-39 mm would make the stereo noise model infinite: nothing would be foreground.
+  if (c.source.stereo_baseline_mm > 0.0F && c.source.stereo_baseline_mm < kMinBaselineMm) {
+    r.fail("source.stereo_baseline_mm", "expected 0 (unknown) or a baseline in [1, 1000] mm, got " +
+                                            config_detail::float_text(c.source.stereo_baseline_mm));
+  }
   c.sim.seed = c.source.seed;
 
   r.integer("sim.width", c.sim.width, 1, 65535);
@@ -54,11 +70,15 @@ void read_source_and_sim(KeyReader& r, Config& c) {
                             " is not a D435 depth resolution; expected 1280x720, 848x480, 640x480, "
                             "640x360, 480x270 or 424x240");
   }
-  r.number("sim.fps", c.sim.fps, Bound::positive);
-  r.integer("sim.frames", c.sim.frames, 1, kMaxCount);
+  r.number_in("sim.fps", c.sim.fps, 1.0, 1000.0, " frames/s");
+  r.integer("sim.frames", c.sim.frames, 1, kMaxSimFrames);
   r.flag("sim.noise", c.sim.noise);
-  r.number("sim.disparity_noise_px", c.sim.disparity_noise_px, Bound::non_negative);
-  r.number("sim.baseline_mm", c.sim.baseline_mm, Bound::positive);
+  // Beyond 10 px of noise the simulated depth is meaningless, and the quantiser's counts overflow.
+  r.number("sim.disparity_noise_px", c.sim.disparity_noise_px, Bound::non_negative, 10.0F);
+  r.number("sim.baseline_mm", c.sim.baseline_mm, Bound::positive, kMaxBaselineMm);
+  if (c.sim.baseline_mm < kMinBaselineMm) {
+    r.fail("sim.baseline_mm", "expected a baseline in [1, 1000] mm, got " + config_detail::float_text(c.sim.baseline_mm));
+  }
   config_detail::read_sim_effects(r, c.sim);
 
   const YAML::Node objects = r.raw("scene.objects");
@@ -69,8 +89,8 @@ void read_source_and_sim(KeyReader& r, Config& c) {
 void read_camera_and_filters(KeyReader& r, Config& c) {
   Eigen::Vector3f translation_m = c.pipeline.T_base_camera.translation().cast<float>();
   Eigen::Vector3f rpy_deg = Eigen::Vector3f::Zero();
-  r.vec3("camera.T_base_camera.translation_m", translation_m);
-  r.vec3("camera.T_base_camera.rotation_rpy_deg", rpy_deg);
+  r.vec3("camera.T_base_camera.translation_m", translation_m, kMaxCoordinateM);
+  r.vec3("camera.T_base_camera.rotation_rpy_deg", rpy_deg, 360.0F);
   c.pipeline.T_base_camera = pose_from_rpy(translation_m, rpy_deg);
 
   config_detail::read_filters(r, c);
@@ -114,10 +134,13 @@ void read_robot_and_safety(KeyReader& r, Config& c) {
 
   SafetyParams& safety = c.pipeline.safety;
   r.number("safety.slow_distance_m", safety.slow_distance_m, Bound::non_negative);
-  r.number("safety.stop_distance_m", safety.stop_distance_m, Bound::non_negative);
-  r.number("safety.max_frame_age_s", safety.max_frame_age_s, Bound::positive);
+  // 0 would not stop for a point touching the robot (distance 0 is not below 0).
+  r.number("safety.stop_distance_m", safety.stop_distance_m, Bound::positive);
+  r.number_in("safety.max_frame_age_s", safety.max_frame_age_s, kMinFrameAgeS, kMaxFrameAgeS, " s");
+  // 0 would switch the check off: a covered camera would then say run.
+  r.number("safety.min_valid_share", safety.min_valid_share, Bound::positive, 1.0F);
   if (safety.stop_distance_m > safety.slow_distance_m) {
-    r.fail("safety.stop_distance_m", "expected stop_distance_m <= slow_distance_m (" +
+    r.fail("safety.stop_distance_m", "expected stop_distance_m <= slow_distance_m (safety.slow_distance_m is " +
                                          config_detail::float_text(safety.slow_distance_m) + ")");
   }
 }
@@ -184,15 +207,11 @@ void apply_override(YAML::Node& root, const std::string& text) {
   if (eq == std::string::npos || eq + 1 == text.size() || !valid_key_text(key)) {
     throw ConfigError("--set '" + text + "': expected KEY=VALUE, e.g. safety.stop_distance_m=0.4");
   }
-  YAML::Node value;
-  try {
-    value = YAML::Load(text.substr(eq + 1));
-  } catch (const YAML::Exception& e) {
-    throw ConfigError("--set '" + text + "': the value is not valid YAML: " + e.msg);
-  }
   if (known_keys().count(key) == 0 && !is_section(key)) {
     throw ConfigError("--set '" + text + "': unknown key '" + key + "'");
   }
+  // As strict as a file: no duplicate keys, second documents or unknown tags in the value.
+  const YAML::Node value = config_detail::parse_yaml_strict(text.substr(eq + 1), "--set '" + text + "'", key, false);
   config_detail::set_path(root, key, value);
 }
 

@@ -170,6 +170,21 @@ RobotDescription arm_description(KeyReader& r, const std::string& model, const Y
   return out;
 }
 
+// The capsules the search uses, in float, finite and within kMaxCoordinateM of the origin. A
+// description's or the padding's numbers are each within a float's range, but their sums (links
+// chained by the kinematics, radius + padding) need not be; a robot at infinity is never near.
+void check_capsules(const KeyReader& r, const RobotModel& robot) {
+  for (size_t i = 0; i < robot.capsules.size(); ++i) {
+    const Capsule& c = robot.capsules[i];
+    const auto near = [](const Eigen::Vector3f& p) { return p.allFinite() && p.cwiseAbs().maxCoeff() <= kMaxCoordinateM; };
+    if (!near(c.a) || !near(c.b) || !std::isfinite(c.radius_m) || c.radius_m > kMaxCoordinateM) {
+      r.fail("robot", "capsule " + std::to_string(i) + " (link " + std::to_string(c.link) +
+                          ") is not within 1000 m of the base frame's origin (radius included); check "
+                          "robot.description, robot.tool, robot.joints_rad and robot.padding_m");
+    }
+  }
+}
+
 std::string limit_text(const JointLimit& limit) {
   char text[96];
   std::snprintf(text, sizeof text, "[%.6g, %.6g] rad ([%.6g, %.6g] deg)", limit.min_rad, limit.max_rad,
@@ -216,7 +231,7 @@ void read_robot(KeyReader& r, Config& c) {
   const YAML::Node tool = r.raw("robot.tool");
   // Default: the 2020 thesis's robot point (-0.5, 0.5, 0.5) m, given there with y up.
   std::vector<Eigen::Vector3f> points_base{Eigen::Vector3f(-0.5F, -0.5F, 0.5F)};
-  r.vec3_list("robot.points_base", points_base);
+  r.vec3_list("robot.points_base", points_base, kMaxCoordinateM);
   r.number_list("robot.joints_rad", c.robot_joints_rad, kJointCount);
   r.choice("robot.base_frame", c.robot_base_frame, {"base", "base_link"});
   c.robot_frame = c.robot_base_frame == "base_link" ? BaseFrame::base_link : BaseFrame::base;
@@ -224,11 +239,12 @@ void read_robot(KeyReader& r, Config& c) {
   if (c.robot_model == "points") {
     if (description.IsDefined()) r.fail("robot.description", "is only read with robot.model custom");
     if (tool.IsDefined()) r.fail("robot.tool", "is only read with an arm (robot.model ur5, ur5e, ur10e or custom)");
-    r.number("robot.padding_m", c.robot_padding_m, Bound::non_negative);
+    r.number("robot.padding_m", c.robot_padding_m, Bound::non_negative, kMaxCoordinateM);
     // Without a robot every distance would be "infinite" and every verdict run: refuse.
     if (points_base.empty()) r.fail("robot.points_base", "expected at least one point [x, y, z] for robot.model points");
     c.robot_arm.reset();
     c.pipeline.robot = robot_points(points_base, c.robot_padding_m);
+    check_capsules(r, c.pipeline.robot);
     return;
   }
 
@@ -240,7 +256,7 @@ void read_robot(KeyReader& r, Config& c) {
     r.set_effective("robot.tool", capsules_node(arm.tool));
   }
   c.robot_padding_m = arm.padding_m;  // the arm's own padding is the default
-  r.number("robot.padding_m", c.robot_padding_m, Bound::non_negative);
+  r.number("robot.padding_m", c.robot_padding_m, Bound::non_negative, kMaxCoordinateM);
   // No default pose: a wrong pose would put the arm where it is not, which is not fail-safe.
   if (c.robot_joints_rad.size() != kJointCount) {
     r.fail("robot.joints_rad", "is required for robot.model " + c.robot_model +
@@ -257,6 +273,7 @@ void read_robot(KeyReader& r, Config& c) {
   }
   c.robot_arm = arm;
   c.pipeline.robot = robot_capsules(arm, joints_rad, c.robot_padding_m, c.robot_frame);
+  check_capsules(r, c.pipeline.robot);
 }
 
 }  // namespace config_detail

@@ -65,6 +65,7 @@ struct SceneReader : YamlTree {
     const YAML::Node node = const_map[name];
     if (!node.IsDefined() || node.IsNull()) return fallback;
     int64_t value = 0;
+    if (node.IsScalar() && !leading_zero_problem(node.Scalar()).empty()) fail(key + "." + name, leading_zero_problem(node.Scalar()));
     if (!node.IsScalar() || !YAML::convert<int64_t>::decode(node, value) || value < min) {
       fail(key + "." + name, "expected an integer >= " + std::to_string(min));
     }
@@ -117,6 +118,7 @@ struct SceneReader : YamlTree {
     std::array<uint8_t, 3> out{};
     for (size_t i = 0; i < 3; ++i) {
       int value = -1;
+      if (node[i].IsScalar() && !leading_zero_problem(node[i].Scalar()).empty()) fail(key, leading_zero_problem(node[i].Scalar()));
       if (!node[i].IsScalar() || !YAML::convert<int>::decode(node[i], value) || value < 0 || value > 255) {
         fail(key, "expected [r, g, b] with integers 0..255");
       }
@@ -240,7 +242,11 @@ void read_sim_effects(KeyReader& r, SimParams& sim) {
     r.number(key, value, Bound::non_negative);
     if (value > 1.0F) r.fail(key, "expected a share between 0 and 1, got " + float_text(value));
   };
-  r.number("sim.disparity_step_px", sim.disparity_step_px, Bound::non_negative);
+  // 0 (off) or at least 1/64 px: a finer step overflows the quantiser's 32-bit step count.
+  r.number("sim.disparity_step_px", sim.disparity_step_px, Bound::non_negative, 1.0F);
+  if (sim.disparity_step_px > 0.0F && sim.disparity_step_px < 1.0F / 64.0F) {
+    r.fail("sim.disparity_step_px", "expected 0 (off) or a step in [0.015625, 1] px, got " + float_text(sim.disparity_step_px));
+  }
   r.flag("sim.left_band", sim.left_band);
   r.flag("sim.occlusion_shadows", sim.occlusion_shadows);
   r.number("sim.max_disparity_px", sim.max_disparity_px, Bound::non_negative);
@@ -253,7 +259,7 @@ void read_sim_effects(KeyReader& r, SimParams& sim) {
   share("sim.low_texture_dropout", sim.low_texture_dropout);
   r.integer("sim.material_cell_px", sim.material_cell_px, 1, 256);
   share("sim.speckle", sim.speckle);
-  r.number("sim.correlated_noise_px", sim.correlated_noise_px, Bound::non_negative);
+  r.number("sim.correlated_noise_px", sim.correlated_noise_px, Bound::non_negative, 10.0F);
   r.integer("sim.correlated_cell_px", sim.correlated_cell_px, 2, 4096);
   r.flag("sim.color", sim.color);
   r.integer("sim.color_width", sim.color_width, 0, 65535);

@@ -13,8 +13,21 @@
 
 namespace hrcsense::config_detail {
 
-/// Parses a YAML file; a missing file or a syntax error is a ConfigError naming the file (and
-/// line:column). `what` names the kind of file in the message ("configuration file", ...).
+/// Parses YAML text strictly. Beyond syntax errors, these are ConfigErrors too, because a YAML
+/// reader would accept them and silently use something else than what was written: a second
+/// document, a key given twice in one map at any depth (yaml-cpp keeps the first, so an override
+/// appended to a file would be ignored), a key that is not a plain scalar (a list, map, alias or
+/// nothing), and a tag other than YAML's standard ones (!!str, !!int, !!float, !!bool, !!null,
+/// !!map, !!seq, and the untagged `!`). `where` starts every message; with `file_positions`
+/// it is a file name and gets ":line:column". `key_prefix` goes before key paths in messages
+/// ("" for a file, the dotted key for a --set value).
+YAML::Node parse_yaml_strict(const std::string& text, const std::string& where, const std::string& key_prefix,
+                             bool file_positions);
+
+/// Reads and parses a YAML file with parse_yaml_strict. A missing file, or one that is not a
+/// regular file (a directory; a FIFO, which would block the open forever), is a ConfigError
+/// naming the file; `what` names the kind of file in the message ("configuration file", ...).
+/// The configuration, robot description files and everything read through them share it.
 YAML::Node load_yaml_file(const std::string& path, const std::string& what);
 
 /// Field access below one node of a file: every error names the file (`where`) and the field's
@@ -30,8 +43,11 @@ struct YamlTree {
   YAML::Node child(const YAML::Node& map, const std::string& name) const;
   /// As child(), but a missing member is an error "key.name is required".
   YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& name) const;
+  /// A number: finite and within a float's range (every number of these files ends up in a
+  /// float somewhere, so the cast is safe), not written with an ambiguous leading zero.
   double number(const YAML::Node& node, const std::string& key) const;
   Eigen::Vector3d vec3(const YAML::Node& node, const std::string& key) const;
+  /// As vec3, in float (safe: number() bounds every component to a float's range).
   Eigen::Vector3f vec3f(const YAML::Node& node, const std::string& key) const { return vec3(node, key).cast<float>(); }
 };
 

@@ -60,7 +60,7 @@ TEST(ConfigErrors, IllTypedValuesNameFileKeyAndExpectation) {
   check("robot: {base_frame: tool0}\n", "'robot.base_frame'", "base, base_link");
   check("proximity: {octree: {height: 11}}\n", "'proximity.octree.height'", "[1, 10]");
   check("safety: {slow_distance_m: 0.5, stop_distance_m: 0.8}\n", "'safety.stop_distance_m'", "slow_distance_m");
-  check("safety: {max_frame_age_s: 0}\n", "'safety.max_frame_age_s'", "> 0");
+  check("safety: {max_frame_age_s: 0}\n", "'safety.max_frame_age_s'", "[0.001, 60] s");
   check("scene: {objects: [{name: x, shapes: [{sphere: {center: [0, 0, 1], radius_m: -1}}]}]}\n",
         "scene.objects[0].shapes[0].sphere.radius_m", "> 0");
   check("scene: {objects: [{name: x, shapes: [{cone: {}}]}]}\n", "scene.objects[0].shapes[0]", "unknown shape");
