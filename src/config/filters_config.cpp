@@ -62,7 +62,8 @@ void read_options(KeyReader& r, FilterChainParams& f) {
   ranged(r, "filters.threshold.min", f.threshold.min_m, 0.0F, 16.0F, "[0, 16] m");
   ranged(r, "filters.threshold.max", f.threshold.max_m, 0.0F, 16.0F, "[0, 16] m");
   if (f.threshold.min_m > f.threshold.max_m) {
-    r.fail("filters.threshold.min", "expected min <= max (filters.threshold.max is " + float_text(f.threshold.max_m) + " m)");
+    r.fail_pair("filters.threshold.min", "filters.threshold.max",
+                "expected min <= max, got " + float_text(f.threshold.min_m) + " m > " + float_text(f.threshold.max_m) + " m");
   }
   r.integer("filters.decimation.magnitude", f.decimation.magnitude, 1, 8);
   ranged(r, "filters.spatial.alpha", f.spatial.alpha, 0.25F, 1.0F, "[0.25, 1]");

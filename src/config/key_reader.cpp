@@ -139,6 +139,10 @@ void KeyReader::fail(const std::string& key, const std::string& what) const {
   config_detail::fail(where_, key, what);
 }
 
+void KeyReader::fail_pair(const std::string& key_a, const std::string& key_b, const std::string& what) const {
+  throw ConfigError(where_ + ": keys '" + key_a + "' and '" + key_b + "': " + what);
+}
+
 YAML::Node KeyReader::lookup(const std::string& key) {
   known_.insert(key);
   YAML::Node node = find_path(root_, key);

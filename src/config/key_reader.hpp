@@ -88,6 +88,9 @@ class KeyReader {
 
   /// Throws ConfigError naming the file and `key`.
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+  /// Throws ConfigError naming the file and both keys of a check between two keys (either may
+  /// be the one the user got wrong): "<where>: keys 'a' and 'b': <what>".
+  [[noreturn]] void fail_pair(const std::string& key_a, const std::string& key_b, const std::string& what) const;
 
   const std::set<std::string>& known() const { return known_; }
   const YAML::Node& effective() const { return effective_; }

@@ -66,7 +66,7 @@ void read_source_and_sim(KeyReader& r, Config& c) {
   r.integer("sim.width", c.sim.width, 1, 65535);
   r.integer("sim.height", c.sim.height, 1, 65535);
   if (!d435_depth_intrinsics(c.sim.width, c.sim.height)) {
-    r.fail("sim.width", std::to_string(c.sim.width) + "x" + std::to_string(c.sim.height) +
+    r.fail_pair("sim.width", "sim.height", std::to_string(c.sim.width) + "x" + std::to_string(c.sim.height) +
                             " is not a D435 depth resolution; expected 1280x720, 848x480, 640x480, "
                             "640x360, 480x270 or 424x240");
   }
@@ -119,7 +119,7 @@ void read_segmentation(KeyReader& r, Config& c) {
   r.vec3("foreground.workspace_base.min", fg.workspace_base.min);
   r.vec3("foreground.workspace_base.max", fg.workspace_base.max);
   if ((fg.workspace_base.min.array() > fg.workspace_base.max.array()).any()) {
-    r.fail("foreground.workspace_base", "expected min <= max on every axis");
+    r.fail_pair("foreground.workspace_base.min", "foreground.workspace_base.max", "expected min <= max on every axis");
   }
 }
 
@@ -140,8 +140,9 @@ void read_robot_and_safety(KeyReader& r, Config& c) {
   // 0 would switch the check off: a covered camera would then say run.
   r.number("safety.min_valid_share", safety.min_valid_share, Bound::positive, 1.0F);
   if (safety.stop_distance_m > safety.slow_distance_m) {
-    r.fail("safety.stop_distance_m", "expected stop_distance_m <= slow_distance_m (safety.slow_distance_m is " +
-                                         config_detail::float_text(safety.slow_distance_m) + ")");
+    r.fail_pair("safety.stop_distance_m", "safety.slow_distance_m",
+                "expected stop_distance_m <= slow_distance_m, got " + config_detail::float_text(safety.stop_distance_m) +
+                    " > " + config_detail::float_text(safety.slow_distance_m));
   }
 }
 

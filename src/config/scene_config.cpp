@@ -267,7 +267,7 @@ void read_sim_effects(KeyReader& r, SimParams& sim) {
   const int width = sim.color_width > 0 ? sim.color_width : sim.width;
   const int height = sim.color_height > 0 ? sim.color_height : sim.height;
   if (sim.color && !d435_color_intrinsics(width, height)) {
-    r.fail("sim.color_width", std::to_string(width) + "x" + std::to_string(height) +
+    r.fail_pair("sim.color_width", "sim.color_height", std::to_string(width) + "x" + std::to_string(height) +
                                   " is not a D435 colour resolution; expected 1920x1080, 1280x720, 960x540, "
                                   "848x480, 640x480, 640x360, 480x270, 424x240 or 320x240 (0x0: the depth's)");
   }

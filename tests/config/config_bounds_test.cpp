@@ -95,7 +95,7 @@ TEST(ConfigBounds, AStopDistanceOfZeroIsAnError) {
   expect_config_error("", {"safety.stop_distance_m=0", "safety.slow_distance_m=0"}, {"'safety.stop_distance_m'", "> 0"});
   expect_config_error("", {"safety.stop_distance_m=0"}, {"'safety.stop_distance_m'", "> 0"});
   expect_config_error("", {"safety.stop_distance_m=0.5", "safety.slow_distance_m=0.4"},
-                      {"'safety.stop_distance_m'", "stop_distance_m <= slow_distance_m (safety.slow_distance_m is 0.4)"});
+                      {"keys 'safety.stop_distance_m' and 'safety.slow_distance_m': expected stop_distance_m <= slow_distance_m, got 0.5 > 0.4"});
   const Config equal = load_config("", {"safety.stop_distance_m=0.4", "safety.slow_distance_m=0.4"});
   EXPECT_EQ(equal.pipeline.safety.stop_distance_m, 0.4F);
 }

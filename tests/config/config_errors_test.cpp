@@ -52,7 +52,7 @@ TEST(ConfigErrors, IllTypedValuesNameFileKeyAndExpectation) {
   check("background: {fill_radius_px: -1}\n", "'background.fill_radius_px'", "integer");
   check("background: {max_noise_per_z2: 0}\n", "'background.max_noise_per_z2'", "> 0");
   check("foreground: {k_sigma: -1}\n", "'foreground.k_sigma'", "> 0");
-  check("foreground: {workspace_base: {min: [0, 0, 1], max: [1, 1, 0]}}\n", "'foreground.workspace_base'", "min <= max");
+  check("foreground: {workspace_base: {min: [0, 0, 1], max: [1, 1, 0]}}\n", "'foreground.workspace_base.min' and 'foreground.workspace_base.max'", "min <= max");
   check("robot: {points_base: [[0, 0]]}\n", "'robot.points_base'", "[x, y, z]");
   check("robot: {points_base: []}\n", "'robot.points_base'", "at least one point");
   check("robot: {padding_m: -0.1}\n", "'robot.padding_m'", ">= 0");
