@@ -4,6 +4,7 @@
 // same holds for robot description files. Files that are folders or FIFOs are refused by name.
 #include "config_test_util.hpp"
 #include "../support/no_block.hpp"
+#include "../support/run_cli.hpp"
 
 #include <gtest/gtest.h>
 
@@ -137,6 +138,26 @@ TEST(ConfigStrict, AFolderAsConfigOrDescriptionIsAConfigErrorNamingIt) {
   EXPECT_EQ(error_of(dir.path()), dir.path() + ": cannot open configuration file: is a directory, not a file");
   expect_config_error("", {"robot.model=custom", "robot.description=" + dir.path(), "robot.joints_rad=[0, 0, 0, 0, 0, 0]"},
                       {"key 'robot.description'", dir.path() + ": cannot open robot description: is a directory"});
+}
+
+TEST(ConfigStrict, TheCliExitsWith2NamingTheFolder) {
+  TempDir dir;
+  // Before: exit 1 and "basic_filebuf::underflow error reading the file: Is a directory".
+  test::CliResult r = test::cli("run --config " + dir.path() + " --out " + dir.path() + "/out.jsonl");
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("hrcsense: error: " + dir.path() + ": cannot open configuration file: is a directory"),
+            std::string::npos)
+      << r.out;
+  r = test::cli("run --set robot.model=custom --set robot.description=" + dir.path() +
+                " --set 'robot.joints_rad=[0,0,0,0,0,0]' --out " + dir.path() + "/out.jsonl");
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("key 'robot.description': " + dir.path() + ": cannot open robot description: is a directory"),
+            std::string::npos)
+      << r.out;
+  const std::string dup = dir.write("dup.yaml", "safety: {stop_distance_m: 0.3}\nsafety: {stop_distance_m: 0.6}\n");
+  r = test::cli("info --config " + dup);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find(dup + ":2:1: duplicate key 'safety'"), std::string::npos) << r.out;
 }
 
 TEST(ConfigStrict, AFifoAsConfigOrDescriptionIsRefusedWithoutBlocking) {
