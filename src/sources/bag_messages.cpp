@@ -3,6 +3,7 @@
 #include "bag_messages.hpp"
 
 #include "hrcsense/camera.hpp"
+#include "hrcsense/io.hpp"
 
 #include <cmath>
 
@@ -102,6 +103,10 @@ std::string parse_camera_info(Cursor c, Intrinsics& out) {
   in.fy = static_cast<float>(k[4]);
   in.ppy = static_cast<float>(k[5]);
   in.model = distortion_from_name(model).value_or(Distortion::none);
+  // The same plausibility as a folder's intrinsics.json: a K of 1e39 or 1e-39 would put every
+  // point at infinity or at the camera (R1).
+  const std::string problem = intrinsics_problem(in, IntrinsicsFieldNames{"K[0]", "K[4]", "K[2]", "K[5]", "D"});
+  if (!problem.empty()) return "camera_info: " + problem;
   out = in;
   return {};
 }
@@ -112,6 +117,9 @@ std::string parse_transform(Cursor c, Pose& out) {
   if (!c.ok) return "transform message is cut off";
   const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
   if (!(std::abs(q.norm() - 1.0) < 1e-3)) return "transform rotation is not a unit quaternion";
+  if (!(std::abs(v[0]) <= 1000.0 && std::abs(v[1]) <= 1000.0 && std::abs(v[2]) <= 1000.0)) {
+    return "transform translation is not finite or beyond 1000 m";
+  }
   out = Pose::Identity();
   out.linear() = q.normalized().toRotationMatrix();
   out.translation() = Eigen::Vector3d(v[0], v[1], v[2]);

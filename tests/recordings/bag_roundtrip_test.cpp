@@ -216,3 +216,32 @@ TEST(BagRoundTrip, ColourIsDecodedWithItsCalibrationWhenAskedFor) {
 
 }  // namespace
 }  // namespace hrcsense
+
+namespace hrcsense {
+namespace {
+
+// R1: a camera_info whose focal length is absurd (1e30 px) is refused naming K[0], as a
+// folder's intrinsics.json is, instead of putting every point at the camera.
+TEST(BagRoundTrip, ImplausibleCameraInfoIsRefusedNamingTheField) {
+  test::ScratchDir dir("bag_bad_k");
+  const std::string path = dir / "bad_k.bag";
+  {
+    test::BagWriter writer(path, test::BagWriterParams{});
+    Frame frame = walk_frames()[0];
+    frame.intrinsics.fx = 1e30F;
+    writer.add_depth(frame);
+    writer.close();
+  }
+  std::string error;
+  try {
+    BagSource source(RecordingParams{path});
+    Frame frame;
+    if (source.next(frame) == Source::Status::error) error = source.error();
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  EXPECT_NE(error.find("K[0]"), std::string::npos) << "error: '" << error << "'";
+}
+
+}  // namespace
+}  // namespace hrcsense
