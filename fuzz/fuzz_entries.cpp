@@ -5,12 +5,14 @@
 // stays failed (fail safe: no frames after damage).
 #include "fuzz_entries.hpp"
 
+#include "hrcsense/config.hpp"
 #include "hrcsense/io.hpp"
 #include "hrcsense/recordings.hpp"
 
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -201,6 +203,43 @@ Outcome run_folder(const uint8_t* data, size_t size) {
 
 std::string folder_seed(FolderTarget target) {
   return std::string(1, static_cast<char>(target)) + folder_base().valid.at(target);
+}
+
+namespace {
+
+// What the stages would compute with: a non-finite value here would reach the pipeline.
+bool stage_parameters_finite(const Config& c) {
+  const PipelineParams& p = c.pipeline;
+  bool ok = p.T_base_camera.matrix().allFinite() && std::isfinite(p.safety.slow_distance_m) &&
+            std::isfinite(p.safety.stop_distance_m) && std::isfinite(p.safety.max_frame_age_s) &&
+            std::isfinite(p.safety.min_valid_share) && std::isfinite(p.foreground.k_sigma) &&
+            std::isfinite(p.foreground.min_margin_m) && std::isfinite(p.foreground.min_object_mm) &&
+            std::isfinite(p.filters.threshold.min_m) && std::isfinite(p.filters.threshold.max_m);
+  for (const Capsule& capsule : p.robot.capsules) {
+    ok = ok && capsule.a.allFinite() && capsule.b.allFinite() && std::isfinite(capsule.radius_m);
+  }
+  return ok;
+}
+
+}  // namespace
+
+Outcome run_config(const uint8_t* data, size_t size) {
+  static const fs::path path = fs::temp_directory_path() / ("hrcsense_fuzz_config_" + std::to_string(::getpid()) + ".yaml");
+  {
+    std::ofstream file(path, std::ios::binary | std::ios::trunc);
+    file.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  }
+  Outcome out;
+  try {
+    const Config config = load_config(path.string(), {});
+    if (!stage_parameters_finite(config)) contract_broken("config", "loaded with a non-finite stage parameter");
+    out.frames = 1;
+  } catch (const ConfigError& e) {
+    out.error = e.what();
+    if (out.error.find(path.string()) == std::string::npos) contract_broken("config error names no file", out.error);
+  }
+  // Any other exception escapes: libFuzzer reports it as a crash (the contract says ConfigError).
+  return out;
 }
 
 }  // namespace hrcsense::fuzz

@@ -44,4 +44,10 @@ Outcome run_folder(const uint8_t* data, size_t size);
 /// seed corpus (fuzz/make_corpus.cpp writes it).
 std::string folder_seed(FolderTarget target);
 
+/// The bytes as a YAML configuration file, read by load_config. Either it loads, and then every
+/// parameter the stages use is finite, or it fails with a ConfigError naming the file; anything
+/// else (another exception, a crash, a sanitizer report) breaks the contract. Outcome::error is
+/// the ConfigError's message ("" when the file loaded); frames is 1 when it loaded.
+Outcome run_config(const uint8_t* data, size_t size);
+
 }  // namespace hrcsense::fuzz

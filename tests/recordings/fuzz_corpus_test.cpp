@@ -33,6 +33,7 @@ std::vector<fs::path> files_under(const std::string& relative) {
 fuzz::Outcome replay(const fs::path& file, const std::string& target) {
   const std::vector<char> bytes = test::read_bytes(file.string());
   const auto* data = reinterpret_cast<const uint8_t*>(bytes.data());
+  if (target == "config") return fuzz::run_config(data, bytes.size());
   return target == "bag" ? fuzz::run_bag(data, bytes.size()) : fuzz::run_folder(data, bytes.size());
 }
 
@@ -57,6 +58,17 @@ TEST(FuzzCorpus, SeedFolderFilesGiveValidFolders) {
   }
 }
 
+// The config seeds are the example configurations: each loads, with finite parameters.
+TEST(FuzzCorpus, SeedConfigsLoad) {
+  const std::vector<fs::path> seeds = files_under("fuzz/corpus/config");
+  ASSERT_GE(seeds.size(), 5U) << "fuzz/corpus/config is missing";
+  for (const fs::path& seed : seeds) {
+    const fuzz::Outcome outcome = replay(seed, "config");
+    EXPECT_EQ(outcome.error, "") << seed;
+    EXPECT_EQ(outcome.frames, 1) << seed;
+  }
+}
+
 TEST(FuzzCorpus, SeedsMatchWhatTheEntryCodeStartsFrom) {
   // The folder seeds are the valid files run_folder rebuilds around an input: if the layout in
   // fuzz_entries.cpp changes, rerun hrcsense-fuzz-corpus (docs/FUZZING.md).
@@ -77,7 +89,7 @@ TEST(FuzzCorpus, SeedsMatchWhatTheEntryCodeStartsFrom) {
 
 TEST(FuzzCorpus, RegressionsEndCleanly) {
   int replayed = 0;
-  for (const std::string target : {"bag", "folder"}) {
+  for (const std::string target : {"bag", "folder", "config"}) {
     for (const fs::path& file : files_under("fuzz/regressions/" + target)) {
       // The entry code aborts on a broken error contract and the sanitizers on memory errors;
       // here every reproducer (a damaged input) must end in a clean error, the same every time
@@ -90,7 +102,7 @@ TEST(FuzzCorpus, RegressionsEndCleanly) {
       ++replayed;
     }
   }
-  EXPECT_GE(replayed, 7) << "fuzz/regressions/ is missing";
+  EXPECT_GE(replayed, 13) << "fuzz/regressions/ is missing";
   RecordProperty("replayed", replayed);
 }
 
