@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tests of the `hrcsense` executable: exit codes, one-line errors, JSON Lines from `run`, `info`.
+#include "../support/cli_folder.hpp"
 #include "../support/run_cli.hpp"
 #include "../support/sanitized.hpp"
 #include "hrcsense/camera.hpp"
@@ -25,24 +26,8 @@ namespace fs = std::filesystem;
 
 using hrcsense::test::kSanitized;
 
-struct Outcome {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-  std::vector<std::string> err_lines() const {
-    std::vector<std::string> lines;
-    std::istringstream in(err);
-    for (std::string line; std::getline(in, line);) lines.push_back(line);
-    return lines;
-  }
-};
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using Outcome = hrcsense::test::CliOutcome;
+using hrcsense::test::read_text;
 
 // The lines of a `run` output without what depends on the machine or the build (timings, wall
 // time, frame rate, commit), so that two runs compare line by line.
@@ -61,36 +46,8 @@ std::vector<json> results_without_timings(const fs::path& jsonl) {
 }
 
 // Runs the CLI in its own temporary folder, capturing stdout and stderr.
-class Cli : public ::testing::Test {
+class Cli : public hrcsense::test::CliFolder {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("hrcsense_cli_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    fs::remove_all(dir_, ignored);
-  }
-
-  Outcome run(const std::string& arguments) const {
-    const std::string command = "cd '" + dir_.string() + "' && '" + HRCSENSE_CLI + "' " + arguments +
-                                " > stdout.txt 2> stderr.txt";
-    const int status = std::system(command.c_str());
-    Outcome outcome;
-    outcome.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    outcome.out = read_text(dir_ / "stdout.txt");
-    outcome.err = read_text(dir_ / "stderr.txt");
-    return outcome;
-  }
-
-  std::string write(const std::string& name, const std::string& text) const {
-    std::ofstream(dir_ / name) << text;
-    return name;
-  }
-
   // Thesis-box, shortened; smaller frames under the sanitizers, which are slow.
   static std::string thesis_box(const std::string& extra) {
     std::string args = std::string("--config '") + HRCSENSE_SOURCE_DIR + "/config/thesis-box.yaml' ";
@@ -106,8 +63,6 @@ class Cli : public ::testing::Test {
       EXPECT_NE(lines[0].find(needle), std::string::npos) << "'" << needle << "' not in: " << lines[0];
     }
   }
-
-  fs::path dir_;
 };
 
 TEST_F(Cli, UnknownConfigKeyIsAUsageError) {

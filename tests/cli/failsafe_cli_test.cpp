@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // R1 through the executable: the commands, signals, a reader that leaves, flushing,
 // exit codes. Each child process is bounded in time: a test that waits too long kills it.
+#include "../support/cli_folder.hpp"
 #include "../support/sanitized.hpp"
 #include "hrcsense/io.hpp"
 
@@ -28,12 +29,7 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using hrcsense::test::read_text;
 
 std::vector<json> json_lines(const std::string& text) {
   std::vector<json> lines;
@@ -138,34 +134,9 @@ class Child {
   std::string buffer_;
 };
 
-class FailsafeCli : public ::testing::Test {
+class FailsafeCli : public hrcsense::test::CliFolder {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("hrcsense_failsafe_cli_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    fs::remove_all(dir_, ignored);
-  }
-
-  struct Outcome {
-    int exit_code = -1;
-    std::string out, err;
-  };
-  // Runs `arguments` through the shell in the test's folder, after `prefix` (e.g. a ulimit).
-  Outcome run(const std::string& arguments, const std::string& prefix = "") const {
-    const std::string command = "cd '" + dir_.string() + "' && " + prefix + " '" + HRCSENSE_CLI + "' " +
-                                arguments + " > stdout.txt 2> stderr.txt";
-    const int status = std::system(command.c_str());
-    Outcome outcome;
-    outcome.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    outcome.out = read_text(dir_ / "stdout.txt");
-    outcome.err = read_text(dir_ / "stderr.txt");
-    return outcome;
-  }
+  using Outcome = hrcsense::test::CliOutcome;
 
   // The last lines of a run that a signal ended: a stop frame line, then the summary.
   static void expect_stop_then_summary(const std::vector<json>& lines, const std::string& end_reason) {
@@ -192,8 +163,6 @@ class FailsafeCli : public ::testing::Test {
     exit_status = child.wait(30.0);
     return json_lines(read_text(out));
   }
-
-  fs::path dir_;
 };
 
 // Item 1, the command: a rotation of 1e39 degrees is inf as a float.

@@ -138,22 +138,11 @@ TEST(Failsafe, InsideTheRobotIsStopWhateverTheZones) {
 // The background a file holds is checked against the first frames. The one learnt here says
 // the wall is at 2 m; a "damaged" copy says 1 m: everything behind it (the real wall) would
 // be hidden, so the check refuses it. The true one passes and the pipeline then measures.
-BackgroundModel learnt_wall() {
-  Pipeline learner(fake_params());
-  Frame frame;
-  FrameResult result;
-  for (int i = 0; i < test::kLearnFrames; ++i) {
-    fill_frame(i, 0.0F, frame);
-    learner.process(frame, result);
-  }
-  return learner.background();
-}
-
 TEST(Failsafe, LoadedBackgroundThatMatchesIsUsedAfterTheCheck) {
   PipelineParams params = fake_params();
   params.background.check_frames = 2;
   Pipeline pipeline(params);
-  pipeline.set_background(learnt_wall());
+  pipeline.set_background(test::learn_empty_background());
   Frame frame;
   FrameResult result;
   // A person in front of the wall only makes pixels nearer: no reason to doubt the file.
@@ -170,9 +159,15 @@ TEST(Failsafe, LoadedBackgroundThatMatchesIsUsedAfterTheCheck) {
   EXPECT_EQ(result.verdict.state, VerdictState::slow);
 }
 
-TEST(Failsafe, LoadedBackgroundNearerThanTheSceneIsRefused) {
-  BackgroundModel damaged = learnt_wall();
+// The learnt wall "damaged" behind a correct checksum: it says 1 m where the wall is at 2 m.
+BackgroundModel nearer_than_the_wall() {
+  BackgroundModel damaged = test::learn_empty_background();
   std::fill(damaged.mean_m.begin(), damaged.mean_m.end(), 1.0F);
+  return damaged;
+}
+
+TEST(Failsafe, LoadedBackgroundNearerThanTheSceneIsRefused) {
+  const BackgroundModel damaged = nearer_than_the_wall();
   PipelineParams params = fake_params();
   params.background.check_frames = 2;
   Pipeline pipeline(params);
@@ -222,11 +217,7 @@ TEST(Failsafe, BackgroundCheckCountsOnlyPixelsFartherThanTheMargin) {
 }
 
 RunSummary run(FakeSource& source, Sink& sink, const PipelineParams& params, const RunOptions& options) {
-  Pipeline pipeline(params);
-  RunHeader header;
-  header.version = "test";
-  header.source = source.info();
-  return run_pipeline(source, pipeline, sink, options, header);
+  return test::run_fake(source, sink, params, options);
 }
 
 // Timestamps that go backwards, repeat, skip frames or jump are counted and marked on their
@@ -317,8 +308,7 @@ TEST(Failsafe, FailedSinkEndsTheRunWithAnError) {
 // Item 6: an exception while processing (std::bad_alloc, say) is the run's error, which the
 // app turns into exit 1; here a background that does not match throws.
 TEST(Failsafe, ProcessingErrorIsTheRunsError) {
-  BackgroundModel damaged = learnt_wall();
-  std::fill(damaged.mean_m.begin(), damaged.mean_m.end(), 1.0F);
+  const BackgroundModel damaged = nearer_than_the_wall();
   PipelineParams params = fake_params();
   params.background.check_frames = 1;
   Pipeline pipeline(params);

@@ -128,6 +128,27 @@ struct CollectingSink : Sink {
   }
 };
 
+/// The background a pipeline learns from the empty fake scene (the wall at 2 m).
+inline BackgroundModel learn_empty_background() {
+  Pipeline learner(fake_params());
+  Frame frame;
+  FrameResult result;
+  for (int i = 0; i < kLearnFrames; ++i) {
+    fill_frame(i, 0.0F, frame);
+    learner.process(frame, result);
+  }
+  return learner.background();
+}
+
+/// run_pipeline over `source` into `sink` with a pipeline built from `params`.
+inline RunSummary run_fake(Source& source, Sink& sink, const PipelineParams& params, const RunOptions& options = {}) {
+  Pipeline pipeline(params);
+  RunHeader header;
+  header.version = "test";
+  header.source = source.info();
+  return run_pipeline(source, pipeline, sink, options, header);
+}
+
 /// `learn` wall frames, then the given steps.
 inline std::vector<Step> after_learning(std::vector<Step> steps) {
   std::vector<Step> all(kLearnFrames, Step{});

@@ -14,17 +14,7 @@ using test::expected_distance_m;
 using test::fake_params;
 using test::fill_frame;
 
-/// The background a pipeline learns from the empty fake scene.
-BackgroundModel learn_empty_background() {
-  Pipeline learner(fake_params());
-  Frame frame;
-  FrameResult result;
-  for (int i = 0; i < test::kLearnFrames; ++i) {
-    fill_frame(i, 0.0F, frame);
-    learner.process(frame, result);
-  }
-  return learner.background();
-}
+using test::learn_empty_background;
 
 TEST(Pipeline, LearnsThenMeasuresTheObject) {
   Pipeline pipeline(fake_params());

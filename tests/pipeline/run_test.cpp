@@ -20,11 +20,7 @@ using test::Step;
 bool starts_with(const std::string& text, const char* prefix) { return text.rfind(prefix, 0) == 0; }
 
 RunSummary run(FakeSource& source, CollectingSink& sink, const PipelineParams& params, RunOptions options = {}) {
-  Pipeline pipeline(params);
-  RunHeader header;
-  header.version = "test";
-  header.source = source.info();
-  return run_pipeline(source, pipeline, sink, options, header);
+  return test::run_fake(source, sink, params, options);
 }
 
 TEST(RunPipeline, UnpacedProcessesEveryFrameWithExpectedVerdicts) {
