@@ -60,58 +60,41 @@ struct LatencyLog {
   }
 };
 
-// Classifies a frame's timestamp against the previous frame's: backwards, repeated, or a
-// gap of more than 1.5 nominal periods (frames the source skipped); counts it and returns the
-// warning for the frame (static text), null when in order.
-const char* check_timestamp(int64_t previous_ns, int64_t timestamp_ns, double nominal_fps, double max_frame_age_s,
-                            TimestampCounts& counts) {
-  const int64_t delta_ns = timestamp_ns - previous_ns;
-  if (delta_ns < 0) {
+// Classifies a frame's timestamp step from the previous frame: backwards, repeated, a jump
+// beyond max_frame_age_s, or a gap of more than 1.5 nominal periods (frames the source
+// skipped); counts it and returns the warning for the frame (static text), null when in order.
+const char* check_timestamp_step(int64_t step_ns, double nominal_fps, double max_frame_age_s, TimestampCounts& counts) {
+  if (step_ns < 0) {
     ++counts.backwards;
     return "timestamp went backwards";
   }
-  if (delta_ns == 0) {
+  if (step_ns == 0) {
     ++counts.repeated;
     return "timestamp repeated";
   }
-  const double delta_s = static_cast<double>(delta_ns) * 1e-9;
-  if (delta_s > max_frame_age_s) {
+  const double step_s = static_cast<double>(step_ns) * 1e-9;
+  if (step_s > max_frame_age_s) {
     ++counts.jumps;
     return "timestamp jumped by more than max_frame_age_s";
   }
-  if (nominal_fps > 0.0 && delta_s * nominal_fps > 1.5) {
+  if (nominal_fps > 0.0 && step_s * nominal_fps > 1.5) {
     ++counts.gaps;
-    counts.frames_skipped += static_cast<int64_t>(delta_s * nominal_fps + 0.5) - 1;
+    counts.frames_skipped += static_cast<int64_t>(step_s * nominal_fps + 0.5) - 1;
     return "timestamp gap: frames skipped";
   }
   return nullptr;
 }
 
-// Paces a source to its timestamps, frame to frame: each frame is due one timestamp step after
-// the previous one. A step that is not positive (repeated or backwards timestamps, sources
-// without timestamps) takes the nominal period; a step longer than max_frame_age_s (a jump in
-// the recording) is cut to max_frame_age_s, so a replay never sleeps for days.
-struct Pacer {
-  double nominal_fps = 30.0;
-  double max_step_s = 0.5;
-  bool started = false;
-  Clock::time_point due{};
-  int64_t last_ns = 0;
-
-  Clock::time_point next(int64_t timestamp_ns) {
-    if (!started) {
-      started = true;
-      due = Clock::now();
-    } else {
-      double step_s = static_cast<double>(timestamp_ns - last_ns) * 1e-9;
-      if (step_s <= 0.0) step_s = nominal_fps > 0.0 ? 1.0 / nominal_fps : 0.0;
-      step_s = std::min(step_s, max_step_s);
-      due += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(step_s));
-    }
-    last_ns = timestamp_ns;
-    return due;
-  }
-};
+// When paced, each frame is due one timestamp step after the previous one. A step that is not
+// positive (repeated or backwards timestamps, sources without timestamps) takes the nominal
+// period; a step longer than max_frame_age_s (a jump in the recording) is cut to
+// max_frame_age_s, so a replay never sleeps for days.
+Clock::duration pacing_step(int64_t step_ns, double nominal_fps, double max_frame_age_s) {
+  double step_s = static_cast<double>(step_ns) * 1e-9;
+  if (step_s <= 0.0) step_s = nominal_fps > 0.0 ? 1.0 / nominal_fps : 0.0;
+  step_s = std::min(step_s, max_frame_age_s);
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(step_s));
+}
 
 bool stop_requested(const RunOptions& options) {
   return options.stop_requested != nullptr && options.stop_requested->load();
@@ -130,7 +113,7 @@ void capture_loop(Source& source, const RunOptions& options, double max_frame_ag
                   CaptureOutcome& outcome) {
   const double nominal_fps = source.info().nominal_fps;
   Captured slot;
-  Pacer pacer{nominal_fps, max_frame_age_s};
+  Clock::time_point due{};  // paced: when the current frame is to be delivered
   int64_t previous_ns = 0;
   for (int64_t n = 0;; ++n) {
     if (stop_requested(options)) {
@@ -156,11 +139,14 @@ void capture_loop(Source& source, const RunOptions& options, double max_frame_ag
       break;
     }
     ++outcome.frames_in;
-    slot.timestamp_warning =
-        n == 0 ? nullptr
-               : check_timestamp(previous_ns, slot.frame.timestamp_ns, nominal_fps, max_frame_age_s, outcome.timestamps);
+    const int64_t step_ns = slot.frame.timestamp_ns - previous_ns;
     previous_ns = slot.frame.timestamp_ns;
-    if (options.pace) sleep_until_interruptible(pacer.next(slot.frame.timestamp_ns), options);
+    slot.timestamp_warning =
+        n == 0 ? nullptr : check_timestamp_step(step_ns, nominal_fps, max_frame_age_s, outcome.timestamps);
+    if (options.pace) {
+      due = n == 0 ? Clock::now() : due + pacing_step(step_ns, nominal_fps, max_frame_age_s);
+      sleep_until_interruptible(due, options);
+    }
     slot.captured_at = Clock::now();
     // Paced: latest wins, a frame not yet taken is dropped and counted. Unpaced: wait for
     // processing. Either fails once processing is gone.
