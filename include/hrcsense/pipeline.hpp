@@ -89,6 +89,9 @@ struct RunSummary {
   double fps = 0.0;               ///< frames_processed / wall_s
   double latency_p50_us = 0.0, latency_p99_us = 0.0;
   float min_distance_m = -1.0F;   ///< smallest distance seen; -1 if never any foreground
+  /// How the run ended: source_ended, frame_limit_reached, stop_requested, source_error,
+  /// processing_error or output_error; end_reason says it for people.
+  ReasonCode end_code = ReasonCode::source_ended;
   std::string end_reason;         ///< "end of source", or the source's error
   /// Why the run failed (source error, processing error, output failed); empty when it ended
   /// normally (end of source, frame limit, stop requested). The app exits 1 when set.

@@ -25,8 +25,11 @@ struct SafetyParams {
 /// foreground without a contact, and for a contact with a non-finite distance or point.
 Verdict verdict_for_contact(const SafetyParams& params, const Contact& contact, size_t foreground_points);
 
-/// A stop verdict with a reason (invalid frame, source failed or ended, stale data, ...).
-Verdict stop_verdict(std::string reason);
+/// A stop verdict with its code and a reason for people (empty: the code's name).
+Verdict stop_verdict(ReasonCode code, std::string reason = {});
+
+/// The stable snake_case name of a reason code ("in_stop_zone", "non_finite_input", ...).
+const char* reason_code_name(ReasonCode code);
 
 /// Name used in the output: "run", "slow", "stop".
 const char* verdict_name(VerdictState state);

@@ -151,11 +151,39 @@ struct RobotModel {
 /// The safety decision for a frame.
 enum class VerdictState { run, slow, stop };
 
+/// Why a verdict is what it is, as a stable code (`reason_code` in the output, its snake_case
+/// name from reason_code_name(); docs/OUTPUT.md lists them). Control flow uses the code, never
+/// the human-readable Verdict::reason.
+enum class ReasonCode {
+  clear,                 ///< run: the contact is at or beyond the slow distance
+  no_foreground,         ///< run: nothing in the cell
+  in_slow_zone,          ///< slow
+  in_stop_zone,          ///< stop: below the stop distance
+  inside_robot,          ///< stop: a foreground point inside a robot capsule
+  non_finite_input,      ///< stop: a NaN/Inf distance or point, or foreground the search cannot place
+  learning_background,   ///< stop: the background is being learnt
+  checking_background,   ///< stop: a loaded background is compared with the first frames
+  no_valid_depth,        ///< stop: no valid pixel, before or after the filters
+  low_valid_share,       ///< stop: fewer valid pixels after the filters than safety.min_valid_share
+  background_mismatch,   ///< stop: the background is not of the filtered frame's size
+  no_robot_model,        ///< stop: no capsules to measure against
+  foreground_failed,     ///< stop: the foreground test could not run
+  stale_frame,           ///< stop: the frame is older than safety.max_frame_age_s
+  no_frame,              ///< stop: the watchdog saw no frame for safety.max_frame_age_s
+  source_ended,          ///< stop: end of the run, the source ended
+  frame_limit_reached,   ///< stop: end of the run, --frames reached
+  stop_requested,        ///< stop: end of the run, SIGINT, SIGTERM or SIGHUP
+  source_error,          ///< stop: end of the run, the source failed
+  processing_error,      ///< stop: end of the run, processing failed
+  output_error,          ///< stop: end of the run, the output failed
+};
+
 struct Verdict {
   VerdictState state = VerdictState::stop;  ///< stop unless proven otherwise
   float speed_scale = 0.0F;                 ///< 1 run, 0 stop, in between slow
   float protective_distance_m = 0.0F;       ///< the distance the rule compared against
-  std::string reason;                       ///< why; never empty for stop
+  ReasonCode code = ReasonCode::no_valid_depth;  ///< why, as a stable code
+  std::string reason;                       ///< why, for people (with details); never empty for stop
 };
 
 /// Time spent in one stage of one frame.

@@ -36,11 +36,12 @@ size_t count_invalid(const DepthImage& depth) {
   return invalid;
 }
 
-// Sets `verdict` to a stop with `reason`, reusing the reason's buffer.
-void set_stop(Verdict& verdict, const char* reason) {
+// Sets `verdict` to a stop with `code` and `reason`, reusing the reason's buffer.
+void set_stop(Verdict& verdict, ReasonCode code, const char* reason) {
   verdict.state = VerdictState::stop;
   verdict.speed_scale = 0.0F;
   verdict.protective_distance_m = 0.0F;
+  verdict.code = code;
   verdict.reason.assign(reason);
 }
 
@@ -72,7 +73,7 @@ void begin_result(const Frame& frame, FrameResult& result) {
 void set_learning(Verdict& verdict, int frames_seen, int frames_total, const std::string& message) {
   char text[96];
   std::snprintf(text, sizeof text, "learning background (%d/%d frames)", frames_seen, frames_total);
-  set_stop(verdict, text);
+  set_stop(verdict, ReasonCode::learning_background, text);
   if (!message.empty()) {
     verdict.reason.append("; restarted: ");
     verdict.reason.append(message);
@@ -115,8 +116,8 @@ const Frame& run_filters(FilterChain& chain, const Frame& frame, Frame& filtered
 // Latency from the frame entering processing to its result.
 void finish(FrameResult& result, Clock::time_point start) { result.latency_us = elapsed_us(start); }
 
-void finish_stop(FrameResult& result, const char* reason, Clock::time_point start) {
-  set_stop(result.verdict, reason);
+void finish_stop(FrameResult& result, ReasonCode code, const char* reason, Clock::time_point start) {
+  set_stop(result.verdict, code, reason);
   finish(result, start);
 }
 
@@ -158,21 +159,27 @@ void Pipeline::process(const Frame& source_frame, FrameResult& result) {
   const Clock::time_point start = Clock::now();
   begin_result(source_frame, result);
   result.invalid_pixels = count_invalid(source_frame.depth);
-  if (result.invalid_pixels == source_frame.depth.pixels.size()) return finish_stop(result, "no valid depth", start);
+  if (result.invalid_pixels == source_frame.depth.pixels.size()) {
+    return finish_stop(result, ReasonCode::no_valid_depth, "no valid depth", start);
+  }
   const Frame& frame = run_filters(filters_, source_frame, filtered_, result);
   if (!enough_valid_depth(frame, result)) return finish(result, start);
   if (!background_ready()) {
     timed(result, "background", [&] { learn_background(learner_, frame, result.verdict); });
     return finish(result, start);
   }
-  if (!same_size(background(), frame.depth)) return finish_stop(result, "background size mismatch", start);
+  if (!same_size(background(), frame.depth)) {
+    return finish_stop(result, ReasonCode::background_mismatch, "background size mismatch", start);
+  }
   if (!background_checked(frame, result)) return finish(result, start);
-  if (params_.robot.capsules.empty()) return finish_stop(result, "no robot model", start);
+  if (params_.robot.capsules.empty()) return finish_stop(result, ReasonCode::no_robot_model, "no robot model", start);
   bool extracted = false;
   timed(result, "foreground", [&] {
     extracted = extract_foreground(extractor_, background(), frame, params_.T_base_camera, foreground_);
   });
-  if (!extracted) return finish_stop(result, "foreground extraction failed", start);
+  if (!extracted) {
+    return finish_stop(result, ReasonCode::foreground_failed, "foreground extraction failed", start);
+  }
   timed(result, "proximity", [&] {
     result.contact = proximity_.closest(foreground_.points_base, foreground_.points_camera, params_.robot);
     result.backend = proximity_backend_name(proximity_.last_backend());
@@ -193,7 +200,7 @@ bool Pipeline::enough_valid_depth(const Frame& frame, FrameResult& result) const
   const size_t invalid = &frame.depth == &filtered_.depth ? count_invalid(frame.depth) : result.invalid_pixels;
   const size_t valid = pixels - invalid;
   if (valid == 0) {
-    set_stop(result.verdict, "no valid depth after filters");
+    set_stop(result.verdict, ReasonCode::no_valid_depth, "no valid depth after filters");
     return false;
   }
   const double share = static_cast<double>(valid) / static_cast<double>(pixels);
@@ -202,7 +209,7 @@ bool Pipeline::enough_valid_depth(const Frame& frame, FrameResult& result) const
   char text[96];
   std::snprintf(text, sizeof text, "valid depth %.4f of pixels after filters, below min_valid_share %.4g", share,
                 static_cast<double>(params_.safety.min_valid_share));
-  set_stop(result.verdict, text);
+  set_stop(result.verdict, ReasonCode::low_valid_share, text);
   return false;
 }
 
@@ -222,7 +229,7 @@ bool Pipeline::background_checked(const Frame& frame, FrameResult& result) {
   }
   char text[64];
   std::snprintf(text, sizeof text, "checking loaded background (%d/%d frames)", seen, check_.frames);
-  set_stop(result.verdict, text);
+  set_stop(result.verdict, ReasonCode::checking_background, text);
   return false;
 }
 

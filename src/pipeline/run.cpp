@@ -31,6 +31,7 @@ struct Captured {
 // Why capture ended: the reason of the final stop result and the summary's end_reason.
 struct CaptureOutcome {
   int64_t frames_in = 0;
+  ReasonCode end_code = ReasonCode::source_ended;
   std::string final_reason = "source ended";
   std::string end_reason = "end of source";
   std::string error;  ///< the source's error; empty when it ended or was stopped
@@ -117,10 +118,12 @@ void capture_loop(Source& source, const RunOptions& options, double max_frame_ag
   int64_t previous_ns = 0;
   for (int64_t n = 0;; ++n) {
     if (stop_requested(options)) {
+      outcome.end_code = ReasonCode::stop_requested;
       outcome.final_reason = outcome.end_reason = "stop requested";
       break;
     }
     if (options.max_frames >= 0 && n >= options.max_frames) {
+      outcome.end_code = ReasonCode::frame_limit_reached;
       outcome.final_reason = outcome.end_reason = "frame limit reached";
       break;
     }
@@ -134,6 +137,7 @@ void capture_loop(Source& source, const RunOptions& options, double max_frame_ag
     }
     if (status == Source::Status::end) break;  // the defaults say "source ended"
     if (status == Source::Status::error) {
+      outcome.end_code = ReasonCode::source_error;
       outcome.error = "source error: " + (error.empty() ? std::string("unknown") : error);
       outcome.final_reason = outcome.end_reason = outcome.error;
       break;
@@ -172,7 +176,7 @@ void processing_loop(Pipeline& pipeline, const RunOptions& options, double max_f
     while (frames.take(in)) {
       pipeline.process(in.frame, result);
       result.timestamp_warning = in.timestamp_warning;
-      if (!(seconds_since(in.captured_at) <= max_frame_age_s)) result.verdict = stop_verdict("stale frame");
+      if (!(seconds_since(in.captured_at) <= max_frame_age_s)) result.verdict = stop_verdict(ReasonCode::stale_frame, "stale frame");
       ++stats.processed;
       stats.latencies.add(result.latency_us);
       if (!(options.pace ? results.put(result) : results.put_wait(result))) break;  // the output ended
@@ -186,12 +190,12 @@ void processing_loop(Pipeline& pipeline, const RunOptions& options, double max_f
 
 // A stop result that stands for no source frame (watchdog, end of run): it repeats the last
 // frame's index and timestamp, so that the output's frame numbers never go backwards.
-void write_stop(Sink& sink, FrameResult& scratch, const FrameResult& last, const std::string& reason) {
+void write_stop(Sink& sink, FrameResult& scratch, const FrameResult& last, ReasonCode code, const std::string& reason) {
   scratch.source_frame = false;
   scratch.frame = last.frame;
   scratch.timestamp_ns = last.timestamp_ns;
   scratch.valid = false;
-  scratch.verdict = stop_verdict(reason);
+  scratch.verdict = stop_verdict(code, reason);
   scratch.contact = Contact{};
   scratch.foreground_points = 0;
   scratch.invalid_pixels = 0;
@@ -240,7 +244,7 @@ FrameResult output_loop(Sink& sink, double max_frame_age_s, Mailbox<FrameResult>
       char reason[96];
       std::snprintf(reason, sizeof reason, "no frame for %.3f s (max_frame_age_s %.3f)", seconds_since(last_arrival),
                     max_frame_age_s);
-      write_stop(sink, watchdog, last, reason);
+      write_stop(sink, watchdog, last, ReasonCode::no_frame, reason);
     }
   } catch (const std::exception& e) {
     error = std::string("output error: ") + e.what();
@@ -274,7 +278,16 @@ RunSummary run_pipeline(Source& source, Pipeline& pipeline, Sink& sink, const Ru
   capture.join();
 
   // The first failure is the run's error: the output's, else processing's, else the source's.
-  summary.error = !output_error.empty() ? output_error : !stats.error.empty() ? stats.error : outcome.error;
+  summary.end_code = outcome.end_code;
+  if (!output_error.empty()) {
+    summary.end_code = ReasonCode::output_error;
+    summary.error = output_error;
+  } else if (!stats.error.empty()) {
+    summary.end_code = ReasonCode::processing_error;
+    summary.error = stats.error;
+  } else {
+    summary.error = outcome.error;
+  }
   if (!summary.error.empty()) outcome.final_reason = outcome.end_reason = summary.error;
   summary.frames_in = outcome.frames_in;
   summary.frames_processed = stats.processed;
@@ -287,7 +300,7 @@ RunSummary run_pipeline(Source& source, Pipeline& pipeline, Sink& sink, const Ru
   // gets it too: it may still reach a file whose pipe reader left).
   try {
     FrameResult scratch;
-    write_stop(sink, scratch, last, outcome.final_reason);
+    write_stop(sink, scratch, last, summary.end_code, outcome.final_reason);
     summary.wall_s = seconds_since(start);
     summary.fps = summary.wall_s > 0.0 ? static_cast<double>(summary.frames_processed) / summary.wall_s : 0.0;
     sink.summary(summary);

@@ -223,6 +223,7 @@ void JsonLinesSink::frame(const FrameResult& result) {
   m.boolean("valid", result.valid);
   m.text("verdict", verdict_name(result.verdict.state));
   m.text("verdict_reason", result.verdict.reason);
+  m.text("reason_code", reason_code_name(result.verdict.code));
   m.number("speed_scale", result.verdict.speed_scale);
 
   m.number_or_null("distance_m", contact.valid, contact.distance_m);
@@ -273,6 +274,7 @@ void JsonLinesSink::summary(const RunSummary& summary) {
   // Negative when there never was any foreground.
   m.number_or_null("min_distance_m", summary.min_distance_m >= 0.0F, summary.min_distance_m);
   m.text("end_reason", summary.end_reason);
+  m.text("end_reason_code", reason_code_name(summary.end_code));
   if (summary.error.empty()) {
     m.null("error");
   } else {

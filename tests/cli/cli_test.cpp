@@ -119,6 +119,9 @@ TEST_F(Cli, RunWritesHeaderFramesAndSummaryWithTheBindingNames) {
     EXPECT_EQ(lines[i]["verdict"], "stop");
     EXPECT_FALSE(lines[i]["valid"].get<bool>());
   }
+  // The run ended at --frames: the last verdict line and the summary say so by code.
+  EXPECT_EQ(lines[lines.size() - 2]["reason_code"], "frame_limit_reached");
+  EXPECT_EQ(lines.back()["end_reason_code"], "frame_limit_reached");
 
   const json& header = lines.front();
   EXPECT_EQ(header["type"], "header");
@@ -132,7 +135,7 @@ TEST_F(Cli, RunWritesHeaderFramesAndSummaryWithTheBindingNames) {
   EXPECT_EQ(header["source"]["type"], "sim");
 
   const char* frame_keys[] = {"frame", "timestamp_ns", "timestamp_s", "valid", "verdict", "verdict_reason",
-                              "distance_m", "closest_camera", "closest_base", "closest_robot_base", "robot_link",
+                              "reason_code", "distance_m", "closest_camera", "closest_base", "closest_robot_base", "robot_link",
                               "backend", "foreground_points", "invalid_pixels", "timings_us", "truth"};
   bool saw_box = false;
   for (size_t i = 1; i <= 130; ++i) {

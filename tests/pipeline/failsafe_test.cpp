@@ -52,6 +52,7 @@ TEST(Failsafe, ForegroundWithoutContactIsStop) {
   EXPECT_FALSE(result.contact.valid);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_EQ(result.verdict.reason, "no contact");
+  EXPECT_EQ(result.verdict.code, ReasonCode::non_finite_input);
   // The empty cell with the same broken pose has no foreground: that one is still run.
   fill_frame(4, 0.0F, frame);
   pipeline.process(frame, result);
@@ -88,6 +89,7 @@ TEST(Failsafe, NoValidDepthAfterTheFiltersIsStop) {
   EXPECT_EQ(result.invalid_pixels, 0U);  // the source frame itself is complete
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_EQ(result.verdict.reason, "no valid depth after filters");
+  EXPECT_EQ(result.verdict.code, ReasonCode::no_valid_depth);
   EXPECT_FALSE(pipeline.background_ready());  // and it is not learnt from
 }
 
@@ -105,6 +107,7 @@ TEST(Failsafe, TooFewValidPixelsIsStop) {
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_NE(result.verdict.reason.find("min_valid_share"), std::string::npos) << result.verdict.reason;
   EXPECT_FLOAT_EQ(result.valid_share, 1.0F / 4800.0F);
+  EXPECT_EQ(result.verdict.code, ReasonCode::low_valid_share);
   EXPECT_FALSE(result.valid);
 
   fill_frame(4, 1.5F, frame);
@@ -133,6 +136,7 @@ TEST(Failsafe, InsideTheRobotIsStopWhateverTheZones) {
   ASSERT_TRUE(result.contact.valid);
   EXPECT_TRUE(result.contact.inside);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
+  EXPECT_EQ(result.verdict.code, ReasonCode::inside_robot);
 }
 
 // The background a file holds is checked against the first frames. The one learnt here says
@@ -150,6 +154,7 @@ TEST(Failsafe, LoadedBackgroundThatMatchesIsUsedAfterTheCheck) {
   pipeline.process(frame, result);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_EQ(result.verdict.reason, "checking loaded background (1/2 frames)");
+  EXPECT_EQ(result.verdict.code, ReasonCode::checking_background);
   fill_frame(1, 1.5F, frame);
   pipeline.process(frame, result);
   EXPECT_EQ(result.verdict.reason, "checking loaded background (2/2 frames)");
@@ -285,6 +290,8 @@ TEST(Failsafe, StopRequestInterruptsAPacedWait) {
   options.stop_requested = &stop;
   const RunSummary summary = run(source, sink, fake_params(60.0), options);
   EXPECT_EQ(summary.end_reason, "stop requested");
+  EXPECT_EQ(summary.end_code, ReasonCode::stop_requested);
+  EXPECT_EQ(sink.results.back().verdict.code, ReasonCode::stop_requested);
   EXPECT_LT(summary.wall_s, 10.0);  // far from the 20 s the step asks for
 }
 
@@ -301,6 +308,7 @@ TEST(Failsafe, FailedSinkEndsTheRunWithAnError) {
   FailingSink sink;
   const RunSummary summary = run(source, sink, fake_params(), RunOptions{});
   EXPECT_EQ(summary.error, "output failed: write failed");
+  EXPECT_EQ(summary.end_code, ReasonCode::output_error);
   EXPECT_LT(summary.frames_in, 503);  // capture stopped early, without waiting for a reader
   EXPECT_EQ(sink.results.back().verdict.state, VerdictState::stop);
 }
@@ -320,7 +328,9 @@ TEST(Failsafe, ProcessingErrorIsTheRunsError) {
   EXPECT_EQ(summary.error.rfind("processing error at frame 0: the loaded background: does not match", 0), 0U)
       << summary.error;
   EXPECT_EQ(summary.end_reason, summary.error);
+  EXPECT_EQ(summary.end_code, ReasonCode::processing_error);
   EXPECT_EQ(sink.results.back().verdict.state, VerdictState::stop);
+  EXPECT_EQ(sink.results.back().verdict.code, ReasonCode::processing_error);
   EXPECT_EQ(sink.results.back().verdict.reason, summary.error);
 }
 
@@ -330,6 +340,8 @@ TEST(Failsafe, NormalEndHasNoError) {
   CollectingSink sink;
   const RunSummary summary = run(source, sink, fake_params(), RunOptions{});
   EXPECT_TRUE(summary.error.empty()) << summary.error;
+  EXPECT_EQ(summary.end_code, ReasonCode::source_ended);
+  EXPECT_EQ(sink.results.back().verdict.code, ReasonCode::source_ended);
 }
 
 

@@ -122,7 +122,7 @@ struct CollectingSink : Sink {
   std::vector<FrameResult> frame_results() const {
     std::vector<FrameResult> out;
     for (size_t i = 0; i + 1 < results.size(); ++i) {
-      if (results[i].verdict.reason.rfind("no frame for", 0) != 0) out.push_back(results[i]);
+      if (results[i].verdict.code != ReasonCode::no_frame) out.push_back(results[i]);
     }
     return out;
   }

@@ -37,6 +37,7 @@ TEST(RunPipeline, UnpacedProcessesEveryFrameWithExpectedVerdicts) {
   for (int i = 0; i < test::kLearnFrames; ++i) {
     EXPECT_FALSE(frames[static_cast<size_t>(i)].valid);
     EXPECT_TRUE(starts_with(frames[static_cast<size_t>(i)].verdict.reason, "learning background"));
+    EXPECT_EQ(frames[static_cast<size_t>(i)].verdict.code, ReasonCode::learning_background);
   }
   EXPECT_EQ(frames[3].verdict.state, VerdictState::run);
   EXPECT_EQ(frames[4].verdict.state, VerdictState::slow);
@@ -92,6 +93,8 @@ TEST(RunPipeline, SourceErrorEndsWithStopCarryingTheError) {
   ASSERT_FALSE(sink.results.empty());
   EXPECT_EQ(sink.results.back().verdict.state, VerdictState::stop);
   EXPECT_EQ(sink.results.back().verdict.reason, "source error: cable unplugged");
+  EXPECT_EQ(sink.results.back().verdict.code, ReasonCode::source_error);
+  EXPECT_EQ(summary.end_code, ReasonCode::source_error);
   EXPECT_EQ(summary.end_reason, "source error: cable unplugged");
   // The frame before the failure still ran normally.
   const std::vector<FrameResult> frames = sink.frame_results();
@@ -108,6 +111,7 @@ TEST(RunPipeline, FrameWithoutValidDepthIsStop) {
   EXPECT_EQ(frames[3].verdict.state, VerdictState::run);
   EXPECT_EQ(frames[4].verdict.state, VerdictState::stop);
   EXPECT_EQ(frames[4].verdict.reason, "no valid depth");
+  EXPECT_EQ(frames[4].verdict.code, ReasonCode::no_valid_depth);
   EXPECT_FALSE(frames[4].valid);
   EXPECT_EQ(frames[5].verdict.state, VerdictState::run);
 }
@@ -121,6 +125,8 @@ TEST(RunPipeline, MaxFramesEndsTheRunWithStop) {
   EXPECT_EQ(summary.frames_in, 4);
   EXPECT_EQ(sink.results.back().verdict.state, VerdictState::stop);
   EXPECT_FALSE(sink.results.back().verdict.reason.empty());
+  EXPECT_EQ(sink.results.back().verdict.code, ReasonCode::frame_limit_reached);
+  EXPECT_EQ(summary.end_code, ReasonCode::frame_limit_reached);
 }
 
 TEST(RunPipeline, WatchdogStopsWhenTheSourceStalls) {
@@ -130,7 +136,8 @@ TEST(RunPipeline, WatchdogStopsWhenTheSourceStalls) {
   run(source, sink, fake_params(0.1));
   size_t first_watchdog = sink.results.size();
   for (size_t i = 0; i < sink.results.size(); ++i) {
-    if (starts_with(sink.results[i].verdict.reason, "no frame for")) {
+    if (sink.results[i].verdict.code == ReasonCode::no_frame) {
+      EXPECT_TRUE(starts_with(sink.results[i].verdict.reason, "no frame for"));
       first_watchdog = std::min(first_watchdog, i);
       EXPECT_EQ(sink.results[i].verdict.state, VerdictState::stop);
       EXPECT_FALSE(sink.results[i].valid);
@@ -154,7 +161,7 @@ TEST(RunPipeline, StaleFrameIsStop) {
   int stale = 0;
   for (const FrameResult& r : sink.results) {
     EXPECT_EQ(r.verdict.state, VerdictState::stop);
-    stale += r.verdict.reason == "stale frame" ? 1 : 0;
+    stale += r.verdict.code == ReasonCode::stale_frame ? 1 : 0;
   }
   EXPECT_EQ(stale, summary.frames_processed);
   EXPECT_EQ(summary.frames_processed, 5);

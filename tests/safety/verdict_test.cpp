@@ -6,6 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <set>
+#include <utility>
+#include <vector>
 #include <string>
 
 namespace hrcsense {
@@ -64,11 +67,12 @@ TEST(Verdict, SpeedScaleIsLinearInTheSlowZone) {
 TEST(Verdict, StopReasonsAreNeverEmpty) {
   const Verdict close = verdict_for_contact(params(), contact_at(0.1F), 1);
   EXPECT_FALSE(close.reason.empty());
-  const Verdict stale = stop_verdict("stale frame");
+  const Verdict stale = stop_verdict(ReasonCode::stale_frame, "stale frame");
   EXPECT_EQ(stale.state, VerdictState::stop);
   EXPECT_EQ(stale.speed_scale, 0.0F);
   EXPECT_EQ(stale.reason, "stale frame");
-  EXPECT_FALSE(stop_verdict("").reason.empty());
+  EXPECT_EQ(stale.code, ReasonCode::stale_frame);
+  EXPECT_EQ(stop_verdict(ReasonCode::no_frame).reason, "no_frame");  // no details: the code's name
 }
 
 TEST(Verdict, EqualThresholdsHaveNoSlowZone) {
@@ -114,6 +118,47 @@ TEST(Verdict, InsideTheRobotAlwaysStops) {
   inside.inside = true;
   EXPECT_EQ(verdict_for_contact(zero, inside, 1).state, VerdictState::stop);
   EXPECT_EQ(verdict_for_contact(params(), inside, 1).reason, "inside robot");
+}
+
+// Each verdict of the zones carries its code (A3): control flow and consumers read the code.
+TEST(Verdict, EveryOutcomeHasItsCode) {
+  const SafetyParams p = params();
+  EXPECT_EQ(verdict_for_contact(p, Contact{}, 0).code, ReasonCode::no_foreground);
+  EXPECT_EQ(verdict_for_contact(p, contact_at(5.0F), 1).code, ReasonCode::clear);
+  EXPECT_EQ(verdict_for_contact(p, contact_at(0.8F), 1).code, ReasonCode::in_slow_zone);
+  EXPECT_EQ(verdict_for_contact(p, contact_at(0.1F), 1).code, ReasonCode::in_stop_zone);
+  EXPECT_EQ(verdict_for_contact(p, Contact{}, 3).code, ReasonCode::non_finite_input);
+  Contact inside = contact_at(0.0F);
+  inside.inside = true;
+  EXPECT_EQ(verdict_for_contact(p, inside, 1).code, ReasonCode::inside_robot);
+  for (float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    const Verdict v = verdict_for_contact(p, contact_at(bad), 1);
+    EXPECT_EQ(v.state, VerdictState::stop);
+    EXPECT_EQ(v.code, ReasonCode::non_finite_input);
+  }
+}
+
+// The codes' names are the stable identifiers of docs/OUTPUT.md: snake_case and distinct.
+TEST(Verdict, ReasonCodeNamesAreDistinctSnakeCase) {
+  const std::vector<std::pair<ReasonCode, std::string>> expected = {
+      {ReasonCode::clear, "clear"}, {ReasonCode::no_foreground, "no_foreground"},
+      {ReasonCode::in_slow_zone, "in_slow_zone"}, {ReasonCode::in_stop_zone, "in_stop_zone"},
+      {ReasonCode::inside_robot, "inside_robot"}, {ReasonCode::non_finite_input, "non_finite_input"},
+      {ReasonCode::learning_background, "learning_background"},
+      {ReasonCode::checking_background, "checking_background"}, {ReasonCode::no_valid_depth, "no_valid_depth"},
+      {ReasonCode::low_valid_share, "low_valid_share"}, {ReasonCode::background_mismatch, "background_mismatch"},
+      {ReasonCode::no_robot_model, "no_robot_model"}, {ReasonCode::foreground_failed, "foreground_failed"},
+      {ReasonCode::stale_frame, "stale_frame"}, {ReasonCode::no_frame, "no_frame"},
+      {ReasonCode::source_ended, "source_ended"}, {ReasonCode::frame_limit_reached, "frame_limit_reached"},
+      {ReasonCode::stop_requested, "stop_requested"}, {ReasonCode::source_error, "source_error"},
+      {ReasonCode::processing_error, "processing_error"}, {ReasonCode::output_error, "output_error"}};
+  std::set<std::string> seen;
+  for (const auto& [code, name] : expected) {
+    EXPECT_EQ(reason_code_name(code), name);
+    EXPECT_TRUE(seen.insert(name).second) << name;
+  }
+  // The last enumerator is output_error: a new code without a name here fails this count.
+  EXPECT_EQ(static_cast<size_t>(ReasonCode::output_error) + 1, expected.size());
 }
 
 TEST(Verdict, Names) {

@@ -212,6 +212,7 @@ TEST(JsonLinesSink, SummaryHasEveryRunSummaryField) {
   EXPECT_EQ(j["min_distance_m"].get<float>(), 1.2196938F);
   EXPECT_EQ(j["end_reason"], "end of source");
   EXPECT_TRUE(j["error"].is_null());  // the run ended normally
+  EXPECT_EQ(j["end_reason_code"], "source_ended");
   EXPECT_EQ(j["timestamps_backwards"], 2);
   EXPECT_EQ(j["timestamps_repeated"], 3);
   EXPECT_EQ(j["timestamp_gaps"], 4);
@@ -241,12 +242,13 @@ TEST(JsonLinesSink, EveryLineIsFlushedAtOnce) {
   sink.header(header);
   EXPECT_EQ(json::parse(available())["type"], "header");
   FrameResult result;
-  result.verdict = stop_verdict("learning background (1/100 frames)");
+  result.verdict = stop_verdict(ReasonCode::learning_background, "learning background (1/100 frames)");
   sink.frame(result);
   const std::string frame_line = available();
   ASSERT_FALSE(frame_line.empty()) << "the frame line is still in the stream's buffer";
   EXPECT_EQ(frame_line.back(), '\n');
   EXPECT_EQ(json::parse(frame_line)["verdict"], "stop");
+  EXPECT_EQ(json::parse(frame_line)["reason_code"], "learning_background");
   EXPECT_FALSE(sink.failed());
   file.close();
   ::close(fds[0]);
@@ -287,7 +289,7 @@ TEST(JsonLinesSink, VerdictWithoutSourceFrameHasItsOwnType) {
   FrameResult result;
   result.frame = 7;
   result.source_frame = false;
-  result.verdict = stop_verdict("source ended");
+  result.verdict = stop_verdict(ReasonCode::source_ended, "source ended");
   sink.frame(result);
   const std::vector<json> lines = parse_lines(out.str());
   ASSERT_EQ(lines.size(), 1U);
