@@ -173,4 +173,36 @@ ClosestPair closest_shape_capsule(const Shape& shape, const Capsule& capsule) {
   return {};
 }
 
+Contact rendered_truth_contact(const PointCloud& points_base, const PointCloud& points_camera,
+                               const RobotModel& robot) {
+  Contact best;
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < points_base.size(); ++i) {
+    const Eigen::Vector3d p = points_base.point(i).cast<double>();
+    for (const Capsule& capsule : robot.capsules) {
+      const Eigen::Vector3d a = capsule.a.cast<double>();
+      const Eigen::Vector3d ab = capsule.b.cast<double>() - a;
+      const double length2 = ab.squaredNorm();
+      const double t = length2 > 0.0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+      const Eigen::Vector3d on_axis = a + t * ab;
+      const double axis_distance = (p - on_axis).norm();
+      const double distance = std::max(axis_distance - static_cast<double>(capsule.radius_m), 0.0);
+      if (!(distance < best_distance)) continue;
+      best_distance = distance;
+      best.valid = true;
+      best.distance_m = static_cast<float>(distance);
+      best.inside = distance == 0.0;
+      best.closest_base = points_base.point(i);
+      // The robot's surface point towards p; inside the capsule, the point itself.
+      const Eigen::Vector3d on_surface =
+          best.inside ? p : on_axis + (p - on_axis) * (static_cast<double>(capsule.radius_m) / axis_distance);
+      best.closest_robot_base = on_surface.cast<float>();
+      best.robot_link = capsule.link;
+      best.closest_camera = points_camera.size() == points_base.size() ? points_camera.point(i) : Eigen::Vector3f::Zero();
+      best.pixel = points_base.pixel.size() == points_base.size() ? static_cast<int>(points_base.pixel[i]) : -1;
+    }
+  }
+  return best;
+}
+
 }  // namespace hrcsense::sim_detail

@@ -98,4 +98,11 @@ struct ClosestPair {
 /// to about 1e-6 of the segment's length; against a robot point it is exact.
 ClosestPair closest_shape_capsule(const Shape& shape, const Capsule& capsule);
 
+/// The ground truth's contact over the rendered points: every point against every capsule, in
+/// double precision, by a plain loop that shares nothing with src/proximity, whose searches the
+/// tests hold against it. Ties keep the lowest point, then the lowest capsule. Invalid when
+/// the cloud or the robot is empty.
+Contact rendered_truth_contact(const PointCloud& points_base, const PointCloud& points_camera,
+                               const RobotModel& robot);
+
 }  // namespace hrcsense::sim_detail

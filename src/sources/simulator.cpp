@@ -2,7 +2,6 @@
 // hrcsense — the simulated D435: places the scene's objects for a frame, casts the depth and
 // colour cameras' rays, applies the sensor model and computes the ground truth.
 
-#include "hrcsense/proximity.hpp"
 #include "hrcsense/sim.hpp"
 #include "sim_color.hpp"
 #include "sim_geometry.hpp"
@@ -153,7 +152,7 @@ void fill_truth_contacts(const Simulator& sim, const PoseF& T_base_camera, Groun
     truth.analytic_contact = Contact{};
     return;
   }
-  truth.contact = closest_contact_brute(scratch.points_base, scratch.points_camera, sim.robot);
+  truth.contact = sim_detail::rendered_truth_contact(scratch.points_base, scratch.points_camera, sim.robot);
   truth.analytic_contact = analytic_contact(scratch, sim.robot, T_base_camera.inverse());
 }
 
