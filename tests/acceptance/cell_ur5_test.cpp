@@ -4,12 +4,14 @@
 
 #include "hrcsense/config.hpp"
 #include "hrcsense/pipeline.hpp"
+#include "hrcsense/robot.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <set>
 #include <string>
+#include <vector>
 
 namespace hrcsense {
 namespace {
@@ -31,15 +33,23 @@ Config noise_free_cell(const std::string& backend) {
 
 TEST(CellUr5, ArmIsSearchedAsPaddedCapsules) {
   const Config config = noise_free_cell("brute");
-  // Base, six links and the tool: the model's capsules carry link indices 0..7.
-  ASSERT_FALSE(config.pipeline.robot.capsules.empty());
+  // The base and the six links (the cell's UR5 has no tool): link indices 0..6, each capsule
+  // exactly the description's own, placed the same, with the cell's 5 cm padding added.
+  ASSERT_TRUE(config.robot_arm.has_value());
+  JointAngles joints{};
+  std::copy(config.robot_joints_rad.begin(), config.robot_joints_rad.end(), joints.begin());
+  const RobotModel unpadded = robot_capsules(*config.robot_arm, joints, 0.0, config.robot_frame);
+  const std::vector<Capsule>& padded = config.pipeline.robot.capsules;
+  ASSERT_EQ(padded.size(), unpadded.capsules.size());
   std::set<int> links;
-  for (const Capsule& capsule : config.pipeline.robot.capsules) {
-    links.insert(capsule.link);
-    EXPECT_GE(capsule.radius_m, 0.05F);  // every capsule carries the 5 cm padding
+  for (size_t i = 0; i < padded.size(); ++i) {
+    links.insert(padded[i].link);
+    EXPECT_EQ(padded[i].link, unpadded.capsules[i].link);
+    EXPECT_NEAR(padded[i].radius_m, unpadded.capsules[i].radius_m + 0.05F, 1e-6F) << "capsule " << i;
+    EXPECT_EQ(padded[i].a, unpadded.capsules[i].a);
+    EXPECT_EQ(padded[i].b, unpadded.capsules[i].b);
   }
-  EXPECT_EQ(*links.begin(), 0);
-  EXPECT_GE(*links.rbegin(), 6);
+  EXPECT_EQ(links, (std::set<int>{0, 1, 2, 3, 4, 5, 6}));
 }
 
 // Empty while learning (the arm is background, so no foreground at all), then the person's
