@@ -7,7 +7,7 @@
 // How the buffers are moved: DepthImage and DisparityImage own their pixels in a std::vector
 // with the default allocator, so the API takes no outside or offset buffer, and glibc's malloc
 // only ever returns 16-byte aligned blocks. This executable therefore replaces the global
-// operator new (as tests/proximity/octree_test.cpp does to count allocations): while a
+// operator new (as tests/alloc/ does to count allocations): while a
 // `Placement` is alive, every allocation starts `offset` bytes past a 64-byte boundary and ends
 // where its block ends (so AddressSanitizer still sees an overrun); operator delete finds such
 // blocks in a small table. Offsets are multiples of the element size, so every uint16_t and

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The octree's structure (leaves partition the cloud, every box holds its points, leaves are
-// cells), repeated searches on one build against a plain scan, and no allocation after the
-// first frame.
+// cells), repeated searches on one build against a plain scan. That a repeated frame allocates
+// nothing is checked in tests/alloc/, whose binary counts allocations.
 
 #include "octree_internal.hpp"
 
@@ -10,33 +10,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
-#include <new>
 #include <random>
 #include <string>
 #include <vector>
-
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-// Counts every allocation of the test executable, to check that a repeated frame allocates
-// nothing. malloc-based, so sanitizers still see every allocation; GCC cannot see that the
-// replaced new and delete match.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-void* operator new(std::size_t size) {
-  ++g_allocations;
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return operator new(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace hrcsense::proximity_detail {
 namespace {
@@ -261,34 +239,6 @@ TEST(Octree, RepeatedSearchesOnOneBuildMatchAPlainScan) {
       }
       check_node(tree, cloud, 0, 0, height, box_of(cloud), cloud.name + " after searches");
     }
-  }
-}
-
-TEST(Octree, ARepeatedFrameAllocatesNothing) {
-  const std::vector<Cloud> clouds = test_clouds();
-  const Cloud& a = clouds[0];
-  const Cloud& b = clouds[4];
-  RobotModel robot;
-  Capsule c;
-  c.a = {0.5F, -0.5F, 0.5F};
-  c.b = {1.0F, 0.0F, 0.7F};
-  c.radius_m = 0.05F;
-  robot.capsules.push_back(c);
-  const std::vector<CapsuleBound> capsules = bounds_of(robot);
-  for (int height : {2, 4, 7}) {
-    Octree tree;
-    auto frame = [&](const Cloud& cloud) {
-      tree.build(cloud.x.data(), cloud.y.data(), cloud.z.data(), cloud.size(), height);
-      return tree.closest(capsules).distance_m;
-    };
-    frame(a);
-    frame(b);
-    const long before = g_allocations.load();
-    const float da = frame(a);
-    const float db = frame(b);
-    EXPECT_EQ(g_allocations.load(), before) << "h" << height;
-    EXPECT_EQ(da, brute_contact(a, robot).distance_m);
-    EXPECT_EQ(db, brute_contact(b, robot).distance_m);
   }
 }
 

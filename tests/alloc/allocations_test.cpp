@@ -1,0 +1,129 @@
+// SPDX-License-Identifier: Apache-2.0
+// After a warm-up at the largest cloud, Pipeline::process allocates nothing (STYLE.md, "Real
+// time"), for every filter preset and for the brute and octree backends. The kd-tree is the
+// documented exception: nanoflann 1.4 frees and re-allocates its node pool at every build
+// (docs/PROXIMITY.md) with malloc itself, which a counting operator new cannot see, so it is
+// not held to this test.
+//
+// This binary replaces the global operator new to count allocations, so it holds no other
+// tests: a replacement in a family binary would count (and could disturb) all of them.
+#include "hrcsense/config.hpp"
+#include "hrcsense/pipeline.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace {
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+// malloc-based, so the sanitizers still see every allocation; GCC cannot see that the replaced
+// new and delete match.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+void* operator new(std::size_t size) {
+  ++g_allocations;
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return operator new(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace hrcsense {
+namespace {
+
+constexpr int kLearnFrames = 20;
+
+// walk.yaml: the empty room for learning, then the person from entering the view to standing
+// at the robot (frames 100-200), rendered before any counting.
+std::vector<Frame> walk_frames(const Config& config) {
+  const Simulator sim = make_simulator(config);
+  std::vector<Frame> frames;
+  for (int i = 0; i < kLearnFrames; ++i) sim.render(i, frames.emplace_back());
+  for (int i = 100; i <= 200; i += 4) sim.render(i, frames.emplace_back());
+  return frames;
+}
+
+// Allocations during the second pass over the frames, after a first pass has grown every
+// buffer to the largest cloud.
+long allocations_after_warm_up(const std::string& preset, const std::string& backend) {
+  const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/walk.yaml",
+                                    {"filters.preset=" + preset, "proximity.backend=" + backend,
+                                     "background.frames=" + std::to_string(kLearnFrames), "sim.color=false"});
+  const std::vector<Frame> frames = walk_frames(config);
+  Pipeline pipeline(config.pipeline);
+  FrameResult result;
+  size_t largest_cloud = 0;
+  for (const Frame& frame : frames) {
+    pipeline.process(frame, result);
+    largest_cloud = std::max(largest_cloud, result.foreground_points);
+  }
+  EXPECT_GT(largest_cloud, 1000U) << preset << "/" << backend << ": the person was not found";
+  const long before = g_allocations.load();
+  for (size_t i = kLearnFrames; i < frames.size(); ++i) pipeline.process(frames[i], result);
+  const long allocations = g_allocations.load() - before;
+  EXPECT_TRUE(result.valid) << result.verdict.reason;
+  return allocations;
+}
+
+TEST(PipelineAllocations, NoneAfterWarmUpForEveryPresetWithBruteAndOctree) {
+  for (const char* preset : {"none", "sdk", "thesis"}) {
+    for (const char* backend : {"brute", "octree"}) {
+      EXPECT_EQ(allocations_after_warm_up(preset, backend), 0) << preset << "/" << backend;
+    }
+  }
+}
+
+// The search alone, frame after frame on clouds of two sizes: after each size has been seen
+// once, neither the octree nor the brute force allocates (both keep their buffers).
+TEST(ProximityAllocations, RepeatedFramesAllocateNothing) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> coordinate(-1.0F, 1.0F);
+  auto cloud_of = [&](size_t n) {
+    PointCloud cloud;
+    for (size_t i = 0; i < n; ++i) cloud.push_back(coordinate(rng), coordinate(rng), 1.5F + coordinate(rng), 0);
+    return cloud;
+  };
+  const PointCloud small = cloud_of(3000), large = cloud_of(120000);
+  RobotModel robot;
+  Capsule capsule;
+  capsule.a = {0.5F, -0.5F, 0.5F};
+  capsule.b = {1.0F, 0.0F, 0.7F};
+  capsule.radius_m = 0.05F;
+  robot.capsules.push_back(capsule);
+  for (const ProximityBackend backend : {ProximityBackend::brute, ProximityBackend::octree}) {
+    ProximityParams params;
+    params.octree_height = 7;
+    ProximitySearch search(backend, params);
+    search.closest(small, PointCloud{}, robot);
+    search.closest(large, PointCloud{}, robot);
+    const long before = g_allocations.load();
+    const Contact a = search.closest(small, PointCloud{}, robot);
+    const Contact b = search.closest(large, PointCloud{}, robot);
+    EXPECT_EQ(g_allocations.load() - before, 0) << proximity_backend_name(backend);
+    EXPECT_TRUE(a.valid && b.valid);
+  }
+}
+
+// The simulator renders a frame into the buffers of the previous one (docs/SIMULATOR.md):
+// depth, colour and truth without allocating once sized.
+TEST(SimulatorAllocations, NoneWhenRenderingAgain) {
+  const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/walk.yaml", {});
+  const Simulator sim = make_simulator(config);
+  Frame frame;
+  for (int i = 150; i < 160; ++i) sim.render(i, frame);  // the person in view: truth points too
+  const long before = g_allocations.load();
+  for (int i = 160; i < 170; ++i) sim.render(i, frame);
+  EXPECT_EQ(g_allocations.load() - before, 0);
+}
+
+}  // namespace
+}  // namespace hrcsense
