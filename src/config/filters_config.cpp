@@ -76,6 +76,45 @@ void read_options(KeyReader& r, FilterChainParams& f) {
   r.integer("filters.hole_filling.mode", f.hole_filling.mode, 0, 2);
 }
 
+// Every option with its block: an option tuned for a block that is not in the chain would be
+// silently ignored (temporal.persistence on the `none` preset), so a value other than the
+// preset's is an error. The preset's own value is accepted, so that the effective
+// configuration (which spells out every option) reads back.
+using OptionValue = double (*)(const FilterChainParams&);
+struct BlockOption {
+  FilterBlock block;
+  const char* key;
+  OptionValue value;
+};
+const BlockOption kBlockOptions[] = {
+    {FilterBlock::threshold, "filters.threshold.min", [](const FilterChainParams& f) -> double { return f.threshold.min_m; }},
+    {FilterBlock::threshold, "filters.threshold.max", [](const FilterChainParams& f) -> double { return f.threshold.max_m; }},
+    {FilterBlock::decimation, "filters.decimation.magnitude",
+     [](const FilterChainParams& f) -> double { return f.decimation.magnitude; }},
+    {FilterBlock::spatial, "filters.spatial.alpha", [](const FilterChainParams& f) -> double { return f.spatial.alpha; }},
+    {FilterBlock::spatial, "filters.spatial.delta", [](const FilterChainParams& f) -> double { return f.spatial.delta; }},
+    {FilterBlock::spatial, "filters.spatial.magnitude",
+     [](const FilterChainParams& f) -> double { return f.spatial.magnitude; }},
+    {FilterBlock::spatial, "filters.spatial.holes_fill",
+     [](const FilterChainParams& f) -> double { return f.spatial.holes_fill; }},
+    {FilterBlock::temporal, "filters.temporal.alpha", [](const FilterChainParams& f) -> double { return f.temporal.alpha; }},
+    {FilterBlock::temporal, "filters.temporal.delta", [](const FilterChainParams& f) -> double { return f.temporal.delta; }},
+    {FilterBlock::temporal, "filters.temporal.persistence",
+     [](const FilterChainParams& f) -> double { return f.temporal.persistence; }},
+    {FilterBlock::hole_filling, "filters.hole_filling.mode",
+     [](const FilterChainParams& f) -> double { return f.hole_filling.mode; }},
+};
+
+void refuse_options_outside_the_chain(KeyReader& r, const Config& c, const FilterChainParams& preset) {
+  const FilterChainParams& f = c.pipeline.filters;
+  for (const BlockOption& option : kBlockOptions) {
+    if (contains(f.order, option.block) || option.value(f) == option.value(preset)) continue;
+    r.fail(option.key, std::string("the ") + filter_block_name(option.block) +
+                           " block is not in the chain (filters.preset " + c.filters_preset +
+                           "), so this option would be ignored; add the block to filters.order or remove the option");
+  }
+}
+
 }  // namespace
 
 void read_filters(KeyReader& r, Config& c) {
@@ -92,7 +131,9 @@ void read_filters(KeyReader& r, Config& c) {
   YAML::Node effective(YAML::NodeType::Sequence);
   for (const FilterBlock block : f.order) effective.push_back(filter_block_name(block));
   r.set_effective("filters.order", effective);
+  const FilterChainParams preset = f;
   read_options(r, f);
+  refuse_options_outside_the_chain(r, c, preset);
 }
 
 }  // namespace hrcsense::config_detail

@@ -68,7 +68,8 @@ TEST(FiltersConfig, OrderAndEnabled) {
 
 TEST(FiltersConfig, OptionsAndTheSdkRanges) {
   const Config c = load_config("", {"filters.spatial.alpha=0.3", "filters.spatial.delta=50", "filters.temporal.alpha=0",
-                                     "filters.threshold.max=16", "filters.hole_filling.mode=2"});
+                                     "filters.threshold.max=16", "filters.hole_filling.enabled=true",
+                                     "filters.hole_filling.mode=2"});
   EXPECT_EQ(c.pipeline.filters.spatial.alpha, 0.3F);
   EXPECT_EQ(c.pipeline.filters.spatial.delta, 50);
   EXPECT_EQ(c.pipeline.filters.temporal.alpha, 0.0F);
@@ -86,6 +87,22 @@ TEST(FiltersConfig, OptionsAndTheSdkRanges) {
   expect_error({"filters.threshold.max=16.5"}, {"filters.threshold.max", "[0, 16] m"});
   expect_error({"filters.threshold.min=2", "filters.threshold.max=1"}, {"filters.threshold.min", "max"});
   expect_error({"filters.spatial.beta=1"}, {"filters.spatial.beta"});
+}
+
+// A tuned option of a block that is not in the chain would be ignored: an error naming it
+// (A3). The preset's own value is accepted, so that the effective configuration reads back.
+TEST(FiltersConfig, OptionOfABlockOutsideTheChainIsAnError) {
+  expect_error({"filters.preset=none", "filters.temporal.persistence=5"},
+               {"filters.temporal.persistence", "not in the chain", "filters.preset none"});
+  expect_error({"filters.hole_filling.mode=2"}, {"filters.hole_filling.mode", "hole_filling block"});  // sdk: no hole fill
+  expect_error({"filters.spatial.enabled=false", "filters.spatial.alpha=0.3"}, {"filters.spatial.alpha"});
+  const FilterChainParams none_defaults = *filter_preset("none");
+  const Config same = load_config("", {"filters.preset=none", "filters.temporal.persistence=" +
+                                                                  std::to_string(none_defaults.temporal.persistence)});
+  EXPECT_TRUE(same.pipeline.filters.order.empty());
+  const Config c = load_config("", {"filters.preset=none", "filters.temporal.enabled=true",
+                                    "filters.temporal.persistence=5"});
+  EXPECT_EQ(c.pipeline.filters.temporal.persistence, 5);
 }
 
 TEST(FiltersPipeline, EveryBlockIsTimedUnderItsName) {
