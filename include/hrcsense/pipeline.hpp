@@ -204,8 +204,9 @@ struct PipelineParams {
   ProximityParams proximity;  ///< octree height, brute threads
 };
 
-/// The per-frame processing path, single-threaded: background → foreground → proximity →
-/// verdict. Owns the stages' state and scratch buffers.
+/// The per-frame processing path: depth filters → background → foreground → proximity →
+/// verdict, on the caller's thread (run_pipeline gives it a thread of its own; the brute-force
+/// search may use a second one, `proximity.threads`). Owns the stages' state and scratch buffers.
 class Pipeline {
  public:
   explicit Pipeline(PipelineParams params);

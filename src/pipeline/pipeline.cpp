@@ -63,7 +63,7 @@ void begin_result(const Frame& frame, FrameResult& result) {
   result.foreground_points = 0;
   result.invalid_pixels = 0;
   result.valid_share = 0.0F;
-  result.timings.clear();  // keeps its capacity: four stages after the first frame
+  result.timings.clear();  // keeps its capacity: one entry per filter block and stage after the first frame
   result.truth.reset();
   if (frame.truth) result.truth = frame.truth->contact;
 }

@@ -33,8 +33,9 @@ Contact make_contact(const Best& best, const PointCloud& points_base, const Poin
 
 namespace {
 
-// `auto`: every backend rebuilds nothing but the cloud changes every frame, so a tree pays its
-// build for one query. The measured crossover (docs/PROXIMITY.md) decides.
+// `auto`: the cloud changes every frame, so a tree pays its whole build for one query; measured
+// (docs/PROXIMITY.md, the crossover table) that never pays off at any cloud size, so `auto` is
+// brute force until a measurement says otherwise. The size is kept for that rule.
 ProximityBackend pick_automatic(size_t /*points*/) { return ProximityBackend::brute; }
 
 }  // namespace

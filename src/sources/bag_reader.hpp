@@ -40,7 +40,7 @@ struct BagMessage {
   uint64_t chunk_offset = 0;    ///< byte offset of the chunk record in the file (for errors)
 };
 
-/// Reads a bag's messages in file order. Every error is a BagError whose message names the
+/// Reads a bag's messages in file order. Every error is an IoError whose message names the
 /// file and the byte offset of the damaged record.
 class BagReader {
  public:
