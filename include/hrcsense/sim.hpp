@@ -5,12 +5,14 @@
 #pragma once
 
 #include "hrcsense/camera.hpp"
+#include "hrcsense/source.hpp"
 #include "hrcsense/types.hpp"
 
 #include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hrcsense {
@@ -200,5 +202,17 @@ std::optional<Intrinsics> d435_color_intrinsics(int width, int height);
 /// Fill rate as the Depth Quality Tool defines it: valid pixels / pixels in the image, over
 /// frames first .. first+count-1 of the simulator. count ≥ 1.
 double sim_fill_rate(const Simulator& sim, int64_t first, int64_t count);
+
+/// The simulator as a source, ending after params.frames frames.
+class SimSource : public Source {
+ public:
+  explicit SimSource(Simulator simulator) : sim_(std::move(simulator)) {}
+  SourceInfo info() const override;
+  Status next(Frame& out) override;
+
+ private:
+  Simulator sim_;
+  int64_t next_index_ = 0;
+};
 
 }  // namespace hrcsense

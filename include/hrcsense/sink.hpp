@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — a consumer of results: the other virtual interface (JSON Lines, the console, later
+// UDP, DDS, the recorder and the viewer), with what a run says before and after its frames.
+#pragma once
+
+#include "hrcsense/source.hpp"
+#include "hrcsense/types.hpp"
+
+#include <cstdint>
+#include <string>
+
+namespace hrcsense {
+
+/// What the run is about, written once before the first frame.
+struct RunHeader {
+  std::string version;  ///< empty: the JSON Lines sink writes the version it was built as
+  std::string commit;   ///< empty: likewise the commit
+  std::string config_hash;
+  SourceInfo source;
+  /// The depth filters as they run: `filters.preset`, the domain of filter_domain(), a note
+  /// when the domain is not the one the preset asks for, and the filtered resolution.
+  struct Filters {
+    std::string preset;    ///< empty: not written (no configuration, e.g. in tests)
+    std::string domain;    ///< "none", "disparity" or "depth"
+    std::string note;      ///< e.g. why there is no disparity domain; empty for none
+    Intrinsics intrinsics; ///< of the filtered image (background, Contact::pixel)
+  } filters;
+};
+
+/// Source timestamps out of order, counted over a run (each frame against the one before).
+struct TimestampCounts {
+  int64_t backwards = 0;       ///< a timestamp earlier than the previous frame's
+  int64_t repeated = 0;        ///< the same timestamp as the previous frame's
+  int64_t gaps = 0;            ///< steps of more than 1.5 nominal periods (up to max_frame_age_s)
+  int64_t frames_skipped = 0;  ///< frames missing in those gaps, at the nominal rate
+  int64_t jumps = 0;           ///< steps longer than safety.max_frame_age_s (paced waits are cut there)
+};
+
+/// Totals written once at the end.
+struct RunSummary {
+  int64_t frames_in = 0;          ///< frames read from the source
+  int64_t frames_processed = 0;   ///< frames that went through processing
+  int64_t frames_dropped = 0;     ///< dropped by mailboxes (paced or live runs only)
+  int64_t frames_valid = 0;
+  int64_t verdict_run = 0, verdict_slow = 0, verdict_stop = 0;
+  double wall_s = 0.0;
+  double fps = 0.0;               ///< frames_processed / wall_s
+  double latency_p50_us = 0.0, latency_p99_us = 0.0;
+  float min_distance_m = -1.0F;   ///< smallest distance seen; -1 if never any foreground
+  /// How the run ended: source_ended, frame_limit_reached, stop_requested, source_error,
+  /// processing_error or output_error; end_reason says it for people.
+  ReasonCode end_code = ReasonCode::source_ended;
+  std::string end_reason;         ///< "end of source", or the source's error
+  /// Why the run failed (source error, processing error, output failed); empty when it ended
+  /// normally (end of source, frame limit, stop requested). The app exits 1 when set.
+  std::string error;
+  TimestampCounts timestamps;     ///< source timestamps out of order
+};
+
+/// A consumer of results. The other virtual interface of hrcsense.
+class Sink {
+ public:
+  virtual ~Sink() = default;
+  virtual void header(const RunHeader& header) = 0;
+  virtual void frame(const FrameResult& result) = 0;
+  virtual void summary(const RunSummary& summary) = 0;
+  /// True once the sink can no longer deliver results (a closed pipe, a full disk); the run
+  /// then ends. failure() says why.
+  virtual bool failed() const { return false; }
+  virtual std::string failure() const { return {}; }
+};
+
+}  // namespace hrcsense

@@ -1,0 +1,34 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — a source of depth frames: one of the two virtual interfaces (simulator, recordings,
+// live cameras implement it).
+#pragma once
+
+#include "hrcsense/types.hpp"
+
+#include <cstdint>
+#include <string>
+
+namespace hrcsense {
+
+/// What a source says about itself before the first frame.
+struct SourceInfo {
+  std::string type;             ///< "sim", "folder", "bag", ...
+  std::string description;      ///< e.g. the scene or file
+  Intrinsics intrinsics;        ///< of the depth stream
+  float stereo_baseline_mm = 0.0F;  ///< 0 when unknown
+  double nominal_fps = 30.0;    ///< for pacing when frames carry no usable timestamps
+  int64_t frame_count = -1;     ///< -1 when unknown
+};
+
+/// A source of depth frames. One of the two virtual interfaces of hrcsense.
+class Source {
+ public:
+  enum class Status { frame, end, error };
+  virtual ~Source() = default;
+  virtual SourceInfo info() const = 0;
+  /// Reads the next frame into `out`, reusing its buffers. After `error`, error() says why.
+  virtual Status next(Frame& out) = 0;
+  virtual std::string error() const { return {}; }
+};
+
+}  // namespace hrcsense
