@@ -215,7 +215,7 @@ bool stage_parameters_finite(const Config& c) {
             std::isfinite(p.safety.min_valid_share) && std::isfinite(p.foreground.k_sigma) &&
             std::isfinite(p.foreground.min_margin_m) && std::isfinite(p.foreground.min_object_mm) &&
             std::isfinite(p.filters.threshold.min_m) && std::isfinite(p.filters.threshold.max_m);
-  for (const Capsule& capsule : p.robot.capsules) {
+  for (const Capsule& capsule : fixed_robot_model(c).capsules) {
     ok = ok && capsule.a.allFinite() && capsule.b.allFinite() && std::isfinite(capsule.radius_m);
   }
   return ok;

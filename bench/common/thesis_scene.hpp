@@ -4,6 +4,7 @@
 #pragma once
 
 #include "hrcsense/pipeline.hpp"
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/sim.hpp"
 
 #include <stdexcept>
@@ -41,7 +42,7 @@ inline Simulator thesis_box_simulator() {
 inline PipelineParams thesis_box_params(const Simulator& sim) {
   PipelineParams params;
   params.T_base_camera = sim.T_base_camera;
-  params.robot = sim.robot;
+  params.robot.points = sim.robot;
   params.background.frames = kLearnFrames;
   return params;
 }
@@ -53,7 +54,7 @@ inline BackgroundModel learn_background(const Simulator& sim, const PipelinePara
   FrameResult result;
   for (int64_t i = 0; i < 4 * kLearnFrames && !pipeline.background_ready(); ++i) {
     sim.render(i, frame);
-    pipeline.process(frame, result);
+    pipeline.process(frame, fixed_robot_state({}), result);
   }
   if (!pipeline.background_ready()) throw std::runtime_error("background did not finish learning");
   return pipeline.background();

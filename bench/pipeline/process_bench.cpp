@@ -17,7 +17,7 @@ void BM_PipelineProcess(benchmark::State& state) {
   FrameResult result;
   size_t i = 0;
   for (auto _ : state) {
-    pipeline.process(frames[i++ % frames.size()], result);
+    pipeline.process(frames[i++ % frames.size()], fixed_robot_state({}), result);
     benchmark::DoNotOptimize(result.contact.distance_m);
   }
   state.SetItemsProcessed(state.iterations());

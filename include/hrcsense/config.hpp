@@ -8,7 +8,6 @@
 #include "hrcsense/robot.hpp"
 #include "hrcsense/sim.hpp"
 
-#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -31,6 +30,13 @@ struct SourceConfig {
   float stereo_baseline_mm = 0.0F; ///< for sources that do not carry one
 };
 
+/// Where the robot's joint state comes from. So far always `fixed`: robot.joints_rad for every
+/// frame (the live sources of `robot.state.source` come with their adapters).
+struct RobotStateConfig {
+  /// `robot.joints_rad`: the fixed pose, joint 1 first (required for an arm; zeros for points).
+  JointAngles joints_rad{};
+};
+
 struct Config {
   std::string file;                ///< where it was read from ("" for defaults only)
   SourceConfig source;
@@ -41,15 +47,12 @@ struct Config {
   std::string filters_preset = "sdk";
   std::string background_path;     ///< `background.path`: load if it exists, else save after learning
   PipelineParams pipeline;         ///< camera pose, robot, background, foreground, proximity, safety
-  std::string robot_model = "points";    ///< `robot.model`: points, ur5, ur5e, ur10e or custom
-  std::vector<double> robot_joints_rad;  ///< `robot.joints_rad`: 6 joint angles (rad), joint 1 first
-  std::string robot_base_frame = "base"; ///< `robot.base_frame`: base or base_link
-  BaseFrame robot_frame = BaseFrame::base;  ///< the same as an enum: the frame of T_base_camera and the robot
-  double robot_padding_m = 0.0;          ///< `robot.padding_m` in effect (an arm's own padding by default)
-  /// The arm (built in or from `robot.description`); empty for robot.model points. With
-  /// robot_joints_rad, robot_frame and robot_padding_m it gives pipeline.robot
-  /// (robot_capsules) and the arm to render (robot_render_capsules).
-  std::optional<RobotDescription> robot_arm;
+  /// `robot.model`: points, ur5, ur5e, ur10e or custom. The arm (built in or from
+  /// `robot.description`), `robot.padding_m` in effect (an arm's own padding by default) and
+  /// `robot.base_frame` are in pipeline.robot.
+  std::string robot_model = "points";
+  std::string robot_base_frame = "base"; ///< `robot.base_frame`: base or base_link (pipeline.robot.base_frame)
+  RobotStateConfig robot_state;          ///< `robot.state.*` and `robot.joints_rad`
   int proximity_octree_height = 4;       ///< `proximity.octree.height` (1-10), for the octree backend
   std::string canonical_yaml;      ///< the effective configuration, for the hash in the header
 };
@@ -62,17 +65,8 @@ Config load_config(const std::string& path, const std::vector<std::string>& over
 /// field, e.g. "arm.yaml: key 'links.forearm[1].radius_m': expected a number >= 0".
 RobotDescription load_robot_description(const std::string& path);
 
-/// The configured arm as a static simulator object named "robot": its rendering capsules
-/// (robot_render_capsules: the visual body, no padding) in the robot.base_frame frame, so the
-/// arm is part of the learnt background. Empty for robot.model points.
-std::optional<SceneObject> robot_scene_object(const Config& config);
-
-/// The simulator described by a configuration (sim.*, scene.*, camera pose, robot).
-Simulator make_simulator(const Config& config);
-
-/// The source the configuration names (source.type); throws ConfigError for a type that is
-/// unknown or not built in.
-std::unique_ptr<Source> make_source(const Config& config);
+/// The robot's capsules at the fixed pose robot.joints_rad (robot_model_at), base frame.
+RobotModel fixed_robot_model(const Config& config);
 
 /// FNV-1a 64-bit hash of the effective configuration, as 16 hex digits.
 std::string config_hash(const Config& config);

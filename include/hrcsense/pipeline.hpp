@@ -6,6 +6,8 @@
 #include "hrcsense/filters.hpp"
 #include "hrcsense/mailbox.hpp"
 #include "hrcsense/proximity.hpp"
+#include "hrcsense/robot.hpp"
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/safety.hpp"
 #include "hrcsense/segmentation.hpp"
 #include "hrcsense/sink.hpp"
@@ -29,7 +31,7 @@ class BackgroundMismatch : public std::runtime_error {
 struct PipelineParams {
   FilterChainParams filters;  ///< depth filters run before segmentation; empty order: none
   Pose T_base_camera = Pose::Identity();
-  RobotModel robot;
+  RobotParams robot;  ///< the arm (capsules from each frame's robot state) or fixed points
   BackgroundParams background;
   ForegroundParams foreground;
   SafetyParams safety;
@@ -39,8 +41,8 @@ struct PipelineParams {
   ProximityParams proximity;  ///< octree height, brute threads
 };
 
-/// The per-frame processing path: depth filters → background → foreground → proximity →
-/// verdict, on the caller's thread (run_pipeline gives it a thread of its own; the brute-force
+/// The per-frame processing path: depth filters → background → foreground → robot capsules →
+/// proximity → verdict, on the caller's thread (run_pipeline gives it a thread of its own; the brute-force
 /// search may use a second one, `proximity.threads`). Owns the stages' state and scratch buffers.
 class Pipeline {
  public:
@@ -53,8 +55,12 @@ class Pipeline {
   void set_background(BackgroundModel model, std::string origin = "the loaded background");
   bool background_ready() const { return learner_.ready() || preset_background_; }
   const BackgroundModel& background() const;
-  /// Processes one frame into `result`, reusing its buffers.
-  void process(const Frame& frame, FrameResult& result);
+  /// Processes one frame into `result`, reusing its buffers. The robot's capsules are built
+  /// from `robot_state` (the arm's joints at the frame's time; ignored by robot.model points,
+  /// but an invalid state is a stop for every model), without allocating once sized.
+  void process(const Frame& frame, const RobotState& robot_state, FrameResult& result);
+  /// The robot's capsules of the last frame that got as far as the search (base frame).
+  const RobotModel& robot() const { return robot_; }
   const Foreground& foreground() const { return foreground_; }
   /// Why the background learning last restarted; empty if it never did.
   const std::string& background_message() const { return learner_.message(); }
@@ -70,6 +76,7 @@ class Pipeline {
   FilterChain filters_;  ///< params_.filters; its temporal state spans frames
   ProximitySearch proximity_;  ///< params_.backend with its reusable search buffers
   Frame filtered_;       ///< the filtered copy of the current frame (buffers reused)
+  RobotModel robot_;     ///< params_.robot at the current frame's robot state (buffer reused)
   BackgroundCheck check_;  ///< of a loaded background against the first frames
 
   bool enough_valid_depth(const Frame& frame, FrameResult& result) const;
@@ -84,8 +91,9 @@ struct RunOptions {
 
 /// Runs capture, processing and output on three threads joined by mailboxes. Unpaced runs
 /// process every frame (the source waits for processing); paced runs drop and count.
+/// Each frame gets the robot state `robot_states` has for the time the frame was delivered.
 /// Writes header, every result and the summary to `sink`; returns the summary.
-RunSummary run_pipeline(Source& source, Pipeline& pipeline, Sink& sink, const RunOptions& options,
-                        const RunHeader& header);
+RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline& pipeline, Sink& sink,
+                        const RunOptions& options, const RunHeader& header);
 
 }  // namespace hrcsense

@@ -7,21 +7,17 @@
 #include "hrcsense/types.hpp"
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace hrcsense {
 
-/// Number of joints of the arms hrcsense describes (6R, standard DH).
-inline constexpr int kJointCount = 6;
 /// Links 0..6: 0 the fixed base (DH frame 0), i the body moved by joint i (DH frame i);
 /// link 6 is wrist 3, whose frame is the tool flange.
 inline constexpr int kArmLinkCount = 7;
 /// Capsule::link of the tool's capsules (given in the flange frame, DH frame 6).
 inline constexpr int kToolLink = 7;
-
-/// Joint angles in radians, joint 1 (base) first, as on the UR pendant and in ROS.
-using JointAngles = std::array<double, kJointCount>;
 
 /// One row of a standard Denavit-Hartenberg table, as Universal Robots publish them:
 /// T_{i-1,i} = Rz(θ_i) · Tz(d) · Tx(a) · Rx(α).
@@ -65,6 +61,15 @@ enum class BaseFrame {
   base_link,  ///< UR's DH frame 0 (ROS's `base_link`)
 };
 
+/// The robot the pipeline measures against (PipelineParams::robot): an arm whose capsules
+/// follow each frame's RobotState, or fixed capsules (robot.model points, the thesis's point).
+struct RobotParams {
+  std::optional<RobotDescription> arm;  ///< with an arm, the capsules come from the joint state
+  double padding_m = 0.0;               ///< `robot.padding_m`, added to every arm capsule's radius
+  BaseFrame base_frame = BaseFrame::base;  ///< `robot.base_frame`: the frame of the capsules
+  RobotModel points;                    ///< without an arm: the capsules as they are (base frame)
+};
+
 /// Pose of every link's DH frame in base_link: frames[0] is the identity (the fixed base),
 /// frames[i] the frame after joint i; frames[6] is the tool flange.
 struct LinkFrames {
@@ -106,6 +111,13 @@ void robot_capsules(const RobotDescription& description, const JointAngles& join
 /// Same, returning a new model.
 RobotModel robot_capsules(const RobotDescription& description, const JointAngles& joints_rad, double padding_m,
                           BaseFrame frame);
+
+/// The capsules of `robot` for the joint state `joints_rad` (robot_capsules of the arm with
+/// its padding and frame), or its fixed points without an arm. Reuses `out`'s buffer: no
+/// allocation once sized.
+void robot_model_at(const RobotParams& robot, const JointAngles& joints_rad, RobotModel& out);
+/// Same, returning a new model.
+RobotModel robot_model_at(const RobotParams& robot, const JointAngles& joints_rad);
 
 /// The arm's own geometry for rendering (the simulator): each link's `visual` shapes, or its
 /// `links` capsules where it has none, and the tool's capsules; no padding. Capsule::link as in

@@ -143,6 +143,26 @@ struct Capsule {
   int link = 0;  ///< which robot link the capsule belongs to
 };
 
+/// Number of joints of the arms hrcsense describes (6R, standard DH).
+inline constexpr int kJointCount = 6;
+
+/// Joint angles in radians (or velocities in rad/s), joint 1 (base) first, as on the UR
+/// pendant and in ROS.
+using JointAngles = std::array<double, kJointCount>;
+
+/// Where a robot state came from (`robot.state.source`).
+enum class RobotStateOrigin { fixed, sim, rtde, udp_json, recorded };
+
+/// The arm's joint state at one instant: what a RobotStateSource delivers for a frame, and
+/// what Pipeline::process builds the robot's capsules from.
+struct RobotState {
+  int64_t host_time_ns = 0;   ///< when the state held, on the host's monotonic clock (0: any time, `fixed`)
+  JointAngles q_rad{};        ///< joint angles
+  JointAngles qd_rad_s{};     ///< joint velocities
+  bool valid = false;         ///< false: no state (never measured, lost, rejected); the frame is a stop
+  RobotStateOrigin origin = RobotStateOrigin::fixed;
+};
+
 /// The robot as the proximity search sees it: capsules in the base frame.
 struct RobotModel {
   std::vector<Capsule> capsules;
@@ -167,6 +187,7 @@ enum class ReasonCode {
   low_valid_share,       ///< stop: fewer valid pixels after the filters than safety.min_valid_share
   background_mismatch,   ///< stop: the background is not of the filtered frame's size
   no_robot_model,        ///< stop: no capsules to measure against
+  no_robot_state,        ///< stop: no valid robot state for the frame (an arm needs its joints)
   foreground_failed,     ///< stop: the foreground test could not run
   stale_frame,           ///< stop: the frame is older than safety.max_frame_age_s
   no_frame,              ///< stop: the watchdog saw no frame for safety.max_frame_age_s
@@ -208,6 +229,7 @@ struct FrameResult {
   /// 0 when the frame was not filtered (no valid depth at all, or no source frame).
   float valid_share = 0.0F;
   std::vector<StageTiming> timings;
+  RobotState robot_state;        ///< the state the robot's capsules were built from
   std::optional<Contact> truth;  ///< simulated sources: ground-truth contact
   double latency_us = 0.0;       ///< from the frame entering processing to the result
   /// The proximity backend that searched this frame (static name, e.g. "octree" when `auto`

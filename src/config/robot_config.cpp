@@ -5,6 +5,7 @@
 
 #include "yaml_tree.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -232,19 +233,23 @@ void read_robot(KeyReader& r, Config& c) {
   // Default: the 2020 thesis's robot point (-0.5, 0.5, 0.5) m, given there with y up.
   std::vector<Eigen::Vector3f> points_base{Eigen::Vector3f(-0.5F, -0.5F, 0.5F)};
   r.vec3_list("robot.points_base", points_base, kMaxCoordinateM);
-  r.number_list("robot.joints_rad", c.robot_joints_rad, kJointCount);
+  std::vector<double> joints_list;
+  r.number_list("robot.joints_rad", joints_list, kJointCount);
+  JointAngles& joints_rad = c.robot_state.joints_rad;
+  if (joints_list.size() == kJointCount) std::copy(joints_list.begin(), joints_list.end(), joints_rad.begin());
   r.choice("robot.base_frame", c.robot_base_frame, {"base", "base_link"});
-  c.robot_frame = c.robot_base_frame == "base_link" ? BaseFrame::base_link : BaseFrame::base;
+  RobotParams& robot = c.pipeline.robot;
+  robot.base_frame = c.robot_base_frame == "base_link" ? BaseFrame::base_link : BaseFrame::base;
 
   if (c.robot_model == "points") {
     if (description.IsDefined()) r.fail("robot.description", "is only read with robot.model custom");
     if (tool.IsDefined()) r.fail("robot.tool", "is only read with an arm (robot.model ur5, ur5e, ur10e or custom)");
-    r.number("robot.padding_m", c.robot_padding_m, Bound::non_negative, kMaxCoordinateM);
+    r.number("robot.padding_m", robot.padding_m, Bound::non_negative, kMaxCoordinateM);
     // Without a robot every distance would be "infinite" and every verdict run: refuse.
     if (points_base.empty()) r.fail("robot.points_base", "expected at least one point [x, y, z] for robot.model points");
-    c.robot_arm.reset();
-    c.pipeline.robot = robot_points(points_base, c.robot_padding_m);
-    check_capsules(r, c.pipeline.robot);
+    robot.arm.reset();
+    robot.points = robot_points(points_base, robot.padding_m);
+    check_capsules(r, robot.points);
     return;
   }
 
@@ -255,15 +260,13 @@ void read_robot(KeyReader& r, Config& c) {
     arm.tool = DescriptionReader{{r.where(), prefix}}.capsules(tool, "tool");
     r.set_effective("robot.tool", capsules_node(arm.tool));
   }
-  c.robot_padding_m = arm.padding_m;  // the arm's own padding is the default
-  r.number("robot.padding_m", c.robot_padding_m, Bound::non_negative, kMaxCoordinateM);
+  robot.padding_m = arm.padding_m;  // the arm's own padding is the default
+  r.number("robot.padding_m", robot.padding_m, Bound::non_negative, kMaxCoordinateM);
   // No default pose: a wrong pose would put the arm where it is not, which is not fail-safe.
-  if (c.robot_joints_rad.size() != kJointCount) {
+  if (joints_list.size() != kJointCount) {
     r.fail("robot.joints_rad", "is required for robot.model " + c.robot_model +
                                    ": 6 joint angles in radians, joint 1 (base) first");
   }
-  JointAngles joints_rad{};
-  for (size_t j = 0; j < kJointCount; ++j) joints_rad[j] = c.robot_joints_rad[j];
   const int outside = joint_outside_limits(arm, joints_rad);
   if (outside >= 0) {
     const size_t j = static_cast<size_t>(outside);
@@ -271,30 +274,16 @@ void read_robot(KeyReader& r, Config& c) {
                                    double_text(joints_rad[j]) + " rad, outside its limits " +
                                    limit_text(arm.limits[j]));
   }
-  c.robot_arm = arm;
-  c.pipeline.robot = robot_capsules(arm, joints_rad, c.robot_padding_m, c.robot_frame);
-  check_capsules(r, c.pipeline.robot);
+  robot.points.capsules.clear();
+  robot.arm = arm;
+  // The capsules at the fixed pose must be sane too (within reach of the base frame).
+  check_capsules(r, robot_model_at(robot, joints_rad));
 }
 
 }  // namespace config_detail
 
-std::optional<SceneObject> robot_scene_object(const Config& config) {
-  if (!config.robot_arm || config.robot_joints_rad.size() != kJointCount) return std::nullopt;
-  JointAngles joints_rad{};
-  for (size_t j = 0; j < kJointCount; ++j) joints_rad[j] = config.robot_joints_rad[j];
-  SceneObject arm;
-  arm.name = "robot";
-  arm.is_static = true;
-  for (const Capsule& capsule : robot_render_capsules(*config.robot_arm, joints_rad, config.robot_frame).capsules) {
-    if (capsule.radius_m <= 0.0F) continue;  // a bare segment has no surface to see
-    Shape shape;
-    shape.type = Shape::Type::capsule;
-    shape.a = capsule.a;
-    shape.b = capsule.b;
-    shape.radius_m = capsule.radius_m;
-    arm.shapes.push_back(shape);
-  }
-  return arm;
+RobotModel fixed_robot_model(const Config& config) {
+  return robot_model_at(config.pipeline.robot, config.robot_state.joints_rad);
 }
 
 RobotDescription load_robot_description(const std::string& path) {

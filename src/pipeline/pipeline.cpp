@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <stdexcept>
@@ -54,8 +55,9 @@ void timed(FrameResult& result, const char* name, Stage&& stage) {
 }
 
 // Resets the per-frame fields of `result`, keeping its buffers.
-void begin_result(const Frame& frame, FrameResult& result) {
+void begin_result(const Frame& frame, const RobotState& robot_state, FrameResult& result) {
   result.frame = frame.index;
+  result.robot_state = robot_state;
   result.timestamp_ns = frame.timestamp_ns;
   result.valid = false;
   result.contact = Contact{};
@@ -113,6 +115,10 @@ const Frame& run_filters(FilterChain& chain, const Frame& frame, Frame& filtered
   return filtered;
 }
 
+bool all_finite(const JointAngles& q_rad) {
+  return std::all_of(q_rad.begin(), q_rad.end(), [](double q) { return std::isfinite(q); });
+}
+
 // Latency from the frame entering processing to its result.
 void finish(FrameResult& result, Clock::time_point start) { result.latency_us = elapsed_us(start); }
 
@@ -155,9 +161,9 @@ const BackgroundModel& Pipeline::background() const {
 }
 
 // One line per stage; every early return leaves a stop verdict with its reason.
-void Pipeline::process(const Frame& source_frame, FrameResult& result) {
+void Pipeline::process(const Frame& source_frame, const RobotState& robot_state, FrameResult& result) {
   const Clock::time_point start = Clock::now();
-  begin_result(source_frame, result);
+  begin_result(source_frame, robot_state, result);
   result.invalid_pixels = count_invalid(source_frame.depth);
   if (result.invalid_pixels == source_frame.depth.pixels.size()) {
     return finish_stop(result, ReasonCode::no_valid_depth, "no valid depth", start);
@@ -172,7 +178,12 @@ void Pipeline::process(const Frame& source_frame, FrameResult& result) {
     return finish_stop(result, ReasonCode::background_mismatch, "background size mismatch", start);
   }
   if (!background_checked(frame, result)) return finish(result, start);
-  if (params_.robot.capsules.empty()) return finish_stop(result, ReasonCode::no_robot_model, "no robot model", start);
+  if (!robot_state.valid) return finish_stop(result, ReasonCode::no_robot_state, "no robot state", start);
+  if (!all_finite(robot_state.q_rad)) {
+    return finish_stop(result, ReasonCode::non_finite_input, "non-finite joint angle in the robot state", start);
+  }
+  robot_model_at(params_.robot, robot_state.q_rad, robot_);
+  if (robot_.capsules.empty()) return finish_stop(result, ReasonCode::no_robot_model, "no robot model", start);
   bool extracted = false;
   timed(result, "foreground", [&] {
     extracted = extract_foreground(extractor_, background(), frame, params_.T_base_camera, foreground_);
@@ -181,7 +192,7 @@ void Pipeline::process(const Frame& source_frame, FrameResult& result) {
     return finish_stop(result, ReasonCode::foreground_failed, "foreground extraction failed", start);
   }
   timed(result, "proximity", [&] {
-    result.contact = proximity_.closest(foreground_.points_base, foreground_.points_camera, params_.robot);
+    result.contact = proximity_.closest(foreground_.points_base, foreground_.points_camera, robot_);
     result.backend = proximity_backend_name(proximity_.last_backend());
   });
   result.foreground_points = foreground_.points_base.size();

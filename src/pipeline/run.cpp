@@ -168,13 +168,19 @@ struct ProcessingStats {
 
 // Processes every frame it takes; a frame older than max_frame_age_s at the end of its
 // processing becomes a stop. Closes `results` when `frames` is closed and drained.
-void processing_loop(Pipeline& pipeline, const RunOptions& options, double max_frame_age_s,
-                     Mailbox<Captured>& frames, Mailbox<FrameResult>& results, ProcessingStats& stats) {
+void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const RunOptions& options,
+                     double max_frame_age_s, Mailbox<Captured>& frames, Mailbox<FrameResult>& results,
+                     ProcessingStats& stats) {
   Captured in;
   FrameResult result;
+  RobotState robot_state;
   try {
     while (frames.take(in)) {
-      pipeline.process(in.frame, result);
+      // The robot as it was when the frame was delivered; none is a stop (Pipeline::process).
+      const int64_t delivered_ns =
+          std::chrono::duration_cast<std::chrono::nanoseconds>(in.captured_at.time_since_epoch()).count();
+      if (!robot_states.state_at(delivered_ns, robot_state)) robot_state.valid = false;
+      pipeline.process(in.frame, robot_state, result);
       result.timestamp_warning = in.timestamp_warning;
       if (!(seconds_since(in.captured_at) <= max_frame_age_s)) result.verdict = stop_verdict(ReasonCode::stale_frame, "stale frame");
       ++stats.processed;
@@ -255,8 +261,8 @@ FrameResult output_loop(Sink& sink, double max_frame_age_s, Mailbox<FrameResult>
 
 }  // namespace
 
-RunSummary run_pipeline(Source& source, Pipeline& pipeline, Sink& sink, const RunOptions& options,
-                        const RunHeader& header) {
+RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline& pipeline, Sink& sink,
+                        const RunOptions& options, const RunHeader& header) {
   const Clock::time_point start = Clock::now();
   const double max_frame_age_s = pipeline.params().safety.max_frame_age_s;
   const int64_t expected = options.max_frames >= 0 ? options.max_frames : source.info().frame_count;
@@ -272,7 +278,7 @@ RunSummary run_pipeline(Source& source, Pipeline& pipeline, Sink& sink, const Ru
 
   sink.header(header);
   std::thread capture([&] { capture_loop(source, options, max_frame_age_s, frames, outcome); });
-  std::thread processing([&] { processing_loop(pipeline, options, max_frame_age_s, frames, results, stats); });
+  std::thread processing([&] { processing_loop(pipeline, robot_states, options, max_frame_age_s, frames, results, stats); });
   const FrameResult last = output_loop(sink, max_frame_age_s, results, summary, output_error);
   processing.join();
   capture.join();

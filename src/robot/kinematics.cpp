@@ -160,6 +160,20 @@ RobotModel robot_capsules(const RobotDescription& description, const JointAngles
   return model;
 }
 
+void robot_model_at(const RobotParams& robot, const JointAngles& joints_rad, RobotModel& out) {
+  if (robot.arm) {
+    robot_capsules(*robot.arm, joints_rad, robot.padding_m, robot.base_frame, out);
+  } else {
+    out.capsules.assign(robot.points.capsules.begin(), robot.points.capsules.end());  // keeps out's capacity
+  }
+}
+
+RobotModel robot_model_at(const RobotParams& robot, const JointAngles& joints_rad) {
+  RobotModel model;
+  robot_model_at(robot, joints_rad, model);
+  return model;
+}
+
 RobotModel robot_render_capsules(const RobotDescription& description, const JointAngles& joints_rad,
                                  BaseFrame frame) {
   // No padding: the visual shapes are the real arm, which the searched capsules (link radius

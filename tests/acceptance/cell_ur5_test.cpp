@@ -2,7 +2,9 @@
 // Acceptance: the UR5 cell. The arm is rendered as part of the static scene, learnt as
 // background, and searched as capsules; a person walks up to it.
 
+#include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/robot.hpp"
 
@@ -35,11 +37,10 @@ TEST(CellUr5, ArmIsSearchedAsPaddedCapsules) {
   const Config config = noise_free_cell("brute");
   // The base and the six links (the cell's UR5 has no tool): link indices 0..6, each capsule
   // exactly the description's own, placed the same, with the cell's 5 cm padding added.
-  ASSERT_TRUE(config.robot_arm.has_value());
-  JointAngles joints{};
-  std::copy(config.robot_joints_rad.begin(), config.robot_joints_rad.end(), joints.begin());
-  const RobotModel unpadded = robot_capsules(*config.robot_arm, joints, 0.0, config.robot_frame);
-  const std::vector<Capsule>& padded = config.pipeline.robot.capsules;
+  ASSERT_TRUE(config.pipeline.robot.arm.has_value());
+  const RobotModel unpadded =
+      robot_capsules(*config.pipeline.robot.arm, config.robot_state.joints_rad, 0.0, config.pipeline.robot.base_frame);
+  const std::vector<Capsule> padded = fixed_robot_model(config).capsules;
   ASSERT_EQ(padded.size(), unpadded.capsules.size());
   std::set<int> links;
   for (size_t i = 0; i < padded.size(); ++i) {
@@ -68,7 +69,7 @@ TEST(CellUr5, ContactIsOnTheTrueLinkWithinOneMillimetre) {
     for (int64_t i = 0; i < sim.params.frames; ++i) {
       if (i > learning && i % kFrameStep != 0) continue;
       sim.render(i, frame);
-      pipeline.process(frame, result);
+      pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
       if (i < learning) continue;
       ASSERT_TRUE(result.valid) << backend << " frame " << i;
       const Contact& truth = frame.truth->contact;
@@ -117,7 +118,7 @@ TEST(CellUr5, NoisyContactOnTheTrueLinkAndNeverFartherThanTheTruth) {
     // The temporal filter needs consecutive frames: sanitizers stop early instead of skipping.
     if (i >= 120 + 240 / kFrameStep) break;
     sim.render(i, frame);
-    pipeline.process(frame, result);
+    pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
     if (!result.valid) continue;
     const Contact& truth = frame.truth->contact;
     if (!truth.valid) {

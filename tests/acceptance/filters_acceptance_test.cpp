@@ -6,7 +6,9 @@
 // The numbers these tests print are the ones in docs/ACCURACY.md.
 
 #include "../support/sanitized.hpp"
+#include "common/assembly.hpp"
 #include "hrcsense/camera.hpp"
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/pipeline.hpp"
 
@@ -145,7 +147,7 @@ TEST(FiltersAcceptance, ThesisPresetClosestDistanceWithinTenMillimetres) {
   int n = 0;
   for (int i = 0; i < learn + measured; ++i) {
     sim.render(i, frame);
-    pipeline.process(frame, result);
+    pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
     if (i < learn) continue;
     ASSERT_TRUE(result.valid) << "frame " << i << ": " << result.verdict.reason;
     ASSERT_TRUE(frame.truth->contact.valid) << "frame " << i;
@@ -183,7 +185,7 @@ TEST(FiltersAcceptance, SdkPresetRunsAtTheDecimatedResolution) {
   FrameResult result;
   for (int i = 0; i < learn + measured; ++i) {
     sim.render(i, frame);
-    pipeline.process(frame, result);
+    pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
     chain.process(frame, filtered);
     if (i < learn) continue;
     ASSERT_TRUE(result.valid) << "frame " << i << ": " << result.verdict.reason;
@@ -237,7 +239,7 @@ Excess headon_excess(const std::string& preset) {
   int approach_n = 0, still_n = 0;
   for (int i = 0; i <= still_last; ++i) {
     sim.render(i, frame);
-    pipeline.process(frame, result);
+    pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
     const bool approaching = i >= approach_first && i < arrive, still = i >= still_first;
     if (!approaching && !still) continue;
     EXPECT_TRUE(result.contact.valid && frame.truth->contact.valid) << preset << " frame " << i;

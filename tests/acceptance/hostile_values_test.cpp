@@ -7,7 +7,9 @@
 // The cell: the thesis box (1.22 m from the robot point, so the unharmed run says `run`,
 // "clear", with foreground) entering right after 3 learning frames, at 424x240.
 
+#include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/pipeline.hpp"
 
 #include <gtest/gtest.h>
@@ -122,10 +124,11 @@ TEST(HostileValues, EveryNumericKeyIsRefusedOrFailsSafe) {
   {
     std::unique_ptr<Source> source = make_source(defaults);
     Pipeline pipeline(defaults.pipeline);
+    FixedRobotState robot_states(defaults.robot_state.joints_rad);
     Keeping sink;
     RunOptions options;
     options.max_frames = kFrames;
-    run_pipeline(*source, pipeline, sink, options, RunHeader{});
+    run_pipeline(*source, robot_states, pipeline, sink, options, RunHeader{});
     ASSERT_GE(sink.results.size(), 5U);
     EXPECT_EQ(sink.results[4].verdict.state, VerdictState::run) << sink.results[4].verdict.reason;
     EXPECT_GT(sink.results[4].foreground_points, 0U);
@@ -150,9 +153,10 @@ TEST(HostileValues, EveryNumericKeyIsRefusedOrFailsSafe) {
       try {
         std::unique_ptr<Source> source = make_source(config);
         Pipeline pipeline(config.pipeline);
+        FixedRobotState robot_states(config.robot_state.joints_rad);
         RunOptions options;
         options.max_frames = kFrames;
-        run_pipeline(*source, pipeline, sink, options, RunHeader{});
+        run_pipeline(*source, robot_states, pipeline, sink, options, RunHeader{});
       } catch (const std::exception& e) {
         ADD_FAILURE() << assignment << ": accepted by config, then failed outside it: " << e.what();
         continue;

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tests of load_config's errors: each names the file (or the override) and the key.
+#include "common/assembly.hpp"
 #include "config_test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -78,7 +79,7 @@ TEST(ConfigErrors, NotYetImplementedChoicesSaySo) {
     (void)make_source(live);
     FAIL() << "no error";
   } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()), "source.type 'realsense' is not available in this build yet");
+    EXPECT_EQ(std::string(e.what()), "configuration: source.type 'realsense': not built into this hrcsense");
   }
   // Recorded sources need a path.
   const Config bag = load_config("", {"source.type=bag"});

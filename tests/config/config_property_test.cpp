@@ -71,7 +71,7 @@ void collect(const YAML::Node& node, const std::string& key, std::vector<Numeric
 std::string non_finite(const Config& c) {
   const PipelineParams& p = c.pipeline;
   if (!p.T_base_camera.matrix().allFinite()) return "T_base_camera";
-  for (const Capsule& capsule : p.robot.capsules) {
+  for (const Capsule& capsule : fixed_robot_model(c).capsules) {
     if (!capsule.a.allFinite() || !capsule.b.allFinite() || !std::isfinite(capsule.radius_m)) return "robot capsule";
   }
   const std::map<std::string, double> values = {
@@ -85,7 +85,7 @@ std::string non_finite(const Config& c) {
       {"spatial.alpha", p.filters.spatial.alpha}, {"temporal.alpha", p.filters.temporal.alpha},
       {"sim.fps", c.sim.fps}, {"sim.noise", c.sim.disparity_noise_px}, {"sim.baseline", c.sim.baseline_mm},
       {"sim.step", c.sim.disparity_step_px}, {"sim.correlated", c.sim.correlated_noise_px},
-      {"source.baseline", c.source.stereo_baseline_mm}, {"padding", c.robot_padding_m}};
+      {"source.baseline", c.source.stereo_baseline_mm}, {"padding", p.robot.padding_m}};
   for (const auto& [name, value] : values) {
     if (!std::isfinite(value)) return name;
   }

@@ -2,6 +2,7 @@
 // Tests of load_config: defaults, every key family, --set overrides, errors, the camera pose.
 #include "config_test_util.hpp"
 
+#include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 
 #include <gtest/gtest.h>
@@ -33,8 +34,8 @@ TEST(Config, DefaultsWithoutFileMatchTheStructDefaults) {
   EXPECT_FLOAT_EQ(config.pipeline.foreground.k_sigma, pipeline.foreground.k_sigma);
   EXPECT_FLOAT_EQ(config.pipeline.safety.slow_distance_m, pipeline.safety.slow_distance_m);
   EXPECT_FLOAT_EQ(config.pipeline.safety.stop_distance_m, pipeline.safety.stop_distance_m);
-  ASSERT_EQ(config.pipeline.robot.capsules.size(), 1U);  // the thesis's robot point, y down
-  EXPECT_EQ(config.pipeline.robot.capsules[0].a, Eigen::Vector3f(-0.5F, -0.5F, 0.5F));
+  ASSERT_EQ(fixed_robot_model(config).capsules.size(), 1U);  // the thesis's robot point, y down
+  EXPECT_EQ(fixed_robot_model(config).capsules[0].a, Eigen::Vector3f(-0.5F, -0.5F, 0.5F));
   EXPECT_EQ(config.pipeline.backend, "brute");
   EXPECT_TRUE(config.pipeline.T_base_camera.isApprox(Pose::Identity()));
   EXPECT_EQ(config.robot_base_frame, "base");
@@ -100,13 +101,13 @@ safety: {slow_distance_m: 1.5, stop_distance_m: 0.7, max_frame_age_s: 0.25}
   EXPECT_FLOAT_EQ(c.pipeline.foreground.min_object_mm, 25.0F);
   EXPECT_EQ(c.pipeline.foreground.workspace_base.min, Eigen::Vector3f(-1, -2, -3));
   EXPECT_EQ(c.pipeline.foreground.workspace_base.max, Eigen::Vector3f(1, 2, 3));
-  ASSERT_EQ(c.pipeline.robot.capsules.size(), 2U);
-  const Capsule& second = c.pipeline.robot.capsules[1];
+  ASSERT_EQ(fixed_robot_model(c).capsules.size(), 2U);
+  const Capsule second = fixed_robot_model(c).capsules[1];
   EXPECT_EQ(second.a, Eigen::Vector3f(4, 5, 6));
   EXPECT_EQ(second.b, Eigen::Vector3f(4, 5, 6));  // a robot point is a zero-length capsule
   EXPECT_FLOAT_EQ(second.radius_m, 0.05F);
   EXPECT_EQ(second.link, 1);
-  EXPECT_EQ(c.robot_joints_rad, (std::vector<double>{0, 1, 2, 3, 4, 5}));
+  EXPECT_EQ(c.robot_state.joints_rad, (JointAngles{0, 1, 2, 3, 4, 5}));
   EXPECT_EQ(c.robot_base_frame, "base_link");
   EXPECT_EQ(c.proximity_octree_height, 6);
   EXPECT_FLOAT_EQ(c.pipeline.safety.slow_distance_m, 1.5F);
@@ -122,9 +123,9 @@ TEST(Config, SetOverridesScalarsAndListsInOrder) {
                                       "camera.T_base_camera={translation_m: [1, 2, 3]}"});
   EXPECT_FLOAT_EQ(c.pipeline.safety.slow_distance_m, 1.25F);  // the override wins over the file
   EXPECT_FLOAT_EQ(c.pipeline.safety.stop_distance_m, 0.5F);   // the file's other keys stay
-  ASSERT_EQ(c.pipeline.robot.capsules.size(), 2U);
-  EXPECT_EQ(c.pipeline.robot.capsules[0].a, Eigen::Vector3f(0, 0, 1));
-  EXPECT_EQ(c.pipeline.robot.capsules[1].a, Eigen::Vector3f(0.5F, -1, 2));
+  ASSERT_EQ(fixed_robot_model(c).capsules.size(), 2U);
+  EXPECT_EQ(fixed_robot_model(c).capsules[0].a, Eigen::Vector3f(0, 0, 1));
+  EXPECT_EQ(fixed_robot_model(c).capsules[1].a, Eigen::Vector3f(0.5F, -1, 2));
   EXPECT_EQ(c.sim.frames, 20);  // the last override wins
   EXPECT_EQ(c.source.type, "bag");
   EXPECT_TRUE(c.pipeline.T_base_camera.translation().isApprox(Eigen::Vector3d(1, 2, 3), 1e-6));
@@ -230,12 +231,12 @@ TEST(Config, ShippedConfigsLoad) {
     const Config c = load_config(path, {});
     EXPECT_EQ(c.source.type, "sim") << name;
     EXPECT_FALSE(c.scene.objects.empty()) << name;
-    EXPECT_FALSE(c.pipeline.robot.capsules.empty()) << name;
+    EXPECT_FALSE(fixed_robot_model(c).capsules.empty()) << name;
     EXPECT_NO_THROW(make_source(c)) << name;
   }
   const Config box = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/thesis-box.yaml", {});
   // The thesis's robot point, y down (config/thesis-box.yaml says where it comes from).
-  EXPECT_EQ(box.pipeline.robot.capsules[0].a, Eigen::Vector3f(-0.5F, -0.5F, 0.5F));
+  EXPECT_EQ(fixed_robot_model(box).capsules[0].a, Eigen::Vector3f(-0.5F, -0.5F, 0.5F));
 }
 
 }  // namespace

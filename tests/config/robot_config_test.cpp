@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/assembly.hpp"
 #include "hrcsense/camera.hpp"
 
 #include <algorithm>
@@ -42,43 +43,43 @@ links:
 
 TEST(RobotConfig, Ur5CapsulesFollowTheJointsAndTheFrame) {
   const Config c = load_config("", {"robot.model=ur5", kZeroPose});
-  ASSERT_TRUE(c.robot_arm.has_value());
-  EXPECT_EQ(c.robot_arm->name, "ur5");
-  ASSERT_EQ(c.pipeline.robot.capsules.size(), 8U);
+  ASSERT_TRUE(c.pipeline.robot.arm.has_value());
+  EXPECT_EQ(c.pipeline.robot.arm->name, "ur5");
+  ASSERT_EQ(fixed_robot_model(c).capsules.size(), 8U);
   // Default frame `base`: the flange (end of wrist 3) at (0.81725, 0.19145, −0.005491).
-  const Capsule& wrist_3 = c.pipeline.robot.capsules.back();
+  const Capsule wrist_3 = fixed_robot_model(c).capsules.back();
   EXPECT_EQ(wrist_3.link, 6);
   EXPECT_LT((wrist_3.b - Eigen::Vector3f(0.81725F, 0.19145F, -0.005491F)).norm(), 1e-6F);
   EXPECT_FLOAT_EQ(wrist_3.radius_m, 0.045F);  // the built-in's wrist radius, no padding by default
 
   const Config link = load_config("", {"robot.model=ur5", kZeroPose, "robot.base_frame=base_link",
                                        "robot.padding_m=0.05"});
-  EXPECT_EQ(link.robot_frame, BaseFrame::base_link);
-  const Capsule& flange = link.pipeline.robot.capsules.back();
+  EXPECT_EQ(link.pipeline.robot.base_frame, BaseFrame::base_link);
+  const Capsule flange = fixed_robot_model(link).capsules.back();
   EXPECT_LT((flange.b - Eigen::Vector3f(-0.81725F, -0.19145F, -0.005491F)).norm(), 1e-6F);
   EXPECT_FLOAT_EQ(flange.radius_m, 0.095F);
-  EXPECT_DOUBLE_EQ(link.robot_padding_m, 0.05);
+  EXPECT_DOUBLE_EQ(link.pipeline.robot.padding_m, 0.05);
 
   // Joint 1 at +90° turns the whole arm about z: in base, Rz(90°)(0.81725, 0.19145) = (−0.19145, 0.81725).
   const Config turned = load_config("", {"robot.model=ur5", "robot.joints_rad=[1.5707963267948966, 0, 0, 0, 0, 0]"});
-  EXPECT_LT((turned.pipeline.robot.capsules.back().b - Eigen::Vector3f(-0.19145F, 0.81725F, -0.005491F)).norm(), 1e-6F);
+  EXPECT_LT((fixed_robot_model(turned).capsules.back().b - Eigen::Vector3f(-0.19145F, 0.81725F, -0.005491F)).norm(), 1e-6F);
 }
 
 TEST(RobotConfig, EveryBuiltinArmLoads) {
   for (const std::string model : {"ur5", "ur5e", "ur10e"}) {
     const Config c = load_config("", {"robot.model=" + model, kZeroPose});
-    EXPECT_EQ(c.pipeline.robot.capsules.size(), 8U) << model;
-    EXPECT_EQ(c.robot_arm->name, model);
+    EXPECT_EQ(fixed_robot_model(c).capsules.size(), 8U) << model;
+    EXPECT_EQ(c.pipeline.robot.arm->name, model);
   }
 }
 
 TEST(RobotConfig, PointsModelIsTheThesisPoint) {
   const Config c = load_config("", {});
   EXPECT_EQ(c.robot_model, "points");
-  EXPECT_FALSE(c.robot_arm.has_value());
-  ASSERT_EQ(c.pipeline.robot.capsules.size(), 1U);
-  EXPECT_EQ(c.pipeline.robot.capsules[0].a, Eigen::Vector3f(-0.5F, -0.5F, 0.5F));
-  EXPECT_EQ(c.pipeline.robot.capsules[0].radius_m, 0.0F);
+  EXPECT_FALSE(c.pipeline.robot.arm.has_value());
+  ASSERT_EQ(fixed_robot_model(c).capsules.size(), 1U);
+  EXPECT_EQ(fixed_robot_model(c).capsules[0].a, Eigen::Vector3f(-0.5F, -0.5F, 0.5F));
+  EXPECT_EQ(fixed_robot_model(c).capsules[0].radius_m, 0.0F);
 }
 
 void expect_same_capsules(const std::vector<LinkCapsule>& file, const std::vector<LinkCapsule>& builtin,
@@ -119,8 +120,8 @@ TEST(RobotConfig, ToolKeyPutsAGripperOnABuiltinArm) {
   // the flange at (a2 + a3, −(d4 + d6), d1 − d5), so the tool ends 0.15 m further along −y.
   const Config c = load_config("", {"robot.model=ur5", kZeroPose, "robot.base_frame=base_link",
                                     "robot.tool=[{a_m: [0, 0, 0], b_m: [0, 0, 0.15], radius_m: 0.04}]"});
-  ASSERT_EQ(c.pipeline.robot.capsules.size(), 9U);
-  const Capsule& tool = c.pipeline.robot.capsules.back();
+  ASSERT_EQ(fixed_robot_model(c).capsules.size(), 9U);
+  const Capsule tool = fixed_robot_model(c).capsules.back();
   EXPECT_EQ(tool.link, kToolLink);
   EXPECT_LT((tool.a - Eigen::Vector3f(-0.81725F, -0.19145F, -0.005491F)).norm(), 1e-6F);
   EXPECT_LT((tool.b - Eigen::Vector3f(-0.81725F, -0.34145F, -0.005491F)).norm(), 1e-6F);
@@ -138,27 +139,27 @@ TEST(RobotConfig, CustomArmFromAFileOrInline) {
   // negated) it runs from (0, 0, 1) to (0, −0.5, 1). The arm's own padding (0.02) is the default.
   const Config c = load_config("", {"robot.model=custom", "robot.description=" + arm,
                                     "robot.joints_rad=[1.5707963267948966, 0, 0, 0, 0, 0]"});
-  ASSERT_EQ(c.pipeline.robot.capsules.size(), 2U);
-  EXPECT_EQ(c.robot_arm->name, "post");
-  const Capsule& shoulder = c.pipeline.robot.capsules[1];
+  ASSERT_EQ(fixed_robot_model(c).capsules.size(), 2U);
+  EXPECT_EQ(c.pipeline.robot.arm->name, "post");
+  const Capsule shoulder = fixed_robot_model(c).capsules[1];
   EXPECT_EQ(shoulder.link, 1);
   EXPECT_LT((shoulder.a - Eigen::Vector3f(0, 0, 1)).norm(), 1e-6F);
   EXPECT_LT((shoulder.b - Eigen::Vector3f(0, -0.5F, 1)).norm(), 1e-6F);
   EXPECT_FLOAT_EQ(shoulder.radius_m, 0.07F);
-  EXPECT_FLOAT_EQ(c.pipeline.robot.capsules[0].radius_m, 0.12F);
+  EXPECT_FLOAT_EQ(fixed_robot_model(c).capsules[0].radius_m, 0.12F);
   // robot.padding_m replaces the arm's own padding.
   const Config padded = load_config("", {"robot.model=custom", "robot.description=" + arm, kZeroPose,
                                          "robot.padding_m=0"});
-  EXPECT_FLOAT_EQ(padded.pipeline.robot.capsules[1].radius_m, 0.05F);
+  EXPECT_FLOAT_EQ(fixed_robot_model(padded).capsules[1].radius_m, 0.05F);
 
   // The shipped UR5 file gives the built-in's capsules.
   const Config from_file = load_config("", {"robot.model=custom", "robot.description=" + robots_dir() + "ur5.yaml",
                                             "robot.joints_rad=[0.3, -1, 1, 0.2, 0.4, 0.5]"});
   const Config builtin = load_config("", {"robot.model=ur5", "robot.joints_rad=[0.3, -1, 1, 0.2, 0.4, 0.5]"});
-  ASSERT_EQ(from_file.pipeline.robot.capsules.size(), builtin.pipeline.robot.capsules.size());
-  for (size_t i = 0; i < builtin.pipeline.robot.capsules.size(); ++i) {
-    EXPECT_LT((from_file.pipeline.robot.capsules[i].a - builtin.pipeline.robot.capsules[i].a).norm(), 1e-6F);
-    EXPECT_LT((from_file.pipeline.robot.capsules[i].b - builtin.pipeline.robot.capsules[i].b).norm(), 1e-6F);
+  ASSERT_EQ(fixed_robot_model(from_file).capsules.size(), fixed_robot_model(builtin).capsules.size());
+  for (size_t i = 0; i < fixed_robot_model(builtin).capsules.size(); ++i) {
+    EXPECT_LT((fixed_robot_model(from_file).capsules[i].a - fixed_robot_model(builtin).capsules[i].a).norm(), 1e-6F);
+    EXPECT_LT((fixed_robot_model(from_file).capsules[i].b - fixed_robot_model(builtin).capsules[i].b).norm(), 1e-6F);
   }
 
   // Inline in the configuration, the same arm.
@@ -173,8 +174,8 @@ TEST(RobotConfig, CustomArmFromAFileOrInline) {
                                                           return indented;
                                                         }());
   const Config inline_arm = load_config(config, {});
-  ASSERT_EQ(inline_arm.pipeline.robot.capsules.size(), 2U);
-  EXPECT_FLOAT_EQ(inline_arm.pipeline.robot.capsules[0].radius_m, 0.12F);
+  ASSERT_EQ(fixed_robot_model(inline_arm).capsules.size(), 2U);
+  EXPECT_FLOAT_EQ(fixed_robot_model(inline_arm).capsules[0].radius_m, 0.12F);
 }
 
 TEST(RobotConfig, HashFollowsTheArmNotTheFileName) {
@@ -194,8 +195,8 @@ TEST(RobotConfig, HashFollowsTheArmNotTheFileName) {
   const std::string again = dir.write("canonical.yaml", original.canonical_yaml);
   const Config reread = load_config(again, {});
   EXPECT_EQ(config_hash(reread), config_hash(original));
-  ASSERT_EQ(reread.pipeline.robot.capsules.size(), original.pipeline.robot.capsules.size());
-  EXPECT_EQ(reread.pipeline.robot.capsules[1].b, original.pipeline.robot.capsules[1].b);
+  ASSERT_EQ(fixed_robot_model(reread).capsules.size(), fixed_robot_model(original).capsules.size());
+  EXPECT_EQ(fixed_robot_model(reread).capsules[1].b, fixed_robot_model(original).capsules[1].b);
 }
 
 // Distance from p to the segment ab (double precision, independent of the proximity code).
@@ -220,7 +221,7 @@ TEST(RobotSceneObject, IsTheArmsVisualBodyWithoutPadding) {
   for (size_t i = 0; i < arm->shapes.size(); ++i) {
     EXPECT_EQ(arm->shapes[i].type, Shape::Type::capsule);
     EXPECT_FLOAT_EQ(arm->shapes[i].radius_m, expected_radii_m[i]) << i;
-    EXPECT_LT(arm->shapes[i].radius_m, c.pipeline.robot.capsules[i].radius_m - 0.04F) << i;
+    EXPECT_LT(arm->shapes[i].radius_m, fixed_robot_model(c).capsules[i].radius_m - 0.04F) << i;
   }
 }
 
@@ -234,9 +235,8 @@ void expect_rendered_inside(const Config& c, double padding_m, std::vector<int>&
   Frame frame;
   sim.render(0, frame);
   ASSERT_TRUE(frame.truth.has_value());
-  JointAngles joints_rad{};
-  for (size_t j = 0; j < kJointCount; ++j) joints_rad[j] = c.robot_joints_rad[j];
-  const RobotModel rendered = robot_render_capsules(*c.robot_arm, joints_rad, c.robot_frame);
+  const RobotModel rendered =
+      robot_render_capsules(*c.pipeline.robot.arm, c.robot_state.joints_rad, c.pipeline.robot.base_frame);
   size_t seen = 0;
   for (int v = 0; v < frame.intrinsics.height; ++v) {
     for (int u = 0; u < frame.intrinsics.width; ++u) {
@@ -257,7 +257,7 @@ void expect_rendered_inside(const Config& c, double padding_m, std::vector<int>&
         }
       }
       double to_bare_m = 1e9;  // signed distance to the union of the searched capsules without padding
-      for (const Capsule& capsule : c.pipeline.robot.capsules) {
+      for (const Capsule& capsule : fixed_robot_model(c).capsules) {
         const double axis_m = segment_distance(p_base, capsule.a.cast<double>(), capsule.b.cast<double>());
         to_bare_m = std::min(to_bare_m, axis_m - (capsule.radius_m - padding_m));
       }

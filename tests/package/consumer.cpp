@@ -5,11 +5,14 @@
 // sqrt(1 + 0.09) - 0.1 = 0.944 from it. The closest contact is point 0 at 0.4 m.
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/proximity.hpp"
+#include "hrcsense/sim.hpp"
 #ifdef CONSUMER_WITH_APPS
 #include "hrcsense/config.hpp"
+#include "hrcsense/recordings.hpp"
 #include "hrcsense/sinks.hpp"
 #endif
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -45,9 +48,32 @@ int main() {
   hrcsense::ProximitySearch kdtree(hrcsense::ProximityBackend::kdtree);
   ok = contact_is_point_0(kdtree.closest(cloud, {}, robot), "kdtree") && ok;
 
+  // The simulator is its own library (hrcsense::sim), built with the core alone too. An empty
+  // scene at 424x240 seen from the origin: every ray misses, so no pixel has depth.
+  hrcsense::Simulator simulator;
+  simulator.params.width = 424;
+  simulator.params.height = 240;
+  simulator.params.noise = false;
+  hrcsense::Frame frame;
+  simulator.render(0, frame);
+  const bool empty_scene = frame.depth.width == 424 && frame.depth.height == 240 &&
+                           std::all_of(frame.depth.pixels.begin(), frame.depth.pixels.end(),
+                                       [](uint16_t d) { return d == 0; });
+  std::printf("simulator: %dx%d, empty scene without depth -> %s\n", frame.depth.width, frame.depth.height,
+              empty_scene ? "ok" : "WRONG");
+  ok = empty_scene && ok;
+
 #ifdef CONSUMER_WITH_APPS
-  // The configuration reader links yaml-cpp (and, through make_source, the recordings' lz4
-  // and bz2) privately: this resolves only if the package config found them.
+  // The recordings link lz4 and bz2 privately: this resolves only if the package config found
+  // them. A missing file is an error naming it.
+  try {
+    hrcsense::BagSource bag(hrcsense::RecordingParams{"/nonexistent/hrcsense-consumer.bag"});
+    std::printf("BagSource: no error for a missing file -> WRONG\n");
+    ok = false;
+  } catch (const std::exception& e) {
+    std::printf("BagSource: error (%s) -> ok\n", e.what());
+  }
+  // The configuration reader links yaml-cpp privately.
   try {
     (void)hrcsense::load_config("/nonexistent/hrcsense-consumer.yaml", {});
     std::printf("load_config: no error for a missing file -> WRONG\n");

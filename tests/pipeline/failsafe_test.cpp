@@ -6,6 +6,7 @@
 #include "fake_scene.hpp"
 
 #include "hrcsense/sinks.hpp"
+#include "hrcsense/robot_state.hpp"
 
 #include <gtest/gtest.h>
 
@@ -32,7 +33,7 @@ constexpr int64_t kFrameNs = 33'333'333;
 void learn(Pipeline& pipeline, Frame& frame, FrameResult& result) {
   for (int i = 0; i < test::kLearnFrames; ++i) {
     fill_frame(i, 0.0F, frame);
-    pipeline.process(frame, result);
+    pipeline.process(frame, fixed_robot_state({}), result);
   }
   ASSERT_TRUE(pipeline.background_ready());
 }
@@ -47,7 +48,7 @@ TEST(Failsafe, ForegroundWithoutContactIsStop) {
   FrameResult result;
   learn(pipeline, frame, result);
   fill_frame(3, 1.5F, frame);  // a 40x40 px object at 1.5 m: 1600 foreground pixels
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.foreground_points, 1600U);
   EXPECT_FALSE(result.contact.valid);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
@@ -55,7 +56,7 @@ TEST(Failsafe, ForegroundWithoutContactIsStop) {
   EXPECT_EQ(result.verdict.code, ReasonCode::non_finite_input);
   // The empty cell with the same broken pose has no foreground: that one is still run.
   fill_frame(4, 0.0F, frame);
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.foreground_points, 0U);
   EXPECT_EQ(result.verdict.state, VerdictState::run);
 }
@@ -63,13 +64,13 @@ TEST(Failsafe, ForegroundWithoutContactIsStop) {
 // The same with a robot capsule at infinity (a robot point of 1e39).
 TEST(Failsafe, RobotAtInfinityIsStop) {
   PipelineParams params = fake_params();
-  params.robot.capsules[0].a = params.robot.capsules[0].b = Eigen::Vector3f(kInf, 0.0F, 0.0F);
+  params.robot.points.capsules[0].a = params.robot.points.capsules[0].b = Eigen::Vector3f(kInf, 0.0F, 0.0F);
   Pipeline pipeline(params);
   Frame frame;
   FrameResult result;
   learn(pipeline, frame, result);
   fill_frame(3, 1.5F, frame);
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_GT(result.foreground_points, 0U);
   EXPECT_NE(result.verdict.state, VerdictState::run) << result.verdict.reason;
   EXPECT_NE(result.verdict.state, VerdictState::slow) << result.verdict.reason;
@@ -85,7 +86,7 @@ TEST(Failsafe, NoValidDepthAfterTheFiltersIsStop) {
   Frame frame;
   FrameResult result;
   fill_frame(0, 0.0F, frame);
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.invalid_pixels, 0U);  // the source frame itself is complete
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_EQ(result.verdict.reason, "no valid depth after filters");
@@ -103,7 +104,7 @@ TEST(Failsafe, TooFewValidPixelsIsStop) {
   fill_frame(3, 0.0F, frame);
   std::fill(frame.depth.pixels.begin(), frame.depth.pixels.end(), uint16_t{0});
   frame.depth.pixels[100] = 2000;
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_NE(result.verdict.reason.find("min_valid_share"), std::string::npos) << result.verdict.reason;
   EXPECT_FLOAT_EQ(result.valid_share, 1.0F / 4800.0F);
@@ -114,7 +115,7 @@ TEST(Failsafe, TooFewValidPixelsIsStop) {
   for (size_t i = 0; i < frame.depth.pixels.size(); ++i) {
     if (frame.depth.pixels[i] == 2000) frame.depth.pixels[i] = 0;  // the wall is gone
   }
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_TRUE(result.valid) << result.verdict.reason;
   EXPECT_FLOAT_EQ(result.valid_share, 1600.0F / 4800.0F);
   EXPECT_EQ(result.verdict.state, VerdictState::run);  // 1.5 m is beyond slow_distance_m 1.0 m
@@ -124,7 +125,7 @@ TEST(Failsafe, TooFewValidPixelsIsStop) {
 // object at 1.5 m) is a stop even when both zones are 0 m, which config refuses.
 TEST(Failsafe, InsideTheRobotIsStopWhateverTheZones) {
   PipelineParams params = fake_params();
-  params.robot.capsules[0].radius_m = 1.8F;
+  params.robot.points.capsules[0].radius_m = 1.8F;
   params.safety.slow_distance_m = 0.0F;
   params.safety.stop_distance_m = 0.0F;
   Pipeline pipeline(params);
@@ -132,7 +133,7 @@ TEST(Failsafe, InsideTheRobotIsStopWhateverTheZones) {
   FrameResult result;
   learn(pipeline, frame, result);
   fill_frame(3, 1.5F, frame);
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   ASSERT_TRUE(result.contact.valid);
   EXPECT_TRUE(result.contact.inside);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
@@ -151,15 +152,15 @@ TEST(Failsafe, LoadedBackgroundThatMatchesIsUsedAfterTheCheck) {
   FrameResult result;
   // A person in front of the wall only makes pixels nearer: no reason to doubt the file.
   fill_frame(0, 1.5F, frame);
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_EQ(result.verdict.reason, "checking loaded background (1/2 frames)");
   EXPECT_EQ(result.verdict.code, ReasonCode::checking_background);
   fill_frame(1, 1.5F, frame);
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.verdict.reason, "checking loaded background (2/2 frames)");
   fill_frame(2, 0.8F, frame);
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_TRUE(result.valid);
   EXPECT_EQ(result.verdict.state, VerdictState::slow);
 }
@@ -180,11 +181,11 @@ TEST(Failsafe, LoadedBackgroundNearerThanTheSceneIsRefused) {
   Frame frame;
   FrameResult result;
   fill_frame(0, 0.0F, frame);
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   fill_frame(1, 0.0F, frame);
   try {
-    pipeline.process(frame, result);
+    pipeline.process(frame, fixed_robot_state({}), result);
     FAIL() << "a background 1 m nearer than the whole scene was accepted";
   } catch (const BackgroundMismatch& e) {
     EXPECT_NE(std::string(e.what()).find("100.0 %"), std::string::npos) << e.what();
@@ -324,7 +325,8 @@ TEST(Failsafe, ProcessingErrorIsTheRunsError) {
   FakeSource source({Step{}, Step{}, Step{}});
   CollectingSink sink;
   RunHeader header;
-  const RunSummary summary = run_pipeline(source, pipeline, sink, RunOptions{}, header);
+  FixedRobotState robot_states({});
+  const RunSummary summary = run_pipeline(source, robot_states, pipeline, sink, RunOptions{}, header);
   EXPECT_EQ(summary.error.rfind("processing error at frame 0: the loaded background: does not match", 0), 0U)
       << summary.error;
   EXPECT_EQ(summary.end_reason, summary.error);

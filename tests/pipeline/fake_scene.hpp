@@ -4,6 +4,7 @@
 #pragma once
 
 #include "hrcsense/pipeline.hpp"
+#include "hrcsense/robot_state.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -60,7 +61,7 @@ inline PipelineParams fake_params(double max_frame_age_s = 0.5) {
   params.background.frames = kLearnFrames;
   Capsule point;
   point.link = 2;
-  params.robot.capsules.push_back(point);
+  params.robot.points.capsules.push_back(point);
   params.safety.slow_distance_m = 1.0F;
   params.safety.stop_distance_m = 0.5F;
   params.safety.max_frame_age_s = max_frame_age_s;
@@ -135,7 +136,7 @@ inline BackgroundModel learn_empty_background() {
   FrameResult result;
   for (int i = 0; i < kLearnFrames; ++i) {
     fill_frame(i, 0.0F, frame);
-    learner.process(frame, result);
+    learner.process(frame, fixed_robot_state({}), result);
   }
   return learner.background();
 }
@@ -146,7 +147,8 @@ inline RunSummary run_fake(Source& source, Sink& sink, const PipelineParams& par
   RunHeader header;
   header.version = "test";
   header.source = source.info();
-  return run_pipeline(source, pipeline, sink, options, header);
+  FixedRobotState robot_states({});  // fake_params' robot is a point: no joints
+  return run_pipeline(source, robot_states, pipeline, sink, options, header);
 }
 
 /// `learn` wall frames, then the given steps.

@@ -22,7 +22,7 @@ TEST(Pipeline, LearnsThenMeasuresTheObject) {
   FrameResult result;
   for (int i = 0; i < test::kLearnFrames; ++i) {
     fill_frame(i, 0.0F, frame);
-    pipeline.process(frame, result);
+    pipeline.process(frame, fixed_robot_state({}), result);
     EXPECT_FALSE(result.valid);
     EXPECT_EQ(result.verdict.state, VerdictState::stop);
     EXPECT_EQ(result.verdict.reason,
@@ -33,7 +33,7 @@ TEST(Pipeline, LearnsThenMeasuresTheObject) {
   EXPECT_TRUE(pipeline.background_ready());
 
   fill_frame(3, 0.8F, frame);
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_TRUE(result.valid);
   EXPECT_EQ(result.frame, 3);
   EXPECT_EQ(result.timestamp_ns, 3 * 33'333'333);
@@ -53,7 +53,7 @@ TEST(Pipeline, LearnsThenMeasuresTheObject) {
 
   // The wall alone again: nothing in the cell, run.
   fill_frame(4, 0.0F, frame);
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_TRUE(result.valid);
   EXPECT_FALSE(result.contact.valid);
   EXPECT_EQ(result.foreground_points, 0U);
@@ -65,7 +65,7 @@ TEST(Pipeline, NoValidDepthIsStop) {
   Frame frame;
   FrameResult result;
   fill_frame(0, -1.0F, frame);
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_FALSE(result.valid);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_EQ(result.verdict.reason, "no valid depth");
@@ -79,7 +79,7 @@ TEST(Pipeline, CountsInvalidPixels) {
   FrameResult result;
   fill_frame(0, 0.0F, frame);
   for (int i = 0; i < 17; ++i) frame.depth.pixels[static_cast<size_t>(i * 7)] = 0;
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.invalid_pixels, 17U);
 }
 
@@ -91,11 +91,11 @@ TEST(Pipeline, CopiesTruthAndClearsItAgain) {
   frame.truth.emplace();
   frame.truth->contact.valid = true;
   frame.truth->contact.distance_m = 1.25F;
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   ASSERT_TRUE(result.truth.has_value());
   EXPECT_EQ(result.truth->distance_m, 1.25F);
   frame.truth.reset();
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_FALSE(result.truth.has_value());
 }
 
@@ -111,7 +111,7 @@ TEST(Pipeline, PresetBackgroundSkipsLearning) {
   pipeline.set_background(background);
   EXPECT_TRUE(pipeline.background_ready());
   fill_frame(0, 0.3F, frame);
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_TRUE(result.valid);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_NEAR(result.contact.distance_m, expected_distance_m(0.3), 1e-4);
@@ -123,12 +123,12 @@ TEST(Pipeline, EmptyRobotModelIsStop) {
   Frame frame;
   FrameResult result;
   PipelineParams params = fake_params();
-  params.robot.capsules.clear();
+  params.robot.points.capsules.clear();
   params.background.check_frames = 0;
   Pipeline pipeline(params);
   pipeline.set_background(background);
   fill_frame(0, 0.0F, frame);  // an empty cell: without the rule this would be run
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_FALSE(result.valid);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_EQ(result.verdict.reason, "no robot model");
@@ -146,7 +146,7 @@ TEST(Pipeline, BackgroundOfAnotherSizeIsStop) {
   Frame frame;
   FrameResult result;
   fill_frame(0, 0.5F, frame);
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_FALSE(result.valid);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_FALSE(result.verdict.reason.empty());
@@ -160,7 +160,7 @@ TEST(Pipeline, MovingSceneRestartsLearningWithTheLearnersMessage) {
   const float batch[] = {0.0F, 1.0F, 0.0F};
   for (int i = 0; i < 3; ++i) {
     fill_frame(i, batch[i], frame);
-    pipeline.process(frame, result);
+    pipeline.process(frame, fixed_robot_state({}), result);
   }
   EXPECT_FALSE(pipeline.background_ready());
   ASSERT_FALSE(pipeline.background_message().empty());

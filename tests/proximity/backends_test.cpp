@@ -2,7 +2,9 @@
 // Every proximity backend against a double-precision brute-force reference on random clouds,
 // and against the brute backend on simulated scenes.
 
+#include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/proximity.hpp"
 
@@ -347,12 +349,12 @@ void expect_backends_agree_on_scene(const char* config_name, int first_frame, in
   FrameResult result;
   int compared = 0;
   while (source->next(frame) == Source::Status::frame) {
-    pipeline.process(frame, result);
+    pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
     if (frame.index < first_frame || !result.valid || !result.contact.valid) continue;
     ASSERT_STREQ(result.backend, "brute");
     const PointCloud& base = pipeline.foreground().points_base;
     for (auto& [name, search] : searches) {
-      const Contact c = search.closest(base, pipeline.foreground().points_camera, config.pipeline.robot);
+      const Contact c = search.closest(base, pipeline.foreground().points_camera, pipeline.robot());
       ASSERT_TRUE(c.valid) << name << " frame " << frame.index;
       EXPECT_EQ(c.distance_m, result.contact.distance_m) << name << " frame " << frame.index;
       EXPECT_EQ(c.pixel, result.contact.pixel) << name << " frame " << frame.index;
@@ -375,7 +377,7 @@ TEST(ProximityScenes, PipelineReportsTheBackendItUsed) {
     Pipeline pipeline(config.pipeline);
     Frame frame;
     FrameResult result;
-    while (source->next(frame) == Source::Status::frame) pipeline.process(frame, result);
+    while (source->next(frame) == Source::Status::frame) pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
     ASSERT_TRUE(result.valid) << backend;
     ASSERT_TRUE(result.contact.valid) << backend;
     // auto names its pick, never "auto".

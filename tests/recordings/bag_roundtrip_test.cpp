@@ -5,6 +5,7 @@
 #include "../support/bag_writer.hpp"
 #include "recordings_test_util.hpp"
 
+#include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/io.hpp"
 #include "hrcsense/recordings.hpp"

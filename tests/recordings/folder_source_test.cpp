@@ -3,6 +3,7 @@
 #include "recordings_test_util.hpp"
 
 #include "hrcsense/io.hpp"
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/recordings.hpp"
 
 #include <gtest/gtest.h>
@@ -195,8 +196,9 @@ TEST(FolderSource, DamageMidSequenceTurnsThePipelineVerdictToStop) {
   PipelineParams params;
   params.background.frames = 1;
   Pipeline pipeline(params);
+  FixedRobotState robot_states({});  // the default robot is a point: no joints
   test::KeepingSink sink;
-  const RunSummary summary = run_pipeline(source, pipeline, sink, RunOptions{}, RunHeader{});
+  const RunSummary summary = run_pipeline(source, robot_states, pipeline, sink, RunOptions{}, RunHeader{});
   EXPECT_EQ(summary.frames_in, 2);
   ASSERT_FALSE(sink.results.empty());
   const FrameResult& last = sink.results.back();

@@ -4,7 +4,9 @@
 // depth filters and with the default (SDK) preset.
 #include "recordings_test_util.hpp"
 
+#include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/io.hpp"
 #include "hrcsense/recordings.hpp"
 
@@ -131,7 +133,7 @@ std::vector<FrameStats> run_people(const std::string& path, const std::vector<st
   std::vector<FrameStats> stats;
   while (source->next(frame) == Source::Status::frame) {
     if (stats.size() < 3) room.add(frame.depth);
-    pipeline.process(frame, result);
+    pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
     const Frame* processed = &frame;
     if (!chain.params.order.empty()) {
       chain.start(frame, filtered);

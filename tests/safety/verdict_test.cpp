@@ -147,7 +147,7 @@ TEST(Verdict, ReasonCodeNamesAreDistinctSnakeCase) {
       {ReasonCode::learning_background, "learning_background"},
       {ReasonCode::checking_background, "checking_background"}, {ReasonCode::no_valid_depth, "no_valid_depth"},
       {ReasonCode::low_valid_share, "low_valid_share"}, {ReasonCode::background_mismatch, "background_mismatch"},
-      {ReasonCode::no_robot_model, "no_robot_model"}, {ReasonCode::foreground_failed, "foreground_failed"},
+      {ReasonCode::no_robot_model, "no_robot_model"}, {ReasonCode::no_robot_state, "no_robot_state"}, {ReasonCode::foreground_failed, "foreground_failed"},
       {ReasonCode::stale_frame, "stale_frame"}, {ReasonCode::no_frame, "no_frame"},
       {ReasonCode::source_ended, "source_ended"}, {ReasonCode::frame_limit_reached, "frame_limit_reached"},
       {ReasonCode::stop_requested, "stop_requested"}, {ReasonCode::source_error, "source_error"},

@@ -7,7 +7,9 @@
 #include "reference_foreground.hpp"
 #include "synthetic_frames.hpp"
 
+#include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/pipeline.hpp"
 
 #include <gtest/gtest.h>
@@ -258,20 +260,20 @@ TEST(FastExtractor, PipelineUsesTheBackgroundSetLast) {
   PipelineParams params;
   Capsule robot_point;
   robot_point.a = robot_point.b = {0.0F, 0.0F, 0.5F};
-  params.robot.capsules.push_back(robot_point);
+  params.robot.points.capsules.push_back(robot_point);
   params.background.check_frames = 0;  // trusted at once: this test is about the extractor
   Pipeline pipeline(params);
   Frame frame = wall_frame(2);
   fill_rect(frame, 20, 15, 10, 10, 1700);
   FrameResult result;
   pipeline.set_background(wall_background());
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   ASSERT_TRUE(result.valid) << result.verdict.reason;
   EXPECT_EQ(result.foreground_points, 100U);
   BackgroundModel nearer_wall = wall_background();
   nearer_wall.mean_m.assign(nearer_wall.mean_m.size(), 1.5F);
   pipeline.set_background(nearer_wall);
-  pipeline.process(frame, result);
+  pipeline.process(frame, fixed_robot_state({}), result);
   ASSERT_TRUE(result.valid) << result.verdict.reason;
   EXPECT_EQ(result.foreground_points, 0U);
 }

@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense CLI — `hrcsense bench`: times Pipeline::process end to end on pre-rendered frames.
-#include "app_errors.hpp"
+#include "common/app_errors.hpp"
 #include "commands.hpp"
 
+#include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
+#include "hrcsense/robot_state.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -65,7 +67,7 @@ BackgroundModel learn(const PipelineParams& params, const std::vector<Frame>& fr
   FrameResult result;
   for (const Frame& frame : frames) {
     if (learner.background_ready()) break;
-    learner.process(frame, result);
+    learner.process(frame, fixed_robot_state({}), result);  // learning needs no robot
   }
   if (!learner.background_ready()) {
     throw std::runtime_error("the background did not finish learning in " + std::to_string(frames.size()) +
@@ -97,12 +99,13 @@ int bench_command(const CommandArgs& args) {
     std::vector<double> latencies_us;
     latencies_us.reserve((frames.size() - first) * kRepetitions);
     FrameResult result;
-    for (size_t i = first; i < frames.size(); ++i) pipeline.process(frames[i], result);  // warm-up
+    const RobotState robot_state = fixed_robot_state(config.robot_state.joints_rad);
+    for (size_t i = first; i < frames.size(); ++i) pipeline.process(frames[i], robot_state, result);  // warm-up
     double total_s = 0.0;
     for (int rep = 0; rep < kRepetitions; ++rep) {
       for (size_t i = first; i < frames.size(); ++i) {
         const Clock::time_point start = Clock::now();
-        pipeline.process(frames[i], result);
+        pipeline.process(frames[i], robot_state, result);
         const double us = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
         latencies_us.push_back(us);
         total_s += us * 1e-6;

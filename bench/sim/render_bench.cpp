@@ -3,6 +3,7 @@
 // D435 sensor model, the ground truth and the colour camera at the same resolution, as the
 // simulator source delivers it; Sim/render_depth/WxH without the colour camera.
 
+#include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/sim.hpp"
 

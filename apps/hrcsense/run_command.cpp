@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense CLI — `hrcsense run`: configured source → pipeline → JSON Lines (+ progress on stderr).
-#include "app_errors.hpp"
 #include "commands.hpp"
-#include "console_sink.hpp"
-#include "tee_sink.hpp"
+#include "common/app_errors.hpp"
+#include "common/assembly.hpp"
+#include "common/console_sink.hpp"
+#include "common/tee_sink.hpp"
 
 #include "hrcsense/config.hpp"
-#include "hrcsense/io.hpp"
 #include "hrcsense/sinks.hpp"
 
 #include <spdlog/spdlog.h>
@@ -56,55 +56,12 @@ const char* signal_name(int signal) {
   }
 }
 
-// Loads background.path when it exists. Returns false when there is nothing to load.
-// The background is at the filtered resolution (after decimation), not the source's.
-bool load_background_file(const Config& config, const SourceInfo& info, Pipeline& pipeline) {
-  if (config.background_path.empty() || !std::filesystem::exists(config.background_path)) return false;
-  BackgroundModel model = load_background(config.background_path);  // IoError: damaged file
-  const Intrinsics filtered = filtered_intrinsics(config.pipeline.filters, info.intrinsics);
-  if (model.width != filtered.width || model.height != filtered.height) {
-    throw IoError(config.background_path + ": background is " + std::to_string(model.width) + "x" +
-                  std::to_string(model.height) + " but the filtered source is " + std::to_string(filtered.width) +
-                  "x" + std::to_string(filtered.height) + " (filters.preset " + config.filters_preset + ")");
-  }
-  pipeline.set_background(std::move(model), "background.path '" + config.background_path + "'");
-  return true;
-}
-
-void save_learnt_background(const Config& config, const Pipeline& pipeline) {
-  if (config.background_path.empty()) return;
-  if (!pipeline.background_ready()) {
-    spdlog::warn("background not saved to {}: learning did not finish", config.background_path);
-    return;
-  }
-  const std::filesystem::path parent = std::filesystem::path(config.background_path).parent_path();
-  if (!parent.empty()) std::filesystem::create_directories(parent);
-  save_background(config.background_path, pipeline.background());
-  spdlog::info("background saved to {}", config.background_path);
-}
-
-// What the JSON Lines header says about the filters; the note explains a depth-domain run of a
-// chain that asks for disparity.
-RunHeader::Filters describe_filters(const Config& config, const SourceInfo& info) {
-  RunHeader::Filters filters;
-  const FilterChainParams& chain = config.pipeline.filters;
-  filters.preset = config.filters_preset;
-  filters.domain = filter_domain(chain, info.stereo_baseline_mm);
-  const bool wants_disparity =
-      std::find(chain.order.begin(), chain.order.end(), FilterBlock::to_disparity) != chain.order.end();
-  if (wants_disparity && filters.domain == "depth") {
-    filters.note = "no stereo baseline: to_disparity/to_depth skipped, spatial and temporal run on depth "
-                   "(set source.stereo_baseline_mm)";
-  }
-  filters.intrinsics = filtered_intrinsics(chain, info.intrinsics);
-  return filters;
-}
-
 }  // namespace
 
 int run_command(const CommandArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
   std::unique_ptr<Source> source = make_source(config);
+  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config);
   const SourceInfo info = source->info();
 
   Pipeline pipeline(config.pipeline);
@@ -124,10 +81,7 @@ int run_command(const CommandArgs& args) {
   ConsoleSink console;
   TeeSink sinks{&jsonl, &console};
 
-  RunHeader header;  // version and commit: the sink fills in the build's own
-  header.config_hash = config_hash(config);
-  header.source = info;
-  header.filters = describe_filters(config, info);
+  const RunHeader header = make_run_header(config, info);
   if (!header.filters.note.empty()) spdlog::warn("filters: {}", header.filters.note);
 
   RunOptions options;
@@ -135,7 +89,7 @@ int run_command(const CommandArgs& args) {
   options.max_frames = args.frames;
   options.stop_requested = &g_stop_requested;
   install_signal_handlers();
-  const RunSummary summary = run_pipeline(*source, pipeline, sinks, options, header);
+  const RunSummary summary = run_pipeline(*source, *robot_states, pipeline, sinks, options, header);
   restore_signal_handlers();
   if (g_stop_signal.load() != 0) spdlog::info("{} received: the run ended with a stop", signal_name(g_stop_signal.load()));
 

@@ -2,7 +2,7 @@
 // hrcsense CLI — `hrcsense verify-filters CASES_JSON [--shared DIR]`: runs every case of a
 // golden file made by the real RealSense SDK (data/sdk_filter_goldens format) through
 // hrcsense's filters and compares every output value for value.
-#include "app_errors.hpp"
+#include "common/app_errors.hpp"
 #include "commands.hpp"
 
 #include "hrcsense/filters.hpp"

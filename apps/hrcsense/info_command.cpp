@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense CLI — `hrcsense info`: what a configured source would deliver.
-#include "app_errors.hpp"
+#include "common/app_errors.hpp"
 #include "commands.hpp"
 
+#include "common/assembly.hpp"
 #include "hrcsense/camera.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/io.hpp"
@@ -74,7 +75,7 @@ int print_sim(const Config& config) {
   std::printf("frames: %lld (%.3f s)\n", static_cast<long long>(sim.frames), static_cast<double>(sim.frames) / sim.fps);
   print_sensor_effects(simulator);
   print_scene(config.scene);
-  std::printf("robot: %s, %zu capsule(s)\n", config.robot_model.c_str(), config.pipeline.robot.capsules.size());
+  std::printf("robot: %s, %zu capsule(s)\n", config.robot_model.c_str(), fixed_robot_model(config).capsules.size());
   std::printf("config hash: %s\n", config_hash(config).c_str());
   return 0;
 }

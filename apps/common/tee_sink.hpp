@@ -2,7 +2,7 @@
 // hrcsense CLI — a sink that forwards every call to several sinks, in order.
 #pragma once
 
-#include "hrcsense/pipeline.hpp"
+#include "hrcsense/sink.hpp"
 
 #include <initializer_list>
 #include <string>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense CLI — progress on stderr: one line per second of wall time, then the summary.
-#include "console_sink.hpp"
+#include "common/console_sink.hpp"
 
 #include "hrcsense/safety.hpp"
 

@@ -2,7 +2,7 @@
 // hrcsense CLI — progress on stderr: one line per second of wall time, then the summary.
 #pragma once
 
-#include "hrcsense/pipeline.hpp"
+#include "hrcsense/sink.hpp"
 
 #include <chrono>
 #include <vector>

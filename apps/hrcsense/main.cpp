@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense CLI — the `hrcsense` executable: parses the command line and runs a subcommand.
-#include "app_errors.hpp"
+#include "common/app_errors.hpp"
 #include "commands.hpp"
 
 #include <CLI/CLI.hpp>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense CLI — one-line error reports and the exit codes they map to.
-#include "app_errors.hpp"
+#include "common/app_errors.hpp"
 
 #include "hrcsense/config.hpp"
 

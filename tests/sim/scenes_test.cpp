@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The shipped scene files (config/*.yaml) do what their comments promise, checked numerically.
 
+#include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/io.hpp"
 #include "hrcsense/sim.hpp"

@@ -1,0 +1,112 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense assembly — sources, the simulator, the robot state and the background file from a
+// configuration.
+#include "common/assembly.hpp"
+
+#include "hrcsense/io.hpp"
+#include "hrcsense/recordings.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <memory>
+#include <utility>
+
+namespace hrcsense {
+
+std::optional<SceneObject> robot_scene_object(const Config& config) {
+  const RobotParams& robot = config.pipeline.robot;
+  if (!robot.arm) return std::nullopt;
+  SceneObject arm;
+  arm.name = "robot";
+  arm.is_static = true;
+  const RobotModel rendered = robot_render_capsules(*robot.arm, config.robot_state.joints_rad, robot.base_frame);
+  for (const Capsule& capsule : rendered.capsules) {
+    if (capsule.radius_m <= 0.0F) continue;  // a bare segment has no surface to see
+    Shape shape;
+    shape.type = Shape::Type::capsule;
+    shape.a = capsule.a;
+    shape.b = capsule.b;
+    shape.radius_m = capsule.radius_m;
+    arm.shapes.push_back(shape);
+  }
+  return arm;
+}
+
+Simulator make_simulator(const Config& config) {
+  Simulator simulator;
+  simulator.params = config.sim;
+  simulator.params.seed = config.source.seed;
+  simulator.scene = config.scene;
+  simulator.T_base_camera = config.pipeline.T_base_camera;
+  simulator.robot = fixed_robot_model(config);
+  // The arm is part of the static scene: rendered, learnt as background, never foreground.
+  if (auto arm = robot_scene_object(config)) simulator.scene.objects.push_back(*arm);
+  return simulator;
+}
+
+std::unique_ptr<Source> make_source(const Config& config) {
+  const std::string where = config.file.empty() ? std::string("configuration") : config.file;
+  if (config.source.type == "sim") return std::make_unique<SimSource>(make_simulator(config));
+  if (config.source.type == "folder" || config.source.type == "bag") {
+    if (config.source.path.empty()) {
+      throw ConfigError(where + ": source.path: required for source.type " + config.source.type);
+    }
+    RecordingParams params{config.source.path, config.source.loop, config.source.stereo_baseline_mm};
+    if (config.source.type == "folder") return std::make_unique<FolderSource>(params);
+    return std::make_unique<BagSource>(params);
+  }
+  // The configuration knows every type; the live adapters are optional targets.
+  throw ConfigError(where + ": source.type '" + config.source.type + "': not built into this hrcsense");
+}
+
+std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config) {
+  return std::make_unique<FixedRobotState>(config.robot_state.joints_rad);
+}
+
+bool load_background_file(const Config& config, const SourceInfo& info, Pipeline& pipeline) {
+  if (config.background_path.empty() || !std::filesystem::exists(config.background_path)) return false;
+  BackgroundModel model = load_background(config.background_path);  // IoError: damaged file
+  // The background is at the filtered resolution (after decimation), not the source's.
+  const Intrinsics filtered = filtered_intrinsics(config.pipeline.filters, info.intrinsics);
+  if (model.width != filtered.width || model.height != filtered.height) {
+    throw IoError(config.background_path + ": background is " + std::to_string(model.width) + "x" +
+                  std::to_string(model.height) + " but the filtered source is " + std::to_string(filtered.width) +
+                  "x" + std::to_string(filtered.height) + " (filters.preset " + config.filters_preset + ")");
+  }
+  pipeline.set_background(std::move(model), "background.path '" + config.background_path + "'");
+  return true;
+}
+
+void save_learnt_background(const Config& config, const Pipeline& pipeline) {
+  if (config.background_path.empty()) return;
+  if (!pipeline.background_ready()) {
+    spdlog::warn("background not saved to {}: learning did not finish", config.background_path);
+    return;
+  }
+  const std::filesystem::path parent = std::filesystem::path(config.background_path).parent_path();
+  if (!parent.empty()) std::filesystem::create_directories(parent);
+  save_background(config.background_path, pipeline.background());
+  spdlog::info("background saved to {}", config.background_path);
+}
+
+RunHeader make_run_header(const Config& config, const SourceInfo& info) {
+  RunHeader header;
+  header.config_hash = config_hash(config);
+  header.source = info;
+  RunHeader::Filters& filters = header.filters;
+  const FilterChainParams& chain = config.pipeline.filters;
+  filters.preset = config.filters_preset;
+  filters.domain = filter_domain(chain, info.stereo_baseline_mm);
+  const bool wants_disparity =
+      std::find(chain.order.begin(), chain.order.end(), FilterBlock::to_disparity) != chain.order.end();
+  if (wants_disparity && filters.domain == "depth") {
+    filters.note = "no stereo baseline: to_disparity/to_depth skipped, spatial and temporal run on depth "
+                   "(set source.stereo_baseline_mm)";
+  }
+  filters.intrinsics = filtered_intrinsics(chain, info.intrinsics);
+  return header;
+}
+
+}  // namespace hrcsense

@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense assembly — what both executables (`hrcsense`, later `hrcsense-view`) build from a
+// configuration: the source, the simulator, the background file, the run header. The
+// configuration itself stays plain data (config.hpp); adapters are chosen here, and one that
+// this build does not have is a ConfigError saying so.
+#pragma once
+
+#include "hrcsense/config.hpp"
+#include "hrcsense/pipeline.hpp"
+#include "hrcsense/robot_state.hpp"
+#include "hrcsense/sim.hpp"
+
+#include <memory>
+#include <optional>
+
+namespace hrcsense {
+
+/// The configured arm as a static simulator object named "robot": its rendering capsules
+/// (robot_render_capsules: the visual body, no padding) at robot.joints_rad in the
+/// robot.base_frame frame, so the arm is part of the learnt background. Empty for robot.model
+/// points.
+std::optional<SceneObject> robot_scene_object(const Config& config);
+
+/// The simulator described by a configuration (sim.*, scene.*, camera pose, robot).
+Simulator make_simulator(const Config& config);
+
+/// The source the configuration names (source.type); throws ConfigError for a type this
+/// build does not have (naming it) or a recorded source without source.path.
+std::unique_ptr<Source> make_source(const Config& config);
+
+/// The robot state source (robot.state.source): today `fixed`, robot.joints_rad.
+std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config);
+
+/// Loads background.path into `pipeline` when the file exists (checked against the filtered
+/// resolution: after decimation); false when there is nothing to load. Throws IoError for a
+/// damaged or mismatched file, naming it.
+bool load_background_file(const Config& config, const SourceInfo& info, Pipeline& pipeline);
+
+/// Saves the learnt background to background.path (creating its folder); a warning on stderr
+/// when learning did not finish. Nothing without background.path.
+void save_learnt_background(const Config& config, const Pipeline& pipeline);
+
+/// The JSON Lines header of a run: config hash, source, filters (with a note when a chain that
+/// asks for disparity runs on depth). Version and commit are the sink's.
+RunHeader make_run_header(const Config& config, const SourceInfo& info);
+
+}  // namespace hrcsense
