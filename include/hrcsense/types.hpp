@@ -188,6 +188,7 @@ enum class ReasonCode {
   background_mismatch,   ///< stop: the background is not of the filtered frame's size
   no_robot_model,        ///< stop: no capsules to measure against
   no_robot_state,        ///< stop: no valid robot state for the frame (an arm needs its joints)
+  robot_state_stale,     ///< stop: the newest robot state is older than robot.state.max_age_s
   foreground_failed,     ///< stop: the foreground test could not run
   stale_frame,           ///< stop: the frame is older than safety.max_frame_age_s
   no_frame,              ///< stop: the watchdog saw no frame for safety.max_frame_age_s

@@ -86,6 +86,7 @@ const char* reason_code_name(ReasonCode code) {
     case ReasonCode::background_mismatch: return "background_mismatch";
     case ReasonCode::no_robot_model: return "no_robot_model";
     case ReasonCode::no_robot_state: return "no_robot_state";
+    case ReasonCode::robot_state_stale: return "robot_state_stale";
     case ReasonCode::foreground_failed: return "foreground_failed";
     case ReasonCode::stale_frame: return "stale_frame";
     case ReasonCode::no_frame: return "no_frame";

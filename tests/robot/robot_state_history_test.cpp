@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: Apache-2.0
+// The robot state history: interpolation, extrapolation for one sample period, staleness,
+// rejected samples; and the sender-to-host clock map. Values worked by hand.
+#include "hrcsense/robot_state_history.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+
+namespace hrcsense {
+namespace {
+
+constexpr int64_t kMs = 1'000'000;
+
+// Joint 1 at q1 rad moving at qd1 rad/s, the others at rest, at t_ms on the host clock.
+RobotState sample(int64_t t_ms, double q1, double qd1 = 0.0) {
+  RobotState s;
+  s.host_time_ns = t_ms * kMs;
+  s.q_rad[0] = q1;
+  s.qd_rad_s[0] = qd1;
+  s.valid = true;
+  s.origin = RobotStateOrigin::rtde;
+  return s;
+}
+
+TEST(RobotStateHistory, NoSampleIsNoRobotState) {
+  RobotStateHistory history;
+  const RobotStateLookup lookup = history.at(5 * kMs);
+  EXPECT_FALSE(lookup.state.valid);
+  EXPECT_EQ(lookup.code, ReasonCode::no_robot_state);
+}
+
+// Samples at 0, 8 and 16 ms (125 Hz), q1 = 0, 0.008, 0.016 (1 rad/s). At 12 ms: halfway
+// between 0.008 and 0.016 → 0.012.
+TEST(RobotStateHistory, InterpolatesBetweenBracketingSamples) {
+  RobotStateHistory history;
+  ASSERT_TRUE(history.add(sample(0, 0.000, 1.0)));
+  ASSERT_TRUE(history.add(sample(8, 0.008, 1.0)));
+  ASSERT_TRUE(history.add(sample(16, 0.016, 1.0)));
+  const RobotStateLookup lookup = history.at(12 * kMs);
+  ASSERT_TRUE(lookup.state.valid);
+  EXPECT_EQ(lookup.code, ReasonCode::clear);
+  EXPECT_NEAR(lookup.state.q_rad[0], 0.012, 1e-12);
+  EXPECT_NEAR(lookup.state.qd_rad_s[0], 1.0, 1e-12);
+  EXPECT_DOUBLE_EQ(lookup.age_ms, 0.0);  // the frame is older than the newest sample
+  EXPECT_FALSE(lookup.extrapolated);
+  EXPECT_EQ(lookup.state.host_time_ns, 12 * kMs);
+  EXPECT_EQ(lookup.state.origin, RobotStateOrigin::rtde);
+  // Exactly on a sample: that sample.
+  EXPECT_NEAR(history.at(8 * kMs).state.q_rad[0], 0.008, 1e-12);
+}
+
+// Past the newest sample (16 ms, q1 0.016 at 1 rad/s, period 8 ms): at 20 ms q1 = 0.016 + 0.004;
+// at 40 ms the extrapolation stops after one period: 0.016 + 0.008, age 24 ms (not stale at 50).
+TEST(RobotStateHistory, ExtrapolatesForAtMostOnePeriod) {
+  RobotStateHistory history;
+  ASSERT_TRUE(history.add(sample(8, 0.008, 1.0)));
+  ASSERT_TRUE(history.add(sample(16, 0.016, 1.0)));
+  RobotStateLookup lookup = history.at(20 * kMs);
+  ASSERT_TRUE(lookup.state.valid);
+  EXPECT_NEAR(lookup.state.q_rad[0], 0.020, 1e-12);
+  EXPECT_TRUE(lookup.extrapolated);
+  EXPECT_DOUBLE_EQ(lookup.age_ms, 4.0);
+  lookup = history.at(40 * kMs);
+  ASSERT_TRUE(lookup.state.valid);
+  EXPECT_NEAR(lookup.state.q_rad[0], 0.024, 1e-12);
+  EXPECT_DOUBLE_EQ(lookup.age_ms, 24.0);
+}
+
+TEST(RobotStateHistory, StaleBeyondMaxAge) {
+  RobotStateHistory history;  // max_age_s 0.05
+  history.add(sample(100, 0.5));
+  EXPECT_TRUE(history.at(150 * kMs).state.valid);  // exactly 50 ms: still allowed
+  const RobotStateLookup lookup = history.at(151 * kMs);
+  EXPECT_FALSE(lookup.state.valid);
+  EXPECT_EQ(lookup.code, ReasonCode::robot_state_stale);
+  EXPECT_DOUBLE_EQ(lookup.age_ms, 51.0);
+}
+
+TEST(RobotStateHistory, BeforeTheOldestSampleGivesTheOldest) {
+  RobotStateHistory history;
+  history.add(sample(10, 0.3));
+  history.add(sample(18, 0.3));
+  EXPECT_NEAR(history.at(2 * kMs).state.q_rad[0], 0.3, 1e-12);
+}
+
+// Rejected: NaN, a timestamp not after the previous one, and a jump. At 1 rad/s over 8 ms a
+// joint may move 0.008 + 0.05 (tolerance) = 0.058 rad: 0.05 is accepted, 0.07 rejected.
+TEST(RobotStateHistory, RejectsAndCountsBadSamples) {
+  RobotStateHistory history;
+  ASSERT_TRUE(history.add(sample(0, 0.0, 1.0)));
+  RobotState nan = sample(8, 0.0);
+  nan.q_rad[3] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(history.add(nan));
+  RobotState inf = sample(8, 0.0);
+  inf.qd_rad_s[5] = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(history.add(inf));
+  EXPECT_FALSE(history.add(sample(0, 0.0)));   // same time
+  EXPECT_FALSE(history.add(sample(-8, 0.0)));  // earlier
+  EXPECT_FALSE(history.add(sample(8, 0.07, 1.0)));
+  EXPECT_TRUE(history.add(sample(8, 0.05, 1.0)));
+  const RobotStateCounts& counts = history.counts();
+  EXPECT_EQ(counts.accepted, 2);
+  EXPECT_EQ(counts.rejected_non_finite, 2);
+  EXPECT_EQ(counts.rejected_backwards, 2);
+  EXPECT_EQ(counts.rejected_jump, 1);
+  EXPECT_EQ(counts.rejected(), 5);
+  EXPECT_EQ(history.size(), 2U);
+}
+
+// After a gap longer than max_age_s (a reconnect) the arm may be anywhere: the new sample
+// starts the history afresh instead of being rejected as a jump.
+TEST(RobotStateHistory, AGapStartsAfresh) {
+  RobotStateHistory history;
+  history.add(sample(0, 0.0));
+  history.add(sample(8, 0.0));
+  ASSERT_TRUE(history.add(sample(500, 2.0)));
+  EXPECT_EQ(history.size(), 1U);
+  EXPECT_NEAR(history.at(500 * kMs).state.q_rad[0], 2.0, 1e-12);
+  EXPECT_EQ(history.counts().rejected_jump, 0);
+}
+
+TEST(RobotStateHistory, KeepsTheNewestCapacitySamples) {
+  RobotStateHistory history;
+  const int n = static_cast<int>(RobotStateHistory::kCapacity) + 10;
+  for (int i = 0; i < n; ++i) ASSERT_TRUE(history.add(sample(i, 0.0)));
+  EXPECT_EQ(history.size(), RobotStateHistory::kCapacity);
+  EXPECT_EQ(history.newest().host_time_ns, (n - 1) * kMs);
+}
+
+// The sender's clock runs 1000 s behind the host's; messages arrive after 3, 1 and 2 ms of
+// transport: the offset is the smallest, 1000 s + 1 ms, so later messages map to sent + that
+// (never later than their arrival).
+TEST(SenderClockMap, UsesTheLeastDelayedMessage) {
+  constexpr int64_t kS = 1'000'000'000;
+  SenderClockMap map(5 * kS);
+  EXPECT_EQ(map.to_host(10 * kS, 1010 * kS + 3 * kMs), 1010 * kS + 3 * kMs);
+  EXPECT_EQ(map.to_host(11 * kS, 1011 * kS + 1 * kMs), 1011 * kS + 1 * kMs);
+  EXPECT_EQ(map.to_host(12 * kS, 1012 * kS + 2 * kMs), 1012 * kS + 1 * kMs);
+  // Two windows later the early minimum has aged out: only the last blocks count.
+  EXPECT_EQ(map.to_host(18 * kS, 1018 * kS + 4 * kMs), 1018 * kS + 1 * kMs);  // new block; previous min 1 ms
+  EXPECT_EQ(map.to_host(24 * kS, 1024 * kS + 5 * kMs), 1024 * kS + 4 * kMs);  // previous block's min 4 ms
+  // The sender restarted (its clock went back): the map starts again.
+  EXPECT_EQ(map.to_host(1 * kS, 1030 * kS), 1030 * kS);
+}
+
+}  // namespace
+}  // namespace hrcsense
