@@ -3,8 +3,9 @@
 // bit for bit, on random images of many sizes (every width modulo the SIMD and strip widths)
 // and every option set; and the properties of issue 4: no filter but threshold turns a valid
 // pixel invalid, the result does not depend on where the data sits in memory (rows shifted
-// across the lanes here; every block with the buffer's base address moved in alignment_test.cpp),
-// and a filter run twice on the same input with reset state gives the same output.
+// across the lanes here; every block with the buffer's base address moved: the binary of its
+// own in tests/filters_alignment/), and a filter run twice on the same input with reset state
+// gives the same output.
 #include "hrcsense/filters.hpp"
 #include "random_images.hpp"
 #include "reference.hpp"
@@ -258,8 +259,9 @@ TEST_P(Properties, NoFilterButThresholdInvalidatesAValidPixel) {
 }
 
 // Each row's data moved by k elements within the image: k empty columns on the left shift every
-// row across the SIMD lanes and strip blocks (the base address itself: alignment_test.cpp). Empty columns are inert in every block (without hole
-// filling, which would fill them), so the rest of the output must not change.
+// row across the SIMD lanes and strip blocks (the base address itself: tests/filters_alignment/).
+// Empty columns are inert in every block (without hole filling, which would fill them), so the
+// rest of the output must not change.
 template <typename Image>
 Image shifted(const Image& in, int k) {
   Image out;

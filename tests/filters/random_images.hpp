@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// Random depth and disparity images for the filters' property tests (fast_test.cpp,
-// alignment_test.cpp): patches, edges, noise, holes and the values the SDK treats specially.
+// Random depth and disparity images for the filters' property tests (fast_test.cpp and
+// tests/filters_alignment/alignment_test.cpp): patches, edges, noise, holes and the values the SDK treats specially.
 #pragma once
 
 #include "hrcsense/filters.hpp"

@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
-// The extractor's per-background tables against the float formulas they replace, and the whole
-// extractor against the plain reference (reference_foreground.hpp) on simulated and hand-built
-// frames: masks and clouds must be identical. Also the fail-safe side of preparing.
+// The extractor's per-background tables against the float test they solve, and the whole
+// extractor against itself with the image moved by a few pixels, on simulated and random
+// hand-built frames: the mask must move along and the clouds stay bit for bit the same. The
+// rules themselves are checked on hand-worked frames (foreground_hand_test.cpp). Also the
+// fail-safe side of preparing.
 
 #include "../../src/segmentation/foreground_tables.hpp"
-#include "reference_foreground.hpp"
 #include "synthetic_frames.hpp"
 
 #include "common/assembly.hpp"
@@ -14,6 +15,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -34,14 +37,10 @@ constexpr int kLearnFrames = 100;
 constexpr int kRandomFrames = 60;
 #endif
 
-/// The old per-pixel test, written out again: valid raw r is foreground iff it passes.
-bool old_test(int r, float mean_m, float spread_m, const detail::NearerTest& t) {
-  const float z = static_cast<float>(r) * t.depth_scale_m;
-  const float a = t.k_sigma * spread_m;
-  const float b = t.k_model * z * z;
-  const float ab = a > b ? a : b;
-  const float margin = ab > t.min_margin_m ? ab : t.min_margin_m;
-  return z < mean_m - margin;
+/// The per-pixel float test the thresholds solve: valid raw r is a candidate iff it passes.
+/// (Its rule is checked by hand in foreground_hand_test.cpp; here only the solving.)
+bool float_test(int r, float mean_m, float spread_m, const detail::NearerTest& t) {
+  return detail::nearer_than_background(static_cast<uint16_t>(r), mean_m, spread_m, t);
 }
 
 // For every raw depth 1..65535, the threshold says exactly what the float test says, including
@@ -65,16 +64,16 @@ TEST(NearerTable, AgreesWithFloatTestAtEveryRawDepth) {
         const detail::NearerTest test{scale, 4.0F, k_model, min_margin};
         for (const auto& [mean_m, spread_m] : pixels) {
           int expected = 0;
-          for (int r = 1; r <= 65535; ++r) expected += old_test(r, mean_m, spread_m, test) ? 1 : 0;
+          for (int r = 1; r <= 65535; ++r) expected += float_test(r, mean_m, spread_m, test) ? 1 : 0;
           const int count = detail::nearer_raw_count(mean_m, spread_m, test);
           ASSERT_EQ(count, expected) << "mean " << mean_m << " spread " << spread_m << " scale " << scale
                                      << " k_model " << k_model << " min_margin " << min_margin;
           // Monotone: the passing depths are exactly 1..count.
           if (count > 0) {
-            EXPECT_TRUE(old_test(count, mean_m, spread_m, test));
+            EXPECT_TRUE(float_test(count, mean_m, spread_m, test));
           }
           if (count < 65535) {
-            EXPECT_FALSE(old_test(count + 1, mean_m, spread_m, test));
+            EXPECT_FALSE(float_test(count + 1, mean_m, spread_m, test));
           }
         }
       }
@@ -117,25 +116,97 @@ TEST(JumpLimits, AreTheRoundedUpFloatLimit) {
   EXPECT_EQ(limit[3000], 136);
 }
 
-/// Expects the extractor's result to be the reference's: same mask, bit-identical camera
-/// points, base points T_base_camera · camera points (float rounding only).
-void expect_same(const Foreground& fast, const ReferenceForeground& ref, const Pose& T_base_camera,
-                 const std::string& where) {
-  ASSERT_EQ(fast.mask, ref.mask) << where;
-  ASSERT_EQ(fast.points_camera.pixel, ref.points_camera.pixel) << where;
-  ASSERT_EQ(fast.points_camera.x, ref.points_camera.x) << where;
-  ASSERT_EQ(fast.points_camera.y, ref.points_camera.y) << where;
-  ASSERT_EQ(fast.points_camera.z, ref.points_camera.z) << where;
-  ASSERT_EQ(fast.points_base.pixel, ref.points_camera.pixel) << where;
-  for (size_t i = 0; i < fast.points_base.size(); ++i) {
-    const Eigen::Vector3d expected = T_base_camera * ref.points_camera.point(i).cast<double>();
-    ASSERT_LT((fast.points_base.point(i).cast<double>() - expected).norm(), 1e-5) << where << " point " << i;
+/// `frame` and `background` placed at (du, dv) in an image `pad` pixels larger than that on the
+/// right and bottom, with the principal point moved along: every pixel keeps its ray (u − ppx
+/// and v − ppy are exact in float for these values). Around it the depth is 0 and the
+/// background unknown, and no valid depth is ever foreground there.
+struct Moved {
+  Frame frame;
+  BackgroundModel background;
+};
+Moved moved(const Frame& frame, const BackgroundModel& background, int du, int dv, int pad) {
+  const int w = frame.depth.width;
+  const int h = frame.depth.height;
+  const int W = w + du + pad;
+  const int H = h + dv + pad;
+  Moved out{frame, BackgroundModel{}};
+  out.frame.depth.resize(W, H);
+  std::fill(out.frame.depth.pixels.begin(), out.frame.depth.pixels.end(), uint16_t{0});
+  out.frame.intrinsics.width = W;
+  out.frame.intrinsics.height = H;
+  out.frame.intrinsics.ppx += static_cast<float>(du);
+  out.frame.intrinsics.ppy += static_cast<float>(dv);
+  const size_t n = static_cast<size_t>(W) * static_cast<size_t>(H);
+  out.background.width = W;
+  out.background.height = H;
+  out.background.mean_m.assign(n, 0.0F);
+  out.background.spread_m.assign(n, 0.0F);
+  out.background.valid_ratio.assign(n, 0.0F);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const size_t from = static_cast<size_t>(v) * static_cast<size_t>(w) + static_cast<size_t>(u);
+      const size_t to = static_cast<size_t>(v + dv) * static_cast<size_t>(W) + static_cast<size_t>(u + du);
+      out.frame.depth.pixels[to] = frame.depth.pixels[from];
+      out.background.mean_m[to] = background.mean_m[from];
+      out.background.spread_m[to] = background.spread_m[from];
+      out.background.valid_ratio[to] = background.valid_ratio[from];
+    }
+  }
+  return out;
+}
+
+/// The extractor's result on `frame` and on the same frame moved by (du, dv) into a larger
+/// image must be the same: the rules look at a pixel, its neighbours and its ray, never at
+/// where it lies in the image. So the mask moves with the image, and the points, in the same
+/// order, are bit for bit the same. What this checks is the machinery that does depend on the
+/// position: the scans that skip 16 pixels at a time and empty rows, the image border in the
+/// flood fill, the rows deprojection visits. The rules themselves: foreground_hand_test.cpp.
+void expect_moves_with_image(const Frame& frame, const BackgroundModel& background, const ForegroundParams& params,
+                             const Pose& T_base_camera, const std::string& where, size_t& points) {
+  ForegroundExtractor extractor;
+  extractor.params = params;
+  extractor.set_background(background, frame.intrinsics.fx, frame.stereo_baseline_mm, frame.depth.depth_scale_m);
+  Foreground at_origin;
+  ASSERT_TRUE(extractor.extract(frame, T_base_camera, at_origin)) << where;
+  points += at_origin.points_camera.size();
+  const int w = frame.depth.width;
+  for (const auto& [du, dv, pad] : {std::array<int, 3>{1, 0, 0}, {3, 1, 5}, {8, 2, 1}, {15, 0, 16}, {17, 5, 3}}) {
+    const std::string at = where + " moved by (" + std::to_string(du) + ", " + std::to_string(dv) + ")";
+    const Moved m = moved(frame, background, du, dv, pad);
+    const int W = m.frame.depth.width;
+    ForegroundExtractor moved_extractor;
+    moved_extractor.params = params;
+    moved_extractor.set_background(m.background, m.frame.intrinsics.fx, m.frame.stereo_baseline_mm,
+                                   m.frame.depth.depth_scale_m);
+    Foreground fg;
+    ASSERT_TRUE(moved_extractor.extract(m.frame, T_base_camera, fg)) << at;
+    // Pixel index i of the original image → its index in the moved one.
+    const auto moved_index = [&](size_t i) {
+      const size_t u = i % static_cast<size_t>(w) + static_cast<size_t>(du);
+      const size_t v = i / static_cast<size_t>(w) + static_cast<size_t>(dv);
+      return v * static_cast<size_t>(W) + u;
+    };
+    std::vector<uint8_t> expected_mask(fg.mask.size(), 0);
+    for (size_t i = 0; i < at_origin.mask.size(); ++i) expected_mask[moved_index(i)] = at_origin.mask[i];
+    std::vector<uint32_t> expected_pixel;
+    for (const uint32_t pixel : at_origin.points_camera.pixel) {
+      expected_pixel.push_back(static_cast<uint32_t>(moved_index(pixel)));
+    }
+    ASSERT_EQ(fg.mask, expected_mask) << at;
+    ASSERT_EQ(fg.points_camera.pixel, expected_pixel) << at;
+    ASSERT_EQ(fg.points_base.pixel, expected_pixel) << at;
+    ASSERT_EQ(fg.points_camera.x, at_origin.points_camera.x) << at;
+    ASSERT_EQ(fg.points_camera.y, at_origin.points_camera.y) << at;
+    ASSERT_EQ(fg.points_camera.z, at_origin.points_camera.z) << at;
+    ASSERT_EQ(fg.points_base.x, at_origin.points_base.x) << at;
+    ASSERT_EQ(fg.points_base.y, at_origin.points_base.y) << at;
+    ASSERT_EQ(fg.points_base.z, at_origin.points_base.z) << at;
   }
 }
 
-/// Renders a configured scene, learns its background, and compares the extractor with the
-/// reference on `frames`.
-void compare_on_scene(const std::string& config_name, uint64_t seed, const std::vector<int64_t>& frames) {
+/// Renders a configured scene, learns its background, and checks on `frames` that the
+/// foreground moves with the image.
+void moves_on_scene(const std::string& config_name, uint64_t seed, const std::vector<int64_t>& frames) {
   const std::string path = std::string(HRCSENSE_SOURCE_DIR) + "/config/" + config_name;
   const Config config = load_config(path, {"source.seed=" + std::to_string(seed)});
   const Simulator sim = make_simulator(config);
@@ -148,36 +219,24 @@ void compare_on_scene(const std::string& config_name, uint64_t seed, const std::
     learner.add(frame);
   }
   ASSERT_TRUE(learner.ready()) << config_name << ": " << learner.message();
-  ForegroundExtractor extractor;
-  extractor.params = config.pipeline.foreground;
-  extractor.set_background(learner.model(), frame.intrinsics.fx, frame.stereo_baseline_mm, frame.depth.depth_scale_m);
-  Foreground fast;
   size_t points = 0;
   for (const int64_t index : frames) {
     sim.render(index, frame);
-    ASSERT_TRUE(extractor.extract(frame, config.pipeline.T_base_camera, fast));
-    const ReferenceForeground ref =
-        reference_foreground(frame, learner.model(), config.pipeline.foreground, config.pipeline.T_base_camera);
-    expect_same(fast, ref, config.pipeline.T_base_camera,
-                config_name + " seed " + std::to_string(seed) + " frame " + std::to_string(index));
-    points += ref.points_camera.size();
+    expect_moves_with_image(frame, learner.model(), config.pipeline.foreground, config.pipeline.T_base_camera,
+                            config_name + " seed " + std::to_string(seed) + " frame " + std::to_string(index), points);
   }
   EXPECT_GT(points, 1000U) << config_name << ": the frames should show the object";
 }
 
-// The walk: the person far, close to the robot and leaving; two noise seeds.
-TEST(FastExtractor, MatchesReferenceOnWalk) {
-  for (const uint64_t seed : {2U, 9U}) compare_on_scene("walk.yaml", seed, {130, 186, 215, 260});
-}
+// The walk: the person far, close to the robot and leaving.
+TEST(FastExtractor, MovesWithTheImageOnWalk) { moves_on_scene("walk.yaml", 2, {130, 215}); }
 
-// The thesis box (with its shiny table's dropouts: unknown background); two noise seeds.
-TEST(FastExtractor, MatchesReferenceOnThesisBox) {
-  for (const uint64_t seed : {4U, 13U}) compare_on_scene("thesis-box.yaml", seed, {100, 101, 150});
-}
+// The thesis box (with its shiny table's dropouts: unknown background).
+TEST(FastExtractor, MovesWithTheImageOnThesisBox) { moves_on_scene("thesis-box.yaml", 4, {100, 150}); }
 
 // Random rectangles at random depths over the small wall, touching the image border, with an
 // unknown patch of background, a workspace, a rotated camera and sometimes distortion.
-TEST(FastExtractor, MatchesReferenceOnRandomHandBuiltFrames) {
+TEST(FastExtractor, MovesWithTheImageOnRandomHandBuiltFrames) {
   std::mt19937 rng(5);
   std::uniform_int_distribution<int> u_pick(-4, kWidth - 2);
   std::uniform_int_distribution<int> v_pick(-4, kHeight - 2);
@@ -191,6 +250,7 @@ TEST(FastExtractor, MatchesReferenceOnRandomHandBuiltFrames) {
   Pose T_base_camera = Pose::Identity();
   T_base_camera.linear() = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   T_base_camera.translation() = Eigen::Vector3d(0.1, -0.2, 0.3);
+  size_t points = 0;
   for (int f = 0; f < kRandomFrames; ++f) {
     Frame frame = wall_frame(f);
     if (f % 3 == 2) {
@@ -207,14 +267,9 @@ TEST(FastExtractor, MatchesReferenceOnRandomHandBuiltFrames) {
     ForegroundParams params;
     params.min_object_mm = f % 2 == 0 ? 40.0F : 15.0F;
     if (f % 4 == 1) params.workspace_base.max.z() = 1.8F;
-    ForegroundExtractor extractor;
-    extractor.params = params;
-    extractor.set_background(background, frame.intrinsics.fx, frame.stereo_baseline_mm, frame.depth.depth_scale_m);
-    Foreground fast;
-    ASSERT_TRUE(extractor.extract(frame, T_base_camera, fast));
-    expect_same(fast, reference_foreground(frame, background, params, T_base_camera), T_base_camera,
-                "random frame " + std::to_string(f));
+    expect_moves_with_image(frame, background, params, T_base_camera, "random frame " + std::to_string(f), points);
   }
+  EXPECT_GT(points, 200U * kRandomFrames) << "the rectangles should be foreground";
 }
 
 // Unprepared, or prepared for another camera or other parameters: extract() refuses (false,

@@ -7,14 +7,19 @@
 // How the buffers are moved: DepthImage and DisparityImage own their pixels in a std::vector
 // with the default allocator, so the API takes no outside or offset buffer, and glibc's malloc
 // only ever returns 16-byte aligned blocks. This executable therefore replaces the global
-// operator new (as tests/alloc/ does to count allocations): while a
-// `Placement` is alive, every allocation starts `offset` bytes past a 64-byte boundary and ends
-// where its block ends (so AddressSanitizer still sees an overrun); operator delete finds such
-// blocks in a small table. Offsets are multiples of the element size, so every uint16_t and
-// float stays naturally aligned; only the vector-width alignment varies. Outside a Placement
-// allocation is plain malloc/free.
+// operator new: while a `Placement` is alive, every allocation starts `offset` bytes past a
+// 64-byte boundary and ends where its block ends (so AddressSanitizer still sees an overrun);
+// operator delete finds such blocks in a small table. Offsets are multiples of the element
+// size, so every uint16_t and float stays naturally aligned; only the vector-width alignment
+// varies. Outside a Placement allocation is plain malloc/free.
+//
+// A replaced operator new holds for the whole executable, so this file is a family of its own
+// (test_filters_alignment, as tests/alloc/ is for the counting allocator) and holds no other
+// tests: in test_filters it would sit under every filter test. It compares the filters with
+// themselves, never with a float reference of its own, so it needs test_filters'
+// -ffp-contract=off no more than the filters library gives it.
 #include "hrcsense/filters.hpp"
-#include "random_images.hpp"
+#include "../filters/random_images.hpp"
 
 #include <gtest/gtest.h>
 
