@@ -9,8 +9,9 @@
 
 namespace hrcsense::segmentation_detail {
 
-// Neighbouring foreground pixels belong to one object unless their depths jump by more than
-// max(kJumpMinM, kJumpSigmas · σ_model(z)) at the farther of the two depths.
+// Neighbouring foreground pixels belong to one object unless their depths jump by
+// max(kJumpMinM, kJumpSigmas · σ_model(z)) or more, at the farther of the two depths (a jump of
+// exactly the limit splits them).
 inline constexpr float kJumpMinM = 0.05F;
 inline constexpr float kJumpSigmas = 4.0F;
 
