@@ -62,7 +62,10 @@ std::unique_ptr<Source> make_source(const Config& config) {
 }
 
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config) {
-  return std::make_unique<FixedRobotState>(config.robot_state.joints_rad);
+  const std::string& source = config.robot_state.source;
+  if (source == "fixed") return std::make_unique<FixedRobotState>(config.robot_state.joints_rad);
+  const std::string where = config.file.empty() ? std::string("configuration") : config.file;
+  throw ConfigError(where + ": robot.state.source '" + source + "': not built into this hrcsense");
 }
 
 bool load_background_file(const Config& config, const SourceInfo& info, Pipeline& pipeline) {

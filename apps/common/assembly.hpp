@@ -28,7 +28,8 @@ Simulator make_simulator(const Config& config);
 /// build does not have (naming it) or a recorded source without source.path.
 std::unique_ptr<Source> make_source(const Config& config);
 
-/// The robot state source (robot.state.source): today `fixed`, robot.joints_rad.
+/// The robot state source (robot.state.source); throws ConfigError for one this build does
+/// not have.
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config);
 
 /// Loads background.path into `pipeline` when the file exists (checked against the filtered

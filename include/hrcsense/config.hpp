@@ -6,6 +6,7 @@
 
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/robot.hpp"
+#include "hrcsense/robot_state_history.hpp"
 #include "hrcsense/sim.hpp"
 
 #include <optional>
@@ -30,11 +31,23 @@ struct SourceConfig {
   float stereo_baseline_mm = 0.0F; ///< for sources that do not carry one
 };
 
-/// Where the robot's joint state comes from. So far always `fixed`: robot.joints_rad for every
-/// frame (the live sources of `robot.state.source` come with their adapters).
+/// Where the robot's joint state comes from (`robot.state.*`, docs/ROBOT.md).
 struct RobotStateConfig {
-  /// `robot.joints_rad`: the fixed pose, joint 1 first (required for an arm; zeros for points).
+  /// `robot.state.source`: fixed (robot.joints_rad), sim (robot.trajectory), rtde (a UR
+  /// controller), udp_json (any robot), recorded (a .bag from hrcsense record).
+  std::string source = "fixed";
+  /// `robot.joints_rad`: the fixed pose, joint 1 first (required for an arm with the fixed
+  /// source; zeros when not given).
   JointAngles joints_rad{};
+  std::string host;              ///< `robot.state.host`: the RTDE controller (required for rtde)
+  int port = 30004;              ///< `robot.state.port`: RTDE's port
+  double frequency_hz = 125.0;   ///< `robot.state.frequency_hz`: RTDE output rate (CB3 ≤ 125, e-Series ≤ 500)
+  std::string listen = "127.0.0.1:30010";  ///< `robot.state.listen`: udp_json address host:port
+  /// `robot.state.max_age_s`, `robot.state.camera_latency_s`: stale limit and camera delay.
+  RobotStateHistoryParams history;
+  double camera_latency_s = 0.0;
+  double sim_latency_s = 0.0;    ///< `robot.state.sim_latency_s`: the simulated state arrives this late
+  double sim_jitter_s = 0.0;     ///< `robot.state.sim_jitter_s`: uniform jitter on that delay
 };
 
 struct Config {

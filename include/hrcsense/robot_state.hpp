@@ -4,6 +4,7 @@
 // scripted arm implement the same interface.
 #pragma once
 
+#include "hrcsense/robot_state_history.hpp"
 #include "hrcsense/types.hpp"
 
 #include <cstdint>
@@ -14,6 +15,15 @@ namespace hrcsense {
 /// `robot.state.source` as a name: fixed, sim, rtde, udp_json, recorded.
 const char* robot_state_origin_name(RobotStateOrigin origin);
 
+/// What a robot state source says about itself over a run (the summary's counters).
+struct RobotStateStats {
+  RobotStateCounts samples;   ///< samples accepted and rejected (RobotStateHistory)
+  int64_t connections = 0;    ///< connections made, reconnections included (live sources)
+  int64_t disconnects = 0;    ///< connections lost or closed by the peer
+  int64_t malformed = 0;      ///< packets or datagrams rejected as malformed
+  std::string last_problem;   ///< the last problem, for people; empty when none
+};
+
 /// Delivers the robot's joint state for the frames of a run.
 class RobotStateSource {
  public:
@@ -23,6 +33,8 @@ class RobotStateSource {
   /// Returns false, with out.valid false, when there is none; error() may say why.
   virtual bool state_at(int64_t host_time_ns, RobotState& out) = 0;
   virtual std::string error() const { return {}; }
+  /// Counters so far; thread-safe (the summary reads them while the source may still run).
+  virtual RobotStateStats stats() const { return {}; }
 };
 
 /// A valid state with the joint angles `q_rad`, zero velocity, origin `fixed`, at any time.

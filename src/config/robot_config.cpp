@@ -225,9 +225,33 @@ YAML::Node robot_description_node(const RobotDescription& description) {
   return out;
 }
 
+// `robot.state.*`: every key is read whatever the source, so the schema knows them all; the
+// assembly builds the source or says it is not built.
+void read_robot_state(KeyReader& r, RobotStateConfig& s) {
+  r.choice("robot.state.source", s.source, {"fixed", "sim", "rtde", "udp_json", "recorded"});
+  r.text("robot.state.host", s.host);
+  r.integer("robot.state.port", s.port, 1, 65535);
+  r.number_in("robot.state.frequency_hz", s.frequency_hz, 1.0, 500.0, " Hz");
+  r.text("robot.state.listen", s.listen);
+  r.number_in("robot.state.max_age_s", s.history.max_age_s, 0.001, 10.0, " s");
+  r.number_in("robot.state.camera_latency_s", s.camera_latency_s, -1.0, 1.0, " s");
+  r.number_in("robot.state.sim_latency_s", s.sim_latency_s, 0.0, 1.0, " s");
+  r.number_in("robot.state.sim_jitter_s", s.sim_jitter_s, 0.0, 1.0, " s");
+  if (s.source == "rtde" && s.host.empty()) {
+    r.fail("robot.state.host", "is required for robot.state.source rtde: the controller's address");
+  }
+  const size_t colon = s.listen.rfind(':');
+  const std::string port = colon == std::string::npos ? "" : s.listen.substr(colon + 1);
+  const bool port_ok = !port.empty() && port.size() <= 5 &&
+                       port.find_first_not_of("0123456789") == std::string::npos && std::stoi(port) >= 1 &&
+                       std::stoi(port) <= 65535;
+  if (colon == 0 || !port_ok) r.fail("robot.state.listen", "expected host:port (e.g. 127.0.0.1:30010), not '" + s.listen + "'");
+}
+
 void read_robot(KeyReader& r, Config& c) {
   // Every key is read unconditionally first: known_keys() learns the schema from these reads.
   r.choice("robot.model", c.robot_model, {"points", "ur5", "ur5e", "ur10e", "custom"});
+  read_robot_state(r, c.robot_state);
   const YAML::Node description = r.raw("robot.description");
   const YAML::Node tool = r.raw("robot.tool");
   // Default: the 2020 thesis's robot point (-0.5, 0.5, 0.5) m, given there with y up.
@@ -263,9 +287,11 @@ void read_robot(KeyReader& r, Config& c) {
   robot.padding_m = arm.padding_m;  // the arm's own padding is the default
   r.number("robot.padding_m", robot.padding_m, Bound::non_negative, kMaxCoordinateM);
   // No default pose: a wrong pose would put the arm where it is not, which is not fail-safe.
-  if (joints_list.size() != kJointCount) {
+  // Live and simulated states bring their own; robot.joints_rad then only places the arm the
+  // simulator renders when it has no trajectory.
+  if (joints_list.size() != kJointCount && c.robot_state.source == "fixed") {
     r.fail("robot.joints_rad", "is required for robot.model " + c.robot_model +
-                                   ": 6 joint angles in radians, joint 1 (base) first");
+                                   " with robot.state.source fixed: 6 joint angles in radians, joint 1 (base) first");
   }
   const int outside = joint_outside_limits(arm, joints_rad);
   if (outside >= 0) {

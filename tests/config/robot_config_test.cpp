@@ -344,3 +344,55 @@ TEST(RobotConfigErrors, DescriptionFilesNameFileAndField) {
 
 }  // namespace
 }  // namespace hrcsense
+
+namespace hrcsense {
+namespace {
+
+TEST(RobotStateConfig, DefaultsAreTheDocumentedOnes) {
+  const Config c = load_config("", {});
+  EXPECT_EQ(c.robot_state.source, "fixed");
+  EXPECT_EQ(c.robot_state.port, 30004);
+  EXPECT_DOUBLE_EQ(c.robot_state.frequency_hz, 125.0);
+  EXPECT_EQ(c.robot_state.listen, "127.0.0.1:30010");
+  EXPECT_DOUBLE_EQ(c.robot_state.history.max_age_s, 0.05);
+  EXPECT_DOUBLE_EQ(c.robot_state.camera_latency_s, 0.0);
+  EXPECT_DOUBLE_EQ(c.robot_state.sim_latency_s, 0.0);
+  EXPECT_DOUBLE_EQ(c.robot_state.sim_jitter_s, 0.0);
+}
+
+TEST(RobotStateConfig, KeysAreReadAndChecked) {
+  const Config c = load_config("", {"robot.state.source=rtde", "robot.state.host=192.168.1.10",
+                                    "robot.state.frequency_hz=500", "robot.state.max_age_s=0.02",
+                                    "robot.state.camera_latency_s=0.015"});
+  EXPECT_EQ(c.robot_state.source, "rtde");
+  EXPECT_EQ(c.robot_state.host, "192.168.1.10");
+  EXPECT_DOUBLE_EQ(c.robot_state.frequency_hz, 500.0);
+  EXPECT_DOUBLE_EQ(c.robot_state.history.max_age_s, 0.02);
+  EXPECT_DOUBLE_EQ(c.robot_state.camera_latency_s, 0.015);
+  test::expect_config_error("", {"robot.state.source=rtde"}, {"'robot.state.host'", "required"});
+  test::expect_config_error("", {"robot.state.source=ros"}, {"'robot.state.source'", "udp_json"});
+  test::expect_config_error("", {"robot.state.frequency_hz=501"}, {"'robot.state.frequency_hz'"});
+  test::expect_config_error("", {"robot.state.max_age_s=0"}, {"'robot.state.max_age_s'"});
+  for (const char* listen : {"30010", "127.0.0.1", "127.0.0.1:", "127.0.0.1:70000", ":30010", "host:3x"}) {
+    test::expect_config_error("", {std::string("robot.state.listen=") + listen}, {"'robot.state.listen'"});
+  }
+  test::expect_config_error("", {"robot.state.listen=localhost"}, {"'robot.state.listen'", "expected host:port"});
+}
+
+// An arm needs robot.joints_rad only with the fixed source: a live or simulated source brings
+// the joints itself.
+TEST(RobotStateConfig, JointsAreRequiredOnlyForTheFixedSource) {
+  test::expect_config_error("", {"robot.model=ur5"}, {"'robot.joints_rad'", "robot.state.source fixed"});
+  const Config live = load_config("", {"robot.model=ur5", "robot.state.source=udp_json"});
+  EXPECT_EQ(live.robot_state.source, "udp_json");
+  // The assembly says what this build lacks, naming the key.
+  try {
+    (void)make_robot_state_source(live);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "configuration: robot.state.source 'udp_json': not built into this hrcsense");
+  }
+}
+
+}  // namespace
+}  // namespace hrcsense
