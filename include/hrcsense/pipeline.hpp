@@ -3,6 +3,7 @@
 // interfaces it joins are in source.hpp, sink.hpp and mailbox.hpp.
 #pragma once
 
+#include "hrcsense/clock.hpp"
 #include "hrcsense/filters.hpp"
 #include "hrcsense/mailbox.hpp"
 #include "hrcsense/proximity.hpp"
@@ -87,6 +88,9 @@ struct RunOptions {
   bool pace = false;         ///< play at the source's timestamps; frames may then be dropped
   int64_t max_frames = -1;   ///< stop after this many source frames; -1: until the source ends
   std::atomic<bool>* stop_requested = nullptr;  ///< set from outside (SIGINT, SIGTERM, SIGHUP) to end the run
+  /// Decides pacing, frame ages, the watchdog and wall_s; null: the steady clock. Tests pass a
+  /// FakeClock. Must outlive the run.
+  RunClock* clock = nullptr;
 };
 
 /// Runs capture, processing and output on three threads joined by mailboxes. Unpaced runs

@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — the three threads around the processing path: capture, processing and output,
 // joined by single-slot mailboxes, with a watchdog and a stop result at the end of every run.
+// Every time decision asks the run's clock (RunOptions::clock), in integer nanoseconds.
 
 #include "hrcsense/pipeline.hpp"
 
 #include <algorithm>
-#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -15,16 +16,21 @@
 namespace hrcsense {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point since) {
-  return std::chrono::duration<double>(Clock::now() - since).count();
+// Seconds (safety.max_frame_age_s, a nominal period) as ns. Not positive or NaN: 0 (every
+// frame that took any time is then stale). At most 10^6 s, so that sums of run-clock times
+// stay far inside int64.
+int64_t seconds_to_ns(double s) {
+  constexpr double kMaxS = 1e6;
+  if (!(s > 0.0)) return 0;
+  return std::llround(std::min(s, kMaxS) * 1e9);
 }
 
-// A frame with the steady-clock time at which the source delivered it, for the frame's age.
+double ns_to_seconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
+
+// A frame with the run-clock time at which the source delivered it, for the frame's age.
 struct Captured {
   Frame frame;
-  Clock::time_point captured_at{};
+  int64_t captured_ns = 0;
   const char* timestamp_warning = nullptr;  ///< static text; null when the timestamp is in order
 };
 
@@ -90,31 +96,23 @@ const char* check_timestamp_step(int64_t step_ns, double nominal_fps, double max
 // positive (repeated or backwards timestamps, sources without timestamps) takes the nominal
 // period; a step longer than max_frame_age_s (a jump in the recording) is cut to
 // max_frame_age_s, so a replay never sleeps for days.
-Clock::duration pacing_step(int64_t step_ns, double nominal_fps, double max_frame_age_s) {
-  double step_s = static_cast<double>(step_ns) * 1e-9;
-  if (step_s <= 0.0) step_s = nominal_fps > 0.0 ? 1.0 / nominal_fps : 0.0;
-  step_s = std::min(step_s, max_frame_age_s);
-  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(step_s));
+int64_t pacing_step_ns(int64_t step_ns, double nominal_fps, int64_t max_frame_age_ns) {
+  if (step_ns <= 0) step_ns = nominal_fps > 0.0 ? seconds_to_ns(1.0 / nominal_fps) : 0;
+  return std::min(step_ns, max_frame_age_ns);
 }
 
 bool stop_requested(const RunOptions& options) {
   return options.stop_requested != nullptr && options.stop_requested->load();
 }
 
-// Sleeps until `due` in short slices, so that a stop request (SIGINT, SIGTERM) ends the wait.
-void sleep_until_interruptible(Clock::time_point due, const RunOptions& options) {
-  constexpr auto kSlice = std::chrono::milliseconds(20);
-  for (Clock::time_point now = Clock::now(); now < due && !stop_requested(options); now = Clock::now()) {
-    std::this_thread::sleep_for(std::min<Clock::duration>(due - now, kSlice));
-  }
-}
-
-// Reads the source until it ends, fails, or the run is stopped; then closes `frames`.
-void capture_loop(Source& source, const RunOptions& options, double max_frame_age_s, Mailbox<Captured>& frames,
-                  CaptureOutcome& outcome) {
+// Reads the source until it ends, fails, or the run is stopped; then closes `frames`. Paced
+// waits are the clock's sleep_until, which a stop request (SIGINT, SIGTERM) ends.
+void capture_loop(Source& source, const RunOptions& options, RunClock& clock, double max_frame_age_s,
+                  Mailbox<Captured>& frames, CaptureOutcome& outcome) {
   const double nominal_fps = source.info().nominal_fps;
+  const int64_t max_frame_age_ns = seconds_to_ns(max_frame_age_s);
   Captured slot;
-  Clock::time_point due{};  // paced: when the current frame is to be delivered
+  int64_t due_ns = 0;  // paced: when the current frame is to be delivered
   int64_t previous_ns = 0;
   for (int64_t n = 0;; ++n) {
     if (stop_requested(options)) {
@@ -148,10 +146,10 @@ void capture_loop(Source& source, const RunOptions& options, double max_frame_ag
     slot.timestamp_warning =
         n == 0 ? nullptr : check_timestamp_step(step_ns, nominal_fps, max_frame_age_s, outcome.timestamps);
     if (options.pace) {
-      due = n == 0 ? Clock::now() : due + pacing_step(step_ns, nominal_fps, max_frame_age_s);
-      sleep_until_interruptible(due, options);
+      due_ns = n == 0 ? clock.now_ns() : due_ns + pacing_step_ns(step_ns, nominal_fps, max_frame_age_ns);
+      clock.sleep_until(due_ns, options.stop_requested);
     }
-    slot.captured_at = Clock::now();
+    slot.captured_ns = clock.now_ns();
     // Paced: latest wins, a frame not yet taken is dropped and counted. Unpaced: wait for
     // processing. Either fails once processing is gone.
     if (!(options.pace ? frames.put(slot) : frames.put_wait(slot))) break;
@@ -167,22 +165,23 @@ struct ProcessingStats {
 };
 
 // Processes every frame it takes; a frame older than max_frame_age_s at the end of its
-// processing becomes a stop. Closes `results` when `frames` is closed and drained.
+// processing becomes a stop. Reads the clock once per frame, there (tests rely on it). Closes
+// `results` when `frames` is closed and drained.
 void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const RunOptions& options,
-                     double max_frame_age_s, Mailbox<Captured>& frames, Mailbox<FrameResult>& results,
-                     ProcessingStats& stats) {
+                     const RunClock& clock, double max_frame_age_s, Mailbox<Captured>& frames,
+                     Mailbox<FrameResult>& results, ProcessingStats& stats) {
+  const int64_t max_frame_age_ns = seconds_to_ns(max_frame_age_s);
   Captured in;
   FrameResult result;
   RobotState robot_state;
   try {
     while (frames.take(in)) {
       // The robot as it was when the frame was delivered; none is a stop (Pipeline::process).
-      const int64_t delivered_ns =
-          std::chrono::duration_cast<std::chrono::nanoseconds>(in.captured_at.time_since_epoch()).count();
-      if (!robot_states.state_at(delivered_ns, robot_state)) robot_state.valid = false;
+      if (!robot_states.state_at(in.captured_ns, robot_state)) robot_state.valid = false;
       pipeline.process(in.frame, robot_state, result);
       result.timestamp_warning = in.timestamp_warning;
-      if (!(seconds_since(in.captured_at) <= max_frame_age_s)) result.verdict = stop_verdict(ReasonCode::stale_frame, "stale frame");
+      const int64_t age_ns = clock.now_ns() - in.captured_ns;
+      if (age_ns > max_frame_age_ns) result.verdict = stop_verdict(ReasonCode::stale_frame, "stale frame");
       ++stats.processed;
       stats.latencies.add(result.latency_us);
       if (!(options.pace ? results.put(result) : results.put_wait(result))) break;  // the output ended
@@ -225,32 +224,52 @@ void tally(RunSummary& summary, const FrameResult& result) {
   }
 }
 
-// Writes every result; when none arrives within max_frame_age_s, writes a watchdog stop.
-// Ends early when the sink fails (a closed pipe, a full disk): closes `results` so that
+// Takes the next result into `out`, waiting until `deadline_ns` on `clock`. The wait is in
+// real-time slices of at most 10 ms with a look at the clock after each, so that the clock (a
+// fake one too) decides when the time is up; on the steady clock the last slice ends at the
+// deadline, as one wait would. A result that is there at the deadline still counts. False when
+// the deadline passed without one, or when `results` is closed and empty.
+bool take_until(Mailbox<FrameResult>& results, FrameResult& out, const RunClock& clock, int64_t deadline_ns) {
+  constexpr int64_t kSliceNs = 10'000'000;
+  for (;;) {
+    const int64_t left_ns = deadline_ns - clock.now_ns();
+    if (left_ns <= 0) return results.take_for(out, 0.0);
+    if (results.take_for(out, ns_to_seconds(std::min(left_ns, kSliceNs)))) return true;
+    if (results.closed()) return false;
+  }
+}
+
+// Writes every result; when none arrives within max_frame_age_s (on the run clock), writes a
+// watchdog stop, and another each max_frame_age_s after it. The wait for the next result
+// starts when the last write ended, at the one clock reading after each write (tests rely on
+// it). Ends early when the sink fails (a closed pipe, a full disk): closes `results` so that
 // processing and capture end too, and says why in `error`. Returns the last result written
 // (for the final stop's frame index).
-FrameResult output_loop(Sink& sink, double max_frame_age_s, Mailbox<FrameResult>& results, RunSummary& summary,
-                        std::string& error) {
+FrameResult output_loop(Sink& sink, const RunClock& clock, double max_frame_age_s, Mailbox<FrameResult>& results,
+                        RunSummary& summary, std::string& error) {
+  const int64_t max_frame_age_ns = seconds_to_ns(max_frame_age_s);
   FrameResult result, last, watchdog;
-  Clock::time_point last_arrival = Clock::now();
+  int64_t last_arrival_ns = clock.now_ns();
+  int64_t waiting_since_ns = last_arrival_ns;
   try {
     for (;;) {
       if (sink.failed()) {
         error = "output failed: " + sink.failure();
         break;
       }
-      if (results.take_for(result, max_frame_age_s)) {
+      if (take_until(results, result, clock, waiting_since_ns + max_frame_age_ns)) {
         sink.frame(result);
         tally(summary, result);
-        last_arrival = Clock::now();
+        last_arrival_ns = waiting_since_ns = clock.now_ns();
         std::swap(last, result);
         continue;
       }
       if (results.closed()) break;
       char reason[96];
-      std::snprintf(reason, sizeof reason, "no frame for %.3f s (max_frame_age_s %.3f)", seconds_since(last_arrival),
-                    max_frame_age_s);
+      std::snprintf(reason, sizeof reason, "no frame for %.3f s (max_frame_age_s %.3f)",
+                    ns_to_seconds(clock.now_ns() - last_arrival_ns), max_frame_age_s);
       write_stop(sink, watchdog, last, ReasonCode::no_frame, reason);
+      waiting_since_ns = clock.now_ns();
     }
   } catch (const std::exception& e) {
     error = std::string("output error: ") + e.what();
@@ -263,7 +282,9 @@ FrameResult output_loop(Sink& sink, double max_frame_age_s, Mailbox<FrameResult>
 
 RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline& pipeline, Sink& sink,
                         const RunOptions& options, const RunHeader& header) {
-  const Clock::time_point start = Clock::now();
+  SteadyClock steady;
+  RunClock& clock = options.clock != nullptr ? *options.clock : steady;
+  const int64_t start_ns = clock.now_ns();
   const double max_frame_age_s = pipeline.params().safety.max_frame_age_s;
   const int64_t expected = options.max_frames >= 0 ? options.max_frames : source.info().frame_count;
   // The latency log is a ring: a long or endless run keeps the most recent million frames.
@@ -277,9 +298,10 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
   std::string output_error;
 
   sink.header(header);
-  std::thread capture([&] { capture_loop(source, options, max_frame_age_s, frames, outcome); });
-  std::thread processing([&] { processing_loop(pipeline, robot_states, options, max_frame_age_s, frames, results, stats); });
-  const FrameResult last = output_loop(sink, max_frame_age_s, results, summary, output_error);
+  std::thread capture([&] { capture_loop(source, options, clock, max_frame_age_s, frames, outcome); });
+  std::thread processing(
+      [&] { processing_loop(pipeline, robot_states, options, clock, max_frame_age_s, frames, results, stats); });
+  const FrameResult last = output_loop(sink, clock, max_frame_age_s, results, summary, output_error);
   processing.join();
   capture.join();
 
@@ -307,7 +329,7 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
   try {
     FrameResult scratch;
     write_stop(sink, scratch, last, summary.end_code, outcome.final_reason);
-    summary.wall_s = seconds_since(start);
+    summary.wall_s = ns_to_seconds(clock.now_ns() - start_ns);
     summary.fps = summary.wall_s > 0.0 ? static_cast<double>(summary.frames_processed) / summary.wall_s : 0.0;
     sink.summary(summary);
   } catch (const std::exception& e) {

@@ -251,25 +251,28 @@ TEST(Failsafe, TimestampsOutOfOrderAreCountedAndMarked) {
 }
 
 // Item 8: a jump of 10^6 s in a paced recording is cut to max_frame_age_s (0.1 s here) instead
-// of a sleep of eleven days. If the wait were not bounded the test would never end; a guard
-// thread asks the run to stop after 30 s so that it fails instead.
+// of a sleep of eleven days. On a fake clock the waits take no real time and add up exactly:
+// 3 steps of 33'333'333 ns, then the jump cut to 100'000'000 ns.
 TEST(Failsafe, PacedJumpIsBoundedByMaxFrameAge) {
   std::vector<Step> steps(after_learning({{1.5F}, {1.5F}}));
   steps[4].timestamp_ns = 1'000'000 * 1'000'000'000LL;
   FakeSource source(steps);
   CollectingSink sink;
+  FakeClock clock;
   RunOptions options;
   options.pace = true;
-  std::atomic<bool> stop{false};
-  options.stop_requested = &stop;
+  options.clock = &clock;
   const RunSummary summary = run(source, sink, fake_params(0.1), options);
   EXPECT_EQ(summary.end_reason, "end of source");
   EXPECT_EQ(summary.frames_in, 5);
   EXPECT_EQ(summary.timestamps.jumps, 1);
+  EXPECT_EQ(clock.now_ns(), 3 * 33'333'333 + 100'000'000);
+  EXPECT_DOUBLE_EQ(summary.wall_s, 0.199999999);
 }
 
 // A paced wait is interruptible: with max_frame_age_s 60 s a 20 s step is waited for, and a
-// stop request (SIGINT, SIGTERM) during it ends the run at once.
+// stop request (SIGINT, SIGTERM) during it ends the run at once. On the steady clock: it is
+// its sleep that must end.
 struct StopOnFirstFrame : CollectingSink {
   std::atomic<bool>* stop = nullptr;
   void frame(const FrameResult& r) override {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Hand-built frames for the pipeline tests: a flat wall, optionally a square object in front
-// of it, seen by an undistorted 80x60 camera whose frame is the robot base frame.
+// of it, seen by an undistorted 80x60 camera whose frame is the robot base frame; a source and
+// a sink that tests can hold back, and a fake clock that tells the run's threads apart.
 #pragma once
 
 #include "hrcsense/pipeline.hpp"
@@ -8,6 +9,9 @@
 
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <functional>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -18,6 +22,9 @@ inline constexpr int kWidth = 80;
 inline constexpr int kHeight = 60;
 inline constexpr float kWallM = 2.0F;
 inline constexpr int kLearnFrames = 3;
+/// How long (real time) a test waits for a run's threads to get somewhere: a wait that times
+/// out fails the test instead of hanging it.
+inline constexpr double kTestWaitS = 10.0;
 
 inline Intrinsics fake_intrinsics() {
   Intrinsics intr;
@@ -71,7 +78,7 @@ inline PipelineParams fake_params(double max_frame_age_s = 0.5) {
 /// What the fake source does at one step.
 struct Step {
   float object_m = 0.0F;   ///< see fill_frame
-  double sleep_s = 0.0;    ///< before delivering
+  double sleep_s = 0.0;    ///< before delivering (real time)
   bool fail = false;       ///< report an error instead of a frame
   int64_t timestamp_ns = -1;  ///< >= 0: this timestamp instead of the index's 30 frames/s one
 };
@@ -89,6 +96,10 @@ class FakeSource : public Source {
   Status next(Frame& out) override {
     if (next_ >= steps_.size()) return Status::end;
     const Step& step = steps_[next_];
+    if (before_step && !before_step(next_)) {
+      error_ = "a test wait before step " + std::to_string(next_) + " timed out";
+      return Status::error;
+    }
     if (step.sleep_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(step.sleep_s));
     if (step.fail) return Status::error;
     fill_frame(static_cast<int64_t>(next_), step.object_m, out);
@@ -96,25 +107,43 @@ class FakeSource : public Source {
     ++next_;
     return Status::frame;
   }
-  std::string error() const override { return "cable unplugged"; }
+  std::string error() const override { return error_; }
+
+  /// Called on the capture thread before step `step` is delivered: where a test waits for the
+  /// run to get somewhere or moves its clock. False (a wait timed out): next() fails.
+  std::function<bool(size_t step)> before_step;
 
  private:
   std::vector<Step> steps_;
   size_t next_ = 0;
+  std::string error_ = "cable unplugged";
 };
 
-/// Keeps everything it is given.
+/// Keeps everything it is given. Other threads may wait for results (wait_until); `results`
+/// itself is for the output thread and for after the run.
 struct CollectingSink : Sink {
   RunHeader header_seen;
   std::vector<FrameResult> results;
   RunSummary summary_seen;
   int headers = 0, summaries = 0;
+  /// Called on the output thread before a result is kept: where a test holds the output back.
+  std::function<void(const FrameResult&)> before_frame;
 
   void header(const RunHeader& h) override {
     header_seen = h;
     ++headers;
   }
-  void frame(const FrameResult& r) override { results.push_back(r); }
+  void frame(const FrameResult& r) override {
+    if (before_frame) before_frame(r);
+    std::lock_guard<std::mutex> lock(mutex_);
+    results.push_back(r);
+    kept_.notify_all();
+  }
+  /// Waits (real time, at most `timeout_s`) until `done(results)`; false on timeout.
+  bool wait_until(const std::function<bool(const std::vector<FrameResult>&)>& done, double timeout_s = kTestWaitS) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    return kept_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return done(results); });
+  }
   void summary(const RunSummary& s) override {
     summary_seen = s;
     ++summaries;
@@ -127,6 +156,74 @@ struct CollectingSink : Sink {
     }
     return out;
   }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable kept_;
+};
+
+/// A FakeClock that tells the run's threads apart by who reads it. run_pipeline writes the
+/// output on the caller's thread (the one that built this clock) and reads the source on the
+/// capture thread (name it with capture_thread_is(), from FakeSource::before_step); any other
+/// reader is the processing thread, which reads the clock once per frame, at the end of
+/// processing it (the age check).
+class WatchedClock : public RunClock {
+ public:
+  mutable FakeClock fake;  ///< the time; the test moves it (and a slow frame's read does)
+
+  int64_t now_ns() const override {
+    const std::thread::id reader = std::this_thread::get_id();
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (reader == output_thread_) {
+      ++output_reads_;
+    } else if (reader != capture_thread_ && processing_reads_++ == slow_frame_) {
+      fake.advance(slow_frame_ns_);
+      slow_frame_done_ = true;
+    }
+    read_.notify_all();
+    return fake.now_ns();
+  }
+  void sleep_until(int64_t t_ns, const std::atomic<bool>* stop_requested) override {
+    fake.sleep_until(t_ns, stop_requested);
+  }
+  void capture_thread_is(std::thread::id id) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    capture_thread_ = id;
+  }
+  /// Processing frame `frame` (the frame-th one processed, from 0) takes `cost_ns` of fake
+  /// time: the processing thread's read at its end moves the clock on by that first.
+  void slow_processing(int64_t frame, int64_t cost_ns) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    slow_frame_ = frame;
+    slow_frame_ns_ = cost_ns;
+  }
+  /// Waits (real time, at most `timeout_s`) until the slow frame has taken its time.
+  bool wait_slow_frame(double timeout_s = kTestWaitS) const {
+    std::unique_lock<std::mutex> lock(mutex_);
+    return read_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return slow_frame_done_; });
+  }
+  /// How often the output thread has read the clock.
+  int64_t output_reads() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return output_reads_;
+  }
+  /// Waits (real time, at most `timeout_s`) until the output thread has read the clock more
+  /// than `count` times.
+  bool wait_output_reads_above(int64_t count, double timeout_s = kTestWaitS) const {
+    std::unique_lock<std::mutex> lock(mutex_);
+    return read_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return output_reads_ > count; });
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  mutable std::condition_variable read_;
+  std::thread::id output_thread_ = std::this_thread::get_id();
+  std::thread::id capture_thread_;
+  mutable int64_t output_reads_ = 0;
+  mutable int64_t processing_reads_ = 0;
+  int64_t slow_frame_ = -1;
+  int64_t slow_frame_ns_ = 0;
+  mutable bool slow_frame_done_ = false;
 };
 
 /// The background a pipeline learns from the empty fake scene (the wall at 2 m).

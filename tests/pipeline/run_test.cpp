@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
-// Tests of run_pipeline: threads, fail-safe stops, watchdog and summary, with a fake source.
+// Tests of run_pipeline: threads, fail-safe stops, watchdog and summary, with a fake source;
+// stalls, ages and pacing on a fake clock.
 
 #include "fake_scene.hpp"
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <string>
+#include <thread>
 
 namespace hrcsense {
 namespace {
@@ -129,32 +132,117 @@ TEST(RunPipeline, MaxFramesEndsTheRunWithStop) {
   EXPECT_EQ(summary.end_code, ReasonCode::frame_limit_reached);
 }
 
-TEST(RunPipeline, WatchdogStopsWhenTheSourceStalls) {
-  // The source stalls for 0.25 s before frame 4; max_frame_age_s is 0.1 s.
-  FakeSource source(after_learning({{1.5F}, {1.5F, 0.25}, {1.5F}}));
-  CollectingSink sink;
-  run(source, sink, fake_params(0.1));
-  size_t first_watchdog = sink.results.size();
-  for (size_t i = 0; i < sink.results.size(); ++i) {
-    if (sink.results[i].verdict.code == ReasonCode::no_frame) {
-      EXPECT_TRUE(starts_with(sink.results[i].verdict.reason, "no frame for"));
-      first_watchdog = std::min(first_watchdog, i);
-      EXPECT_EQ(sink.results[i].verdict.state, VerdictState::stop);
-      EXPECT_FALSE(sink.results[i].valid);
-      EXPECT_NE(sink.results[i].verdict.reason.find("max_frame_age_s 0.100"), std::string::npos);
-    }
-  }
-  ASSERT_LT(first_watchdog, sink.results.size()) << "no watchdog stop was written";
-  EXPECT_EQ(sink.results[first_watchdog - 1].frame, 3);  // it came after frame 3, before frame 4
-  // The run recovers: the frames after the stall are processed normally.
-  const std::vector<FrameResult> frames = sink.frame_results();
-  ASSERT_EQ(frames.size(), 6U);
-  EXPECT_EQ(frames[4].verdict.state, VerdictState::run);
-  EXPECT_EQ(frames[5].verdict.state, VerdictState::run);
+// Waits (real time, bounded) until the sink has `count` results; false on timeout.
+bool has_results(CollectingSink& sink, size_t count) {
+  return sink.wait_until([&](const std::vector<FrameResult>& results) { return results.size() >= count; });
 }
 
+// On a fake clock the source stalls before frame 4 for 0.25 s (max_frame_age_s 0.1 s). It
+// starts the stall once frame 3 is written and the output has looked at the clock since, and
+// ends it once the watchdog has written its stop; the clock does not move while it waits, so
+// there is exactly one, 0.25 s after frame 3.
+TEST(RunPipeline, WatchdogStopsWhenTheSourceStalls) {
+  test::WatchedClock clock;
+  FakeSource source(after_learning({{1.5F}, {1.5F}, {1.5F}}));
+  CollectingSink sink;
+  source.before_step = [&](size_t step) {
+    if (step != 4) return true;
+    if (!has_results(sink, 4) || !clock.wait_output_reads_above(clock.output_reads())) return false;
+    clock.fake.advance(250'000'000);
+    return sink.wait_until([](const std::vector<FrameResult>& results) {
+      return !results.empty() && results.back().verdict.code == ReasonCode::no_frame;
+    });
+  };
+  RunOptions options;
+  options.clock = &clock;
+  const RunSummary summary = run(source, sink, fake_params(0.1), options);
+
+  ASSERT_EQ(sink.results.size(), 8U);  // 6 frames, the watchdog's stop, the final stop
+  const FrameResult& watchdog = sink.results[4];
+  EXPECT_EQ(watchdog.verdict.code, ReasonCode::no_frame);
+  EXPECT_EQ(watchdog.verdict.state, VerdictState::stop);
+  EXPECT_EQ(watchdog.verdict.reason, "no frame for 0.250 s (max_frame_age_s 0.100)");
+  EXPECT_FALSE(watchdog.valid);
+  EXPECT_FALSE(watchdog.source_frame);
+  EXPECT_EQ(watchdog.frame, 3);  // it repeats the last frame's index
+  // The run recovers: the frames after the stall are processed normally, none of them stale.
+  const std::vector<FrameResult> frames = sink.frame_results();
+  ASSERT_EQ(frames.size(), 6U);
+  for (size_t i = 3; i < frames.size(); ++i) {
+    EXPECT_EQ(frames[i].frame, static_cast<int64_t>(i));
+    EXPECT_EQ(frames[i].verdict.state, VerdictState::run) << "frame " << i;
+  }
+  EXPECT_EQ(summary.verdict_run, 3);
+  EXPECT_EQ(summary.verdict_stop, 3);  // learning; the watchdog's stop is no frame's verdict
+  EXPECT_DOUBLE_EQ(summary.wall_s, 0.25);
+  EXPECT_EQ(sink.results.back().verdict.reason, "source ended");
+}
+
+// The same on the steady clock, with a real stall of 0.4 s (max_frame_age_s 0.1 s): at least
+// one watchdog stop comes after frame 3 and before frame 4. (How many, and whether a loaded
+// machine adds some elsewhere, is up to the scheduler; the fake clock's test counts them.)
+TEST(RunPipeline, WatchdogOnTheSteadyClockStopsWhenTheSourceStalls) {
+  FakeSource source(after_learning({{1.5F}, {1.5F, 0.4}, {1.5F}}));
+  CollectingSink sink;
+  run(source, sink, fake_params(0.1));
+  size_t after_3 = 0, before_4 = 0;
+  for (size_t i = 0; i < sink.results.size(); ++i) {
+    if (sink.results[i].source_frame && sink.results[i].frame == 3) after_3 = i;
+    if (sink.results[i].source_frame && sink.results[i].frame == 4) before_4 = i;
+  }
+  ASSERT_GT(before_4, after_3 + 1) << "no watchdog stop between frames 3 and 4";
+  for (size_t i = after_3 + 1; i < before_4; ++i) {
+    EXPECT_EQ(sink.results[i].verdict.code, ReasonCode::no_frame);
+    EXPECT_TRUE(starts_with(sink.results[i].verdict.reason, "no frame for")) << sink.results[i].verdict.reason;
+    EXPECT_NE(sink.results[i].verdict.reason.find("(max_frame_age_s 0.100)"), std::string::npos);
+  }
+  const std::vector<FrameResult> frames = sink.frame_results();
+  ASSERT_EQ(frames.size(), 6U);
+  EXPECT_EQ(frames[4].verdict.state, VerdictState::run) << frames[4].verdict.reason;
+}
+
+// On a fake clock, processing frame 4 takes 2 × max_frame_age_s (0.2 s): exactly that frame is
+// a stale stop. Frame 5 is read only after that time has passed (so it is not older by it),
+// and the output looks at the clock after frame 3 only then too (so the watchdog, which would
+// rightly count 0.2 s without a result as well, sees none: tested above).
+TEST(RunPipeline, FrameThatTakesTooLongToProcessIsStale) {
+  test::WatchedClock clock;
+  clock.slow_processing(4, 200'000'000);
+  FakeSource source(after_learning({{1.5F}, {1.5F}, {1.5F}}));
+  source.before_step = [&](size_t step) {
+    clock.capture_thread_is(std::this_thread::get_id());
+    return step != 5 || clock.wait_slow_frame();
+  };
+  CollectingSink sink;
+  sink.before_frame = [&](const FrameResult& r) {
+    if (r.frame == 3) {
+      EXPECT_TRUE(clock.wait_slow_frame());
+    }
+  };
+  RunOptions options;
+  options.clock = &clock;
+  const RunSummary summary = run(source, sink, fake_params(0.1), options);
+
+  ASSERT_EQ(sink.results.size(), 7U);  // no watchdog stop
+  for (size_t i = 0; i < 6; ++i) {
+    const FrameResult& r = sink.results[i];
+    EXPECT_EQ(r.frame, static_cast<int64_t>(i));
+    EXPECT_EQ(r.verdict.code == ReasonCode::stale_frame, i == 4) << "frame " << i << ": " << r.verdict.reason;
+    if (i == 3 || i == 5) {
+      EXPECT_EQ(r.verdict.state, VerdictState::run) << "frame " << i;
+    }
+  }
+  EXPECT_EQ(sink.results[4].verdict.state, VerdictState::stop);
+  EXPECT_EQ(sink.results[4].verdict.reason, "stale frame");
+  EXPECT_TRUE(sink.results[4].contact.valid);  // it was measured, but too late
+  EXPECT_EQ(summary.verdict_stop, 4);  // 3 learning + the stale one
+  EXPECT_EQ(summary.verdict_run, 2);
+  EXPECT_DOUBLE_EQ(summary.wall_s, 0.2);
+}
+
+// On the steady clock: no frame can be processed within 100 ns of its capture, every one is
+// stale.
 TEST(RunPipeline, StaleFrameIsStop) {
-  // No frame can be processed within 100 ns of its capture: every one is stale.
   FakeSource source(after_learning({{1.5F}, {1.5F}}));
   CollectingSink sink;
   const RunSummary summary = run(source, sink, fake_params(1e-7));
@@ -168,18 +256,72 @@ TEST(RunPipeline, StaleFrameIsStop) {
   EXPECT_EQ(summary.verdict_run, 0);
 }
 
+// Paced at the fake's 30 fps timestamps on a fake clock, whose sleeps take no real time: the
+// source delivers as fast as it can, faster than processing, so frames may be dropped;
+// whatever is dropped is counted, so every frame read is either written or counted as
+// dropped. The clock ends at the last frame's due time: 5 steps of 33'333'333 ns.
 TEST(RunPipeline, PacedRunCountsWhatItDrops) {
-  // Paced at the fake's 30 fps timestamps; whatever is dropped is counted, so every frame read
-  // is either written or counted as dropped.
   FakeSource source(after_learning({{1.5F}, {0.8F}, {1.5F}}));
   CollectingSink sink;
+  FakeClock clock;
   RunOptions options;
   options.pace = true;
+  options.clock = &clock;
   const RunSummary summary = run(source, sink, fake_params(), options);
   EXPECT_EQ(summary.frames_in, 6);
   const auto written = static_cast<int64_t>(sink.frame_results().size());
   EXPECT_EQ(written + summary.frames_dropped, summary.frames_in);
   EXPECT_EQ(sink.results.back().verdict.reason, "source ended");
+  EXPECT_EQ(clock.now_ns(), 5 * 33'333'333);
+  EXPECT_DOUBLE_EQ(summary.wall_s, 0.166666665);
+}
+
+// A paced run of 31 frames at 30 frames/s on a fake clock takes 30 periods of fake time. The
+// source reads frame k only once frame k-1 is written, so nothing is dropped, nothing is
+// stale (each frame is processed before the clock moves on) and the watchdog (0.5 s) is
+// quiet: the output is exactly the 31 frames and the final stop.
+TEST(RunPipeline, PacedRunTakesItsTimestampsTimeOnAFakeClock) {
+  FakeSource source(std::vector<Step>(31, Step{}));
+  CollectingSink sink;
+  source.before_step = [&](size_t step) { return has_results(sink, step); };
+  FakeClock clock(1'000'000'000);  // any origin
+  RunOptions options;
+  options.pace = true;
+  options.clock = &clock;
+  const RunSummary summary = run(source, sink, fake_params(), options);
+  EXPECT_EQ(summary.frames_in, 31);
+  EXPECT_EQ(summary.frames_processed, 31);
+  EXPECT_EQ(summary.frames_dropped, 0);
+  ASSERT_EQ(sink.results.size(), 32U);
+  for (size_t i = 0; i < 31; ++i) {
+    EXPECT_EQ(sink.results[i].frame, static_cast<int64_t>(i));
+    EXPECT_EQ(sink.results[i].verdict.code, i < 3 ? ReasonCode::learning_background : ReasonCode::no_foreground) << i;
+  }
+  EXPECT_EQ(clock.now_ns(), 1'000'000'000 + 30 * 33'333'333);
+  EXPECT_DOUBLE_EQ(summary.wall_s, 0.99999999);
+  EXPECT_DOUBLE_EQ(summary.fps, 31 / 0.99999999);
+}
+
+// Paced waits on a fake clock take no real time: 3 steps of 20 s (max_frame_age_s 60 s) are
+// a minute of fake time, and the run is over in far less real time than that.
+TEST(RunPipeline, PacedWaitsOnAFakeClockTakeNoRealTime) {
+  std::vector<Step> steps(4, Step{});
+  for (size_t i = 0; i < steps.size(); ++i) steps[i].timestamp_ns = static_cast<int64_t>(i) * 20'000'000'000;
+  FakeSource source(steps);
+  CollectingSink sink;
+  source.before_step = [&](size_t step) { return has_results(sink, step); };
+  FakeClock clock;
+  RunOptions options;
+  options.pace = true;
+  options.clock = &clock;
+  const auto real_start = std::chrono::steady_clock::now();
+  const RunSummary summary = run(source, sink, fake_params(60.0), options);
+  const double real_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - real_start).count();
+  EXPECT_EQ(summary.frames_in, 4);
+  EXPECT_EQ(summary.frames_dropped, 0);
+  EXPECT_EQ(clock.now_ns(), 60'000'000'000);
+  EXPECT_DOUBLE_EQ(summary.wall_s, 60.0);
+  EXPECT_LT(real_s, 30.0);
 }
 
 TEST(RunPipeline, StopRequestEndsTheRun) {
