@@ -98,6 +98,7 @@ RunHeader make_run_header(const Config& config, const SourceInfo& info) {
   RunHeader header;
   header.config_hash = config_hash(config);
   header.source = info;
+  header.robot_state = config.robot_state.source;
   RunHeader::Filters& filters = header.filters;
   const FilterChainParams& chain = config.pipeline.filters;
   filters.preset = config.filters_preset;

@@ -86,6 +86,7 @@ int run_command(const CommandArgs& args) {
 
   RunOptions options;
   options.pace = config.source.pace;
+  options.camera_latency_s = config.robot_state.camera_latency_s;
   options.max_frames = args.frames;
   options.stop_requested = &g_stop_requested;
   install_signal_handlers();

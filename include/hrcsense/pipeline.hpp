@@ -91,11 +91,18 @@ struct RunOptions {
   /// Decides pacing, frame ages, the watchdog and wall_s; null: the steady clock. Tests pass a
   /// FakeClock. Must outlive the run.
   RunClock* clock = nullptr;
+  /// `robot.state.camera_latency_s`: the robot state is looked up this much before the frame's
+  /// host time (positive: the camera's image is older than its stamp says).
+  double camera_latency_s = 0.0;
 };
 
 /// Runs capture, processing and output on three threads joined by mailboxes. Unpaced runs
 /// process every frame (the source waits for processing); paced runs drop and count.
-/// Each frame gets the robot state `robot_states` has for the time the frame was delivered.
+/// Each frame gets the robot state `robot_states` has at the frame's host time minus
+/// camera_latency_s. The host time is the source's own (a live camera's capture time) when it
+/// sets Frame::host_time_ns; else the delivery time on the run's clock for paced runs and
+/// live robot states, and the source timestamp for unpaced runs with a `fixed` or `sim` state
+/// (docs/ROBOT.md, "Clocks").
 /// Writes header, every result and the summary to `sink`; returns the summary.
 RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline& pipeline, Sink& sink,
                         const RunOptions& options, const RunHeader& header);

@@ -31,7 +31,7 @@ struct RobotStateCounts {
 
 /// The state for one frame, with how it was found.
 struct RobotStateLookup {
-  RobotState state;           ///< valid false for no_robot_state / robot_state_stale
+  RobotState state;           ///< valid false for no_robot_state / robot_state_stale; sample_time_ns the newest sample's
   ReasonCode code = ReasonCode::no_robot_state;  ///< clear when valid
   double age_ms = 0.0;        ///< frame time minus the newest sample's time, ≥ 0
   bool extrapolated = false;  ///< the frame is past the newest sample: q moved on with qd

@@ -3,6 +3,7 @@
 // UDP, DDS, the recorder and the viewer), with what a run says before and after its frames.
 #pragma once
 
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/source.hpp"
 #include "hrcsense/types.hpp"
 
@@ -17,6 +18,7 @@ struct RunHeader {
   std::string commit;   ///< empty: likewise the commit
   std::string config_hash;
   SourceInfo source;
+  std::string robot_state;  ///< `robot.state.source` (fixed, sim, rtde, udp_json); empty: not written
   /// The depth filters as they run: `filters.preset`, the domain of filter_domain(), a note
   /// when the domain is not the one the preset asks for, and the filtered resolution.
   struct Filters {
@@ -55,6 +57,7 @@ struct RunSummary {
   /// normally (end of source, frame limit, stop requested). The app exits 1 when set.
   std::string error;
   TimestampCounts timestamps;     ///< source timestamps out of order
+  RobotStateStats robot_state;    ///< the robot state source's counters
 };
 
 /// A consumer of results. The other virtual interface of hrcsense.

@@ -98,6 +98,10 @@ struct GroundTruth {
 struct Frame {
   int64_t index = 0;                 ///< 0-based index of the frame in its source
   int64_t timestamp_ns = 0;          ///< capture time; integer so recordings round-trip exactly
+  /// The frame's time on the host's monotonic clock (ns), what the robot state is looked up
+  /// at: a live source sets it (its capture time mapped to the host clock); 0 leaves it to
+  /// run_pipeline (docs/ROBOT.md, "Clocks").
+  int64_t host_time_ns = 0;
   DepthImage depth;
   Intrinsics intrinsics;             ///< of the depth image
   float stereo_baseline_mm = 0.0F;   ///< 0 when the source does not know it
@@ -157,6 +161,10 @@ enum class RobotStateOrigin { fixed, sim, rtde, udp_json, recorded };
 /// what Pipeline::process builds the robot's capsules from.
 struct RobotState {
   int64_t host_time_ns = 0;   ///< when the state held, on the host's monotonic clock (0: any time, `fixed`)
+  /// The newest sample this state was read from (interpolated or extrapolated from): the
+  /// frame's robot_state_age_ms is measured from it. 0 for a state that ages not (`fixed`); a
+  /// state that is invalid with a sample time is stale rather than missing.
+  int64_t sample_time_ns = 0;
   JointAngles q_rad{};        ///< joint angles
   JointAngles qd_rad_s{};     ///< joint velocities
   bool valid = false;         ///< false: no state (never measured, lost, rejected); the frame is a stop
@@ -231,6 +239,9 @@ struct FrameResult {
   float valid_share = 0.0F;
   std::vector<StageTiming> timings;
   RobotState robot_state;        ///< the state the robot's capsules were built from
+  int64_t host_time_ns = 0;      ///< the frame's host time (Frame::host_time_ns as the run set it)
+  /// Frame host time minus robot_state.sample_time_ns, ≥ 0; 0 for a state that ages not.
+  double robot_state_age_ms = 0.0;
   std::optional<Contact> truth;  ///< simulated sources: ground-truth contact
   double latency_us = 0.0;       ///< from the frame entering processing to the result
   /// The proximity backend that searched this frame (static name, e.g. "octree" when `auto`

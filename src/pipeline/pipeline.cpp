@@ -58,6 +58,11 @@ void timed(FrameResult& result, const char* name, Stage&& stage) {
 void begin_result(const Frame& frame, const RobotState& robot_state, FrameResult& result) {
   result.frame = frame.index;
   result.robot_state = robot_state;
+  result.host_time_ns = frame.host_time_ns;
+  result.robot_state_age_ms =
+      robot_state.sample_time_ns > 0
+          ? static_cast<double>(std::max<int64_t>(0, frame.host_time_ns - robot_state.sample_time_ns)) * 1e-6
+          : 0.0;
   result.timestamp_ns = frame.timestamp_ns;
   result.valid = false;
   result.contact = Contact{};
@@ -178,7 +183,15 @@ void Pipeline::process(const Frame& source_frame, const RobotState& robot_state,
     return finish_stop(result, ReasonCode::background_mismatch, "background size mismatch", start);
   }
   if (!background_checked(frame, result)) return finish(result, start);
-  if (!robot_state.valid) return finish_stop(result, ReasonCode::no_robot_state, "no robot state", start);
+  if (!robot_state.valid) {
+    // A state with a sample time had samples that are now too old; one without never had any.
+    if (robot_state.sample_time_ns > 0) {
+      char text[64];
+      std::snprintf(text, sizeof text, "robot state stale (%.1f ms old)", result.robot_state_age_ms);
+      return finish_stop(result, ReasonCode::robot_state_stale, text, start);
+    }
+    return finish_stop(result, ReasonCode::no_robot_state, "no robot state", start);
+  }
   if (!all_finite(robot_state.q_rad)) {
     return finish_stop(result, ReasonCode::non_finite_input, "non-finite joint angle in the robot state", start);
   }

@@ -108,7 +108,7 @@ bool stop_requested(const RunOptions& options) {
 // Reads the source until it ends, fails, or the run is stopped; then closes `frames`. Paced
 // waits are the clock's sleep_until, which a stop request (SIGINT, SIGTERM) ends.
 void capture_loop(Source& source, const RunOptions& options, RunClock& clock, double max_frame_age_s,
-                  Mailbox<Captured>& frames, CaptureOutcome& outcome) {
+                  bool host_time_is_source_time, Mailbox<Captured>& frames, CaptureOutcome& outcome) {
   const double nominal_fps = source.info().nominal_fps;
   const int64_t max_frame_age_ns = seconds_to_ns(max_frame_age_s);
   Captured slot;
@@ -127,6 +127,7 @@ void capture_loop(Source& source, const RunOptions& options, RunClock& clock, do
     }
     Source::Status status = Source::Status::error;
     std::string error;
+    slot.frame.host_time_ns = 0;  // the buffer is reused: only a live source sets it again
     try {
       status = source.next(slot.frame);
       if (status == Source::Status::error) error = source.error();
@@ -150,6 +151,9 @@ void capture_loop(Source& source, const RunOptions& options, RunClock& clock, do
       clock.sleep_until(due_ns, options.stop_requested);
     }
     slot.captured_ns = clock.now_ns();
+    if (slot.frame.host_time_ns == 0) {
+      slot.frame.host_time_ns = host_time_is_source_time ? slot.frame.timestamp_ns : slot.captured_ns;
+    }
     // Paced: latest wins, a frame not yet taken is dropped and counted. Unpaced: wait for
     // processing. Either fails once processing is gone.
     if (!(options.pace ? frames.put(slot) : frames.put_wait(slot))) break;
@@ -171,13 +175,14 @@ void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const R
                      const RunClock& clock, double max_frame_age_s, Mailbox<Captured>& frames,
                      Mailbox<FrameResult>& results, ProcessingStats& stats) {
   const int64_t max_frame_age_ns = seconds_to_ns(max_frame_age_s);
+  const int64_t camera_latency_ns = std::llround(options.camera_latency_s * 1e9);
   Captured in;
   FrameResult result;
   RobotState robot_state;
   try {
     while (frames.take(in)) {
-      // The robot as it was when the frame was delivered; none is a stop (Pipeline::process).
-      if (!robot_states.state_at(in.captured_ns, robot_state)) robot_state.valid = false;
+      // The robot as it was when the camera saw the frame; none is a stop (Pipeline::process).
+      if (!robot_states.state_at(in.frame.host_time_ns - camera_latency_ns, robot_state)) robot_state.valid = false;
       pipeline.process(in.frame, robot_state, result);
       result.timestamp_warning = in.timestamp_warning;
       const int64_t age_ns = clock.now_ns() - in.captured_ns;
@@ -199,6 +204,9 @@ void write_stop(Sink& sink, FrameResult& scratch, const FrameResult& last, Reaso
   scratch.source_frame = false;
   scratch.frame = last.frame;
   scratch.timestamp_ns = last.timestamp_ns;
+  scratch.host_time_ns = last.host_time_ns;
+  scratch.robot_state = RobotState{};  // a stop that stands for no frame measured against no robot
+  scratch.robot_state_age_ms = 0.0;
   scratch.valid = false;
   scratch.verdict = stop_verdict(code, reason);
   scratch.contact = Contact{};
@@ -298,7 +306,13 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
   std::string output_error;
 
   sink.header(header);
-  std::thread capture([&] { capture_loop(source, options, clock, max_frame_age_s, frames, outcome); });
+  // Unpaced runs of files and the simulator against a fixed or simulated arm live on the
+  // source's timeline; anything paced or live on the host's.
+  const RobotStateOrigin origin = robot_states.origin();
+  const bool host_time_is_source_time =
+      !options.pace && (origin == RobotStateOrigin::fixed || origin == RobotStateOrigin::sim);
+  std::thread capture(
+      [&] { capture_loop(source, options, clock, max_frame_age_s, host_time_is_source_time, frames, outcome); });
   std::thread processing(
       [&] { processing_loop(pipeline, robot_states, options, clock, max_frame_age_s, frames, results, stats); });
   const FrameResult last = output_loop(sink, clock, max_frame_age_s, results, summary, output_error);
@@ -321,6 +335,7 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
   summary.frames_processed = stats.processed;
   summary.frames_dropped = frames.dropped() + results.dropped();
   summary.timestamps = outcome.timestamps;
+  summary.robot_state = robot_states.stats();
   summary.end_reason = outcome.end_reason;
   summary.latency_p50_us = stats.latencies.percentile(0.50);
   summary.latency_p99_us = stats.latencies.percentile(0.99);

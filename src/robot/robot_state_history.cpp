@@ -59,6 +59,7 @@ RobotStateLookup RobotStateHistory::at(int64_t host_time_ns) const {
   if (size_ == 0) return out;  // no_robot_state
   const RobotState& last = newest();
   out.state.origin = last.origin;
+  out.state.sample_time_ns = last.host_time_ns;
   const int64_t age_ns = std::max<int64_t>(0, host_time_ns - last.host_time_ns);
   out.age_ms = static_cast<double>(age_ns) * 1e-6;
   if (!(seconds(age_ns) <= params.max_age_s)) {

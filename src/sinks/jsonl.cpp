@@ -184,6 +184,7 @@ void JsonLinesSink::header(const RunHeader& header) {
   m.text("version", header.version.empty() ? HRCSENSE_VERSION : header.version);
   m.text("commit", header.commit.empty() ? HRCSENSE_COMMIT : header.commit);
   m.text("config_hash", header.config_hash);
+  if (!header.robot_state.empty()) m.text("robot_state", header.robot_state);
 
   const SourceInfo& source = header.source;
   m.open("source");
@@ -242,6 +243,20 @@ void JsonLinesSink::frame(const FrameResult& result) {
   m.integer("foreground_points", static_cast<int64_t>(result.foreground_points));
   m.integer("invalid_pixels", static_cast<int64_t>(result.invalid_pixels));
   m.number("valid_share", result.valid_share);
+  m.integer("host_time_ns", result.host_time_ns);
+  // The joints the robot's capsules were built from; null without a valid robot state.
+  put_key(line_, "joints_rad");
+  if (result.robot_state.valid) {
+    line_ += '[';
+    for (size_t j = 0; j < kJointCount; ++j) {
+      if (j > 0) line_ += ',';
+      put_double(line_, result.robot_state.q_rad[j]);
+    }
+    line_ += ']';
+  } else {
+    line_ += "null";
+  }
+  m.number("robot_state_age_ms", result.robot_state_age_ms);
   m.number("latency_us", result.latency_us);
   m.open("timings_us");
   for (const StageTiming& timing : result.timings) m.number(timing.stage, timing.us);
@@ -285,6 +300,21 @@ void JsonLinesSink::summary(const RunSummary& summary) {
   m.integer("timestamp_gaps", summary.timestamps.gaps);
   m.integer("frames_skipped_source", summary.timestamps.frames_skipped);
   m.integer("timestamp_jumps", summary.timestamps.jumps);
+  const RobotStateStats& robot = summary.robot_state;
+  m.open("robot_state");
+  m.integer("accepted", robot.samples.accepted);
+  m.integer("rejected_non_finite", robot.samples.rejected_non_finite);
+  m.integer("rejected_backwards", robot.samples.rejected_backwards);
+  m.integer("rejected_jump", robot.samples.rejected_jump);
+  m.integer("connections", robot.connections);
+  m.integer("disconnects", robot.disconnects);
+  m.integer("malformed", robot.malformed);
+  if (robot.last_problem.empty()) {
+    m.null("last_problem");
+  } else {
+    m.text("last_problem", robot.last_problem);
+  }
+  m.close();
   line_ += "}\n";
   write_line();
 }

@@ -5,6 +5,7 @@
 
 #include "fake_scene.hpp"
 
+#include "hrcsense/clock.hpp"
 #include "hrcsense/robot_state.hpp"
 
 #include <gtest/gtest.h>
@@ -176,6 +177,113 @@ TEST(RobotStatePerFrame, RunAsksTheSourceForEveryFrame) {
   EXPECT_EQ(results[4].verdict.code, ReasonCode::no_robot_state);
   EXPECT_EQ(results[5].verdict.code, ReasonCode::no_foreground);
   EXPECT_EQ(results[3].robot_state.origin, RobotStateOrigin::udp_json);
+}
+
+// A state whose newest sample is too old is stale, not missing: another reason code, and the
+// age in the result (frame host time 1.08 s, sample at 1.0 s: 80 ms).
+TEST(RobotStatePerFrame, StaleStateSaysHowOld) {
+  Pipeline pipeline(stick_params());
+  learn(pipeline);
+  Frame frame;
+  FrameResult result;
+  fill_frame(3, 0.0F, frame);
+  frame.host_time_ns = 1'080'000'000;
+  RobotState stale = joints(0.0);
+  stale.valid = false;
+  stale.sample_time_ns = 1'000'000'000;
+  pipeline.process(frame, stale, result);
+  EXPECT_EQ(result.verdict.state, VerdictState::stop);
+  EXPECT_EQ(result.verdict.code, ReasonCode::robot_state_stale);
+  EXPECT_EQ(result.verdict.reason, "robot state stale (80.0 ms old)");
+  EXPECT_DOUBLE_EQ(result.robot_state_age_ms, 80.0);
+  EXPECT_EQ(result.host_time_ns, 1'080'000'000);
+  // A valid state 4 ms old: measured, with its age.
+  RobotState fresh = joints(0.0);
+  fresh.sample_time_ns = 1'076'000'000;
+  pipeline.process(frame, fresh, result);
+  EXPECT_EQ(result.verdict.code, ReasonCode::no_foreground);
+  EXPECT_DOUBLE_EQ(result.robot_state_age_ms, 4.0);
+}
+
+// Records the times it is asked for; answers like a live source (origin rtde) or a fixed one.
+class AskedTimes final : public RobotStateSource {
+ public:
+  explicit AskedTimes(RobotStateOrigin origin) : origin_(origin) {}
+  RobotStateOrigin origin() const override { return origin_; }
+  bool state_at(int64_t host_time_ns, RobotState& out) override {
+    asked_ns.push_back(host_time_ns);
+    out = joints(0.0);
+    out.host_time_ns = host_time_ns;
+    return true;
+  }
+  std::vector<int64_t> asked_ns;
+
+ private:
+  RobotStateOrigin origin_;
+};
+
+// Unpaced with a fixed arm: the frames live on the source's timeline, so the state is asked
+// for at each timestamp (index · 33 333 333 ns) minus robot.state.camera_latency_s (10 ms), and
+// host_time_ns is the timestamp.
+TEST(RobotStateClocks, UnpacedFixedRunUsesTheSourceTimeMinusTheCameraLatency) {
+  test::FakeSource source({test::Step{}, test::Step{}, test::Step{}, test::Step{}});
+  AskedTimes robot_states(RobotStateOrigin::fixed);
+  Pipeline pipeline(stick_params());
+  test::CollectingSink sink;
+  FakeClock clock(500'000'000'000);
+  RunOptions options;
+  options.clock = &clock;
+  options.camera_latency_s = 0.010;
+  run_pipeline(source, robot_states, pipeline, sink, options, RunHeader{});
+  ASSERT_EQ(robot_states.asked_ns.size(), 4U);
+  const std::vector<FrameResult> results = sink.frame_results();
+  ASSERT_EQ(results.size(), 4U);
+  for (int64_t i = 0; i < 4; ++i) {
+    const size_t k = static_cast<size_t>(i);
+    EXPECT_EQ(robot_states.asked_ns[k], i * 33'333'333 - 10'000'000) << i;
+    EXPECT_EQ(results[k].host_time_ns, i * 33'333'333) << i;
+  }
+}
+
+// With a live robot state the frames of a file are stamped when delivered, on the run's clock:
+// the fake clock does not move, so every frame is at its start time.
+TEST(RobotStateClocks, LiveStateUsesTheDeliveryTime) {
+  test::FakeSource source({test::Step{}, test::Step{}, test::Step{}});
+  AskedTimes robot_states(RobotStateOrigin::rtde);
+  Pipeline pipeline(stick_params());
+  test::CollectingSink sink;
+  FakeClock clock(500'000'000'000);
+  RunOptions options;
+  options.clock = &clock;
+  run_pipeline(source, robot_states, pipeline, sink, options, RunHeader{});
+  ASSERT_EQ(robot_states.asked_ns.size(), 3U);
+  for (const int64_t t : robot_states.asked_ns) EXPECT_EQ(t, 500'000'000'000);
+  for (const FrameResult& r : sink.frame_results()) EXPECT_EQ(r.host_time_ns, 500'000'000'000);
+}
+
+// A source that stamps host time itself (a live camera) keeps it.
+class HostStampedSource final : public Source {
+ public:
+  SourceInfo info() const override { return inner_.info(); }
+  Status next(Frame& out) override {
+    const Status status = inner_.next(out);
+    if (status == Status::frame) out.host_time_ns = 7'000'000'000 + out.index;
+    return status;
+  }
+
+ private:
+  test::FakeSource inner_{{test::Step{}, test::Step{}}};
+};
+
+TEST(RobotStateClocks, ASourceHostTimeIsKept) {
+  HostStampedSource source;
+  AskedTimes robot_states(RobotStateOrigin::rtde);
+  Pipeline pipeline(stick_params());
+  test::CollectingSink sink;
+  run_pipeline(source, robot_states, pipeline, sink, RunOptions{}, RunHeader{});
+  ASSERT_EQ(robot_states.asked_ns.size(), 2U);
+  EXPECT_EQ(robot_states.asked_ns[0], 7'000'000'000);
+  EXPECT_EQ(robot_states.asked_ns[1], 7'000'000'001);
 }
 
 }  // namespace

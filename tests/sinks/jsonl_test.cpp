@@ -54,6 +54,10 @@ FrameResult contact_result() {
   r.invalid_pixels = 17;
   r.latency_us = 812.5;
   r.timings = {{"foreground", 700.25}, {"proximity", 4.5}};
+  r.host_time_ns = 9'000'000'123;
+  r.robot_state.valid = true;
+  r.robot_state.q_rad = {2.2, -1.5, 1.4, -1.7, -1.5708, 0.125};
+  r.robot_state_age_ms = 3.5;
   Contact truth;
   truth.valid = true;
   truth.distance_m = 0.725F;
@@ -69,6 +73,7 @@ TEST(JsonLinesSink, HeaderCarriesVersionSourceAndIntrinsics) {
   header.version = "9.8.7";
   header.commit = "abc123";
   header.config_hash = "0123456789abcdef";
+  header.robot_state = "udp_json";
   header.source.type = "sim";
   header.source.description = "a scene";
   header.source.frame_count = 400;
@@ -92,6 +97,7 @@ TEST(JsonLinesSink, HeaderCarriesVersionSourceAndIntrinsics) {
   EXPECT_EQ(h["version"], "9.8.7");
   EXPECT_EQ(h["commit"], "abc123");
   EXPECT_EQ(h["config_hash"], "0123456789abcdef");
+  EXPECT_EQ(h["robot_state"], "udp_json");
   EXPECT_EQ(h["source"]["type"], "sim");
   EXPECT_EQ(h["source"]["description"], "a scene");
   EXPECT_EQ(h["source"]["frame_count"], 400);
@@ -140,6 +146,9 @@ TEST(JsonLinesSink, FrameWithContactHasEveryField) {
   EXPECT_EQ(f["timings_us"]["proximity"].get<double>(), 4.5);
   EXPECT_EQ(f["truth"]["distance_m"].get<float>(), 0.725F);
   expect_vec3(f["truth"]["closest_base"], {-1.5F, 2.0F, 0.301F});
+  EXPECT_EQ(f["host_time_ns"].get<int64_t>(), 9'000'000'123);
+  EXPECT_EQ(f["joints_rad"].get<std::vector<double>>(), (std::vector<double>{2.2, -1.5, 1.4, -1.7, -1.5708, 0.125}));
+  EXPECT_EQ(f["robot_state_age_ms"].get<double>(), 3.5);
 }
 
 TEST(JsonLinesSink, FrameWithoutContactWritesNulls) {
@@ -150,6 +159,7 @@ TEST(JsonLinesSink, FrameWithoutContactWritesNulls) {
   r.truth->valid = false;
   r.timings.clear();
   r.timestamp_ns = 3'000'000'000;
+  r.robot_state.valid = false;
   sink.frame(r);
   r.truth.reset();  // a source without ground truth: no truth member at all
   sink.frame(r);
@@ -166,6 +176,7 @@ TEST(JsonLinesSink, FrameWithoutContactWritesNulls) {
   EXPECT_TRUE(f["truth"]["distance_m"].is_null());
   EXPECT_TRUE(f["truth"]["closest_base"].is_null());
   EXPECT_FALSE(lines[1].contains("truth"));
+  EXPECT_TRUE(f["joints_rad"].is_null());  // no valid robot state
 }
 
 TEST(JsonLinesSink, SummaryHasEveryRunSummaryField) {
@@ -190,6 +201,14 @@ TEST(JsonLinesSink, SummaryHasEveryRunSummaryField) {
   s.timestamps.gaps = 4;
   s.timestamps.frames_skipped = 9;
   s.timestamps.jumps = 1;
+  s.robot_state.samples.accepted = 1000;
+  s.robot_state.samples.rejected_non_finite = 1;
+  s.robot_state.samples.rejected_backwards = 2;
+  s.robot_state.samples.rejected_jump = 3;
+  s.robot_state.connections = 2;
+  s.robot_state.disconnects = 1;
+  s.robot_state.malformed = 4;
+  s.robot_state.last_problem = "127.0.0.1:40000: q: expected 6 numbers";
   sink.summary(s);
   s.min_distance_m = -1.0F;
   s.error = "processing error: std::bad_alloc";
@@ -218,6 +237,15 @@ TEST(JsonLinesSink, SummaryHasEveryRunSummaryField) {
   EXPECT_EQ(j["timestamp_gaps"], 4);
   EXPECT_EQ(j["frames_skipped_source"], 9);
   EXPECT_EQ(j["timestamp_jumps"], 1);
+  const json& robot = j["robot_state"];
+  EXPECT_EQ(robot["accepted"], 1000);
+  EXPECT_EQ(robot["rejected_non_finite"], 1);
+  EXPECT_EQ(robot["rejected_backwards"], 2);
+  EXPECT_EQ(robot["rejected_jump"], 3);
+  EXPECT_EQ(robot["connections"], 2);
+  EXPECT_EQ(robot["disconnects"], 1);
+  EXPECT_EQ(robot["malformed"], 4);
+  EXPECT_EQ(robot["last_problem"], "127.0.0.1:40000: q: expected 6 numbers");
   EXPECT_TRUE(lines[1]["min_distance_m"].is_null());  // never any foreground
   EXPECT_EQ(lines[1]["error"], "processing error: std::bad_alloc");
 }
