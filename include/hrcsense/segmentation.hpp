@@ -58,12 +58,35 @@ struct BackgroundParams {
   float max_noise_per_z2 = 0.01F;
   /// Stereo noise model used for σ_model(z) (subpixel RMS in px; baseline from the frame).
   float subpixel_rms_px = 0.08F;
+  /// `background.motion_max_distance_m`: with a MotionRegion, motion counts only where the
+  /// moving pixel's mean lies within this distance of the robot's capsules (and inside the
+  /// workspace): what matters for safety is motion near the robot, not at the far wall.
+  float motion_max_distance_m = 2.0F;
   /// A background loaded from a file is compared with this many first frames before it is
   /// trusted (BackgroundCheck); 0 trusts it at once (tests only).
   int check_frames = 5;
   /// The loaded background is refused when more than this share of the compared pixels are
   /// measured farther than it (BackgroundCheck).
   float check_max_farther_share = 0.05F;
+};
+
+/// Axis-aligned box in the base frame.
+struct AlignedBox {
+  Eigen::Vector3f min = Eigen::Vector3f::Constant(-1e9F);
+  Eigen::Vector3f max = Eigen::Vector3f::Constant(1e9F);
+  bool contains(const Eigen::Vector3f& p) const {
+    return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
+  }
+};
+
+/// Where motion during learning counts (BackgroundLearner::add): near the robot and inside the
+/// workspace, base frame. Pixels that move elsewhere do not restart learning; their background
+/// becomes unknown instead (foreground wherever it lies in the workspace, like an unseen
+/// pixel), and BackgroundLearner::unsettled_pixels() counts them.
+struct MotionRegion {
+  Pose T_base_camera = Pose::Identity();
+  const RobotModel* robot = nullptr;  ///< the robot's capsules now; null or empty: motion counts everywhere
+  AlignedBox workspace_base;          ///< `foreground.workspace_base`
 };
 
 /// Learns the background from consecutive frames. When the scene moved during a batch of
@@ -76,7 +99,11 @@ struct BackgroundLearner {
 
   /// Adds one frame. Returns `restarted` (with `message()` saying why) when the batch just
   /// completed showed motion, `ready` once `model()` is usable.
-  Status add(const Frame& frame);
+  /// With `region`, motion counts only inside it (see MotionRegion).
+  Status add(const Frame& frame, const MotionRegion* region = nullptr);
+  /// Pixels whose background is unknown because they moved outside the motion region in the
+  /// batch that was learnt (0 before).
+  size_t unsettled_pixels() const { return unsettled_; }
   bool ready() const { return ready_; }
   const BackgroundModel& model() const { return model_; }
   /// Why learning last restarted; empty if it never did.
@@ -88,6 +115,7 @@ struct BackgroundLearner {
 
  private:
   std::vector<double> sum_, sum_sq_;
+  size_t unsettled_ = 0;
   std::vector<uint32_t> valid_count_;
   int count_ = 0;
   bool ready_ = false;
@@ -97,7 +125,7 @@ struct BackgroundLearner {
   // Scratch of the batch summary, sized with the image: spread / mean² samples for the noise
   // median, the moving mask and its erosion, and the fill's queue and distance per pixel.
   std::vector<float> ratios_;
-  std::vector<uint8_t> moving_, eroded_;
+  std::vector<uint8_t> moving_, eroded_, outside_;  ///< per pixel: moved, wide motion, moved outside the region
   std::vector<int32_t> fill_queue_;
   std::vector<uint16_t> fill_layer_;
 };
@@ -126,15 +154,6 @@ struct BackgroundCheck {
   int seen_ = 0;
   int64_t compared_ = 0;
   int64_t farther_ = 0;
-};
-
-/// Axis-aligned box in the base frame.
-struct AlignedBox {
-  Eigen::Vector3f min = Eigen::Vector3f::Constant(-1e9F);
-  Eigen::Vector3f max = Eigen::Vector3f::Constant(1e9F);
-  bool contains(const Eigen::Vector3f& p) const {
-    return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
-  }
 };
 
 struct ForegroundParams {

@@ -111,6 +111,7 @@ void read_segmentation(KeyReader& r, Config& c) {
   r.integer("background.fill_radius_px", bg.fill_radius_px, 0, 1000);
   r.integer("background.unseen_min_frames", bg.unseen_min_frames, 1, std::numeric_limits<int>::max());
   r.number("background.max_noise_per_z2", bg.max_noise_per_z2, Bound::positive);
+  r.number("background.motion_max_distance_m", bg.motion_max_distance_m, Bound::positive, kMaxCoordinateM);
 
   ForegroundParams& fg = c.pipeline.foreground;
   r.number("foreground.k_sigma", fg.k_sigma, Bound::positive);

@@ -89,9 +89,9 @@ void set_learning(Verdict& verdict, int frames_seen, int frames_total, const std
 
 // Adds a frame to the learner and sets the learning verdict. The frame that completes the
 // model is a learning frame too, so it stays invalid like the ones before it.
-void learn_background(BackgroundLearner& learner, const Frame& frame, Verdict& verdict) {
+void learn_background(BackgroundLearner& learner, const Frame& frame, const MotionRegion* region, Verdict& verdict) {
   const int frames_total = learner.params.frames;
-  const bool completed = learner.add(frame) == BackgroundLearner::Status::ready;
+  const bool completed = learner.add(frame, region) == BackgroundLearner::Status::ready;
   set_learning(verdict, completed ? frames_total : learner.frames_seen(), frames_total, learner.message());
 }
 
@@ -176,7 +176,13 @@ void Pipeline::process(const Frame& source_frame, const RobotState& robot_state,
   const Frame& frame = run_filters(filters_, source_frame, filtered_, result);
   if (!enough_valid_depth(frame, result)) return finish(result, start);
   if (!background_ready()) {
-    timed(result, "background", [&] { learn_background(learner_, frame, result.verdict); });
+    timed(result, "background", [&] {
+      // Motion counts near the robot where it is now; without a usable state, everywhere.
+      const bool placed = robot_state.valid && all_finite(robot_state.q_rad);
+      if (placed) robot_model_at(params_.robot, robot_state.q_rad, robot_);
+      const MotionRegion region{params_.T_base_camera, placed ? &robot_ : nullptr, params_.foreground.workspace_base};
+      learn_background(learner_, frame, &region, result.verdict);
+    });
     return finish(result, start);
   }
   if (!same_size(background(), frame.depth)) {

@@ -16,6 +16,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <optional>
 
 namespace hrcsense {
 namespace {
@@ -219,7 +221,50 @@ void fill_unreliable(BackgroundModel& model, float min_valid_ratio, int radius_p
 
 }  // namespace
 
-BackgroundLearner::Status BackgroundLearner::add(const Frame& frame) {
+namespace {
+
+// Distance from `p` to the surface of the nearest capsule (negative inside), base frame.
+float distance_to_capsules(const RobotModel& robot, const Eigen::Vector3f& p) {
+  float best = std::numeric_limits<float>::infinity();
+  for (const Capsule& c : robot.capsules) {
+    const Eigen::Vector3f ab = c.b - c.a;
+    const float length2 = ab.squaredNorm();
+    const float t = length2 > 0.0F ? std::clamp((p - c.a).dot(ab) / length2, 0.0F, 1.0F) : 0.0F;
+    best = std::min(best, (p - (c.a + t * ab)).norm() - c.radius_m);
+  }
+  return best;
+}
+
+// Clears the moving pixels whose batch mean lies outside `region` (farther than
+// max_distance_m from the robot, or outside the workspace) and marks them in `outside`.
+// Returns how many were cleared. A pixel that cannot be placed (no mean, a failed
+// deprojection) stays moving: only motion known to be far away is forgiven.
+size_t keep_motion_near_robot(const BackgroundModel& model, const Intrinsics& intrinsics, const MotionRegion& region,
+                              float max_distance_m, uint8_t* moving, uint8_t* outside) {
+  size_t cleared = 0;
+  const size_t n = model.mean_m.size();
+  const Eigen::Matrix3f R = region.T_base_camera.linear().cast<float>();
+  const Eigen::Vector3f t = region.T_base_camera.translation().cast<float>();
+  for (size_t i = 0; i < n; ++i) {
+    outside[i] = 0;
+    if (moving[i] == 0 || !(model.mean_m[i] > 0.0F)) continue;
+    const Eigen::Vector2f pixel(static_cast<float>(i % static_cast<size_t>(model.width)),
+                                static_cast<float>(i / static_cast<size_t>(model.width)));
+    const std::optional<Eigen::Vector3f> p_camera = deproject(intrinsics, pixel, model.mean_m[i]);
+    if (!p_camera) continue;
+    const Eigen::Vector3f p_base = R * *p_camera + t;
+    const bool near = region.workspace_base.contains(p_base) && distance_to_capsules(*region.robot, p_base) <= max_distance_m;
+    if (near) continue;
+    moving[i] = 0;
+    outside[i] = 1;
+    ++cleared;
+  }
+  return cleared;
+}
+
+}  // namespace
+
+BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const MotionRegion* region) {
   if (ready_) return Status::ready;
   const DepthImage& depth = frame.depth;
   const size_t n = static_cast<size_t>(depth.width) * static_cast<size_t>(depth.height);
@@ -245,6 +290,7 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame) {
     ratios_.reserve(n);
     moving_.assign(n, 0);
     eroded_.assign(n, 0);
+    outside_.assign(n, 0);
     fill_queue_.assign(n, 0);
     fill_layer_.assign(n, 0);
     count_ = 0;
@@ -276,6 +322,10 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame) {
                       : std::min(learnt_noise_per_z2(sums, model_, params.min_valid_ratio, ratios_),
                                  static_cast<double>(params.max_noise_per_z2));
   const size_t reliable = mark_moving(model_, params, noise_per_z2_, moving_.data());
+  const bool gated = region != nullptr && region->robot != nullptr && !region->robot->capsules.empty();
+  const size_t unsettled = gated ? keep_motion_near_robot(model_, frame.intrinsics, *region,
+                                                          params.motion_max_distance_m, moving_.data(), outside_.data())
+                                 : 0;
   const size_t moving = count_wide_motion(moving_.data(), depth.width, depth.height, params.motion_min_width_px,
                                           eroded_.data());
   const double moving_share = reliable == 0 ? 0.0 : static_cast<double>(moving) / static_cast<double>(reliable);
@@ -287,6 +337,15 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame) {
   if (!have_model) apply_noise_floor(model_, noise_per_z2_, params.min_valid_ratio);
   const bool keep_unseen = batch_frames >= params.unseen_min_frames;
   fill_unreliable(model_, params.min_valid_ratio, params.fill_radius_px, keep_unseen, fill_queue_, fill_layer_);
+  // What moved far from the robot never settled: its background is unknown, not its mean.
+  if (unsettled > 0) {
+    for (size_t i = 0; i < n; ++i) {
+      if (outside_[i] == 0) continue;
+      model_.mean_m[i] = 0.0F;
+      model_.spread_m[i] = 0.0F;
+    }
+  }
+  unsettled_ = unsettled;
   ready_ = true;
   return Status::ready;
 }

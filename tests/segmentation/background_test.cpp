@@ -350,3 +350,96 @@ TEST(BackgroundLearner, BatchesReuseBuffers) {
 
 }  // namespace
 }  // namespace hrcsense
+
+namespace hrcsense {
+namespace {
+
+// background.motion_max_distance_m. A 40x30 view (fx = fy = 400, centre 19.5, 14.5, camera
+// frame = base frame) of a wall at 3 m with a 10x10 block at u, v 0..9 that jumps between
+// 2.0 and 2.8 m every frame: mean 2.4 m, spread 0.4 m, far above the noise of the still wall,
+// so 100 of 1200 pixels move (8 %, far above max_moving_share 0.2 %). The block's pixel (5, 5)
+// lies at (−14.5/400·2.4, −9.5/400·2.4, 2.4) = (−0.087, −0.057, 2.4).
+Frame jumping_block_frame(int index) {
+  Frame frame;
+  frame.index = index;
+  frame.intrinsics.width = 40;
+  frame.intrinsics.height = 30;
+  frame.intrinsics.fx = frame.intrinsics.fy = 400.0F;
+  frame.intrinsics.ppx = 19.5F;
+  frame.intrinsics.ppy = 14.5F;
+  frame.depth.resize(40, 30);
+  for (int v = 0; v < 30; ++v) {
+    for (int u = 0; u < 40; ++u) {
+      const bool block = u < 10 && v < 10;
+      frame.depth.pixels[static_cast<size_t>(v) * 40 + u] = block ? (index % 2 == 0 ? 2000 : 2800) : 3000;
+    }
+  }
+  return frame;
+}
+
+RobotModel robot_point_at(const Eigen::Vector3f& p) {
+  RobotModel robot;
+  robot.capsules.push_back(Capsule{p, p, 0.0F, 0});
+  return robot;
+}
+
+Status learn_batch(BackgroundLearner& learner, const MotionRegion* region) {
+  Status status = Status::learning;
+  for (int i = 0; i < learner.params.frames; ++i) status = learner.add(jumping_block_frame(i), region);
+  return status;
+}
+
+TEST(BackgroundMotionRegion, MotionFarFromTheRobotDoesNotRestartLearning) {
+  BackgroundLearner learner;
+  learner.params.frames = 4;
+  // The robot point 0.5 m behind the camera: the block is sqrt(0.087² + 0.057² + 2.9²) ≈ 2.90 m
+  // away, beyond the default 2 m.
+  const RobotModel robot = robot_point_at({0.0F, 0.0F, -0.5F});
+  const MotionRegion region{Pose::Identity(), &robot, AlignedBox{}};
+  ASSERT_EQ(learn_batch(learner, &region), Status::ready) << learner.message();
+  EXPECT_EQ(learner.unsettled_pixels(), 100U);
+  // The block's background is unknown (anything there later is foreground in the workspace);
+  // the wall's is the wall.
+  const BackgroundModel& model = learner.model();
+  EXPECT_EQ(model.mean_m[5 * 40 + 5], 0.0F);
+  EXPECT_NEAR(model.mean_m[20 * 40 + 30], 3.0F, 1e-6F);
+}
+
+TEST(BackgroundMotionRegion, MotionNearTheRobotStillRestarts) {
+  // The robot point 1 m in front of the camera: the block is ≈ 1.40 m from it.
+  const RobotModel robot = robot_point_at({0.0F, 0.0F, 1.0F});
+  const MotionRegion region{Pose::Identity(), &robot, AlignedBox{}};
+  BackgroundLearner near;
+  near.params.frames = 4;
+  EXPECT_EQ(learn_batch(near, &region), Status::restarted);
+  // A shorter reach (1.3 m) puts the same block out of it.
+  BackgroundLearner short_reach;
+  short_reach.params.frames = 4;
+  short_reach.params.motion_max_distance_m = 1.3F;
+  EXPECT_EQ(learn_batch(short_reach, &region), Status::ready);
+  // Without a robot (no state, no region) motion counts everywhere, as before.
+  BackgroundLearner everywhere;
+  everywhere.params.frames = 4;
+  EXPECT_EQ(learn_batch(everywhere, nullptr), Status::restarted);
+  const RobotModel no_capsules;
+  const MotionRegion empty{Pose::Identity(), &no_capsules, AlignedBox{}};
+  BackgroundLearner empty_robot;
+  empty_robot.params.frames = 4;
+  EXPECT_EQ(learn_batch(empty_robot, &empty), Status::restarted);
+}
+
+TEST(BackgroundMotionRegion, MotionOutsideTheWorkspaceDoesNotCount) {
+  // Near the robot, but the workspace ends at z = 2 m in front of the camera: the block (2.4 m)
+  // is outside it.
+  const RobotModel robot = robot_point_at({0.0F, 0.0F, 1.0F});
+  AlignedBox workspace;
+  workspace.max.z() = 2.0F;
+  const MotionRegion region{Pose::Identity(), &robot, workspace};
+  BackgroundLearner learner;
+  learner.params.frames = 4;
+  EXPECT_EQ(learn_batch(learner, &region), Status::ready);
+  EXPECT_EQ(learner.unsettled_pixels(), 100U);
+}
+
+}  // namespace
+}  // namespace hrcsense
