@@ -5,6 +5,7 @@
 
 #include "hrcsense/io.hpp"
 #include "hrcsense/recordings.hpp"
+#include "hrcsense/udp_json.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -65,6 +66,17 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config) 
   const std::string& source = config.robot_state.source;
   if (source == "fixed") return std::make_unique<FixedRobotState>(config.robot_state.joints_rad);
   const std::string where = config.file.empty() ? std::string("configuration") : config.file;
+  if (source == "udp_json") {
+    UdpJsonParams params;
+    params.listen = config.robot_state.listen;
+    params.history = config.robot_state.history;
+    // Arrival times on the steady clock, run_pipeline's default (RunOptions::clock null): the
+    // state is looked up at frame times on that clock. SteadyClock has no state, so one shared
+    // instance is as good as the run's own.
+    // A bind failure (port in use, address not local) is a runtime error naming the address.
+    static SteadyClock steady;
+    return std::make_unique<UdpJsonRobotState>(params, steady);
+  }
   throw ConfigError(where + ": robot.state.source '" + source + "': not built into this hrcsense");
 }
 
