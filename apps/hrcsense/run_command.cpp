@@ -81,7 +81,8 @@ int run_command(const CommandArgs& args) {
   ConsoleSink console;
   TeeSink sinks{&jsonl, &console};
 
-  const RunHeader header = make_run_header(config, info);
+  RunHeader header = make_run_header(config, info);
+  header.unknown_background_share = pipeline.unknown_background_share();  // a loaded background's
   if (!header.filters.note.empty()) spdlog::warn("filters: {}", header.filters.note);
 
   RunOptions options;

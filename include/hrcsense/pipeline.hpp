@@ -63,6 +63,9 @@ class Pipeline {
   /// The robot's capsules of the last frame that got as far as the search (base frame).
   const RobotModel& robot() const { return robot_; }
   const Foreground& foreground() const { return foreground_; }
+  /// Share of the background's pixels whose depth is unknown (never measured, or never settled
+  /// while learning: BackgroundLearner::unsettled_pixels), 0..1; -1 before a background exists.
+  double unknown_background_share() const;
   /// Why the background learning last restarted; empty if it never did.
   const std::string& background_message() const { return learner_.message(); }
 

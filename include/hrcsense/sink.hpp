@@ -19,6 +19,9 @@ struct RunHeader {
   std::string config_hash;
   SourceInfo source;
   std::string robot_state;  ///< `robot.state.source` (fixed, sim, rtde, udp_json); empty: not written
+  /// Pipeline::unknown_background_share of a background loaded before the run; < 0 (null):
+  /// not known yet (it is learnt during the run; the summary has it then).
+  double unknown_background_share = -1.0;
   /// The depth filters as they run: `filters.preset`, the domain of filter_domain(), a note
   /// when the domain is not the one the preset asks for, and the filtered resolution.
   struct Filters {
@@ -58,6 +61,7 @@ struct RunSummary {
   std::string error;
   TimestampCounts timestamps;     ///< source timestamps out of order
   RobotStateStats robot_state;    ///< the robot state source's counters
+  double unknown_background_share = -1.0;  ///< Pipeline::unknown_background_share at the end; < 0: no background
 };
 
 /// A consumer of results. The other virtual interface of hrcsense.

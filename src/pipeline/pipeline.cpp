@@ -161,6 +161,14 @@ void Pipeline::set_background(BackgroundModel model, std::string origin) {
   extractor_.clear_background();  // its tables belong to the previous model
 }
 
+double Pipeline::unknown_background_share() const {
+  if (!background_ready()) return -1.0;
+  const std::vector<float>& mean_m = background().mean_m;
+  if (mean_m.empty()) return -1.0;
+  const auto unknown = std::count_if(mean_m.begin(), mean_m.end(), [](float m) { return !(m > 0.0F); });
+  return static_cast<double>(unknown) / static_cast<double>(mean_m.size());
+}
+
 const BackgroundModel& Pipeline::background() const {
   return preset_background_ ? preset_model_ : learner_.model();
 }

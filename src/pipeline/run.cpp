@@ -336,6 +336,7 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
   summary.frames_dropped = frames.dropped() + results.dropped();
   summary.timestamps = outcome.timestamps;
   summary.robot_state = robot_states.stats();
+  summary.unknown_background_share = pipeline.unknown_background_share();
   summary.end_reason = outcome.end_reason;
   summary.latency_p50_us = stats.latencies.percentile(0.50);
   summary.latency_p99_us = stats.latencies.percentile(0.99);

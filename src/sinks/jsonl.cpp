@@ -185,6 +185,8 @@ void JsonLinesSink::header(const RunHeader& header) {
   m.text("commit", header.commit.empty() ? HRCSENSE_COMMIT : header.commit);
   m.text("config_hash", header.config_hash);
   if (!header.robot_state.empty()) m.text("robot_state", header.robot_state);
+  m.number_or_null("unknown_background_share", header.unknown_background_share >= 0.0,
+                   header.unknown_background_share);
 
   const SourceInfo& source = header.source;
   m.open("source");
@@ -300,6 +302,8 @@ void JsonLinesSink::summary(const RunSummary& summary) {
   m.integer("timestamp_gaps", summary.timestamps.gaps);
   m.integer("frames_skipped_source", summary.timestamps.frames_skipped);
   m.integer("timestamp_jumps", summary.timestamps.jumps);
+  m.number_or_null("unknown_background_share", summary.unknown_background_share >= 0.0,
+                   summary.unknown_background_share);
   const RobotStateStats& robot = summary.robot_state;
   m.open("robot_state");
   m.integer("accepted", robot.samples.accepted);

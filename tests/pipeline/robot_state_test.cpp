@@ -288,3 +288,23 @@ TEST(RobotStateClocks, ASourceHostTimeIsKept) {
 
 }  // namespace
 }  // namespace hrcsense
+
+namespace hrcsense {
+namespace {
+
+// The unknown share of the background: -1 before there is one; the share of pixels without a
+// depth after (a loaded model with 600 of the fake scene's 4800 pixels unknown: 0.125).
+TEST(UnknownBackground, ShareOfPixelsWithoutDepth) {
+  Pipeline pipeline(test::fake_params());
+  EXPECT_EQ(pipeline.unknown_background_share(), -1.0);
+  BackgroundModel model = test::learn_empty_background();
+  ASSERT_EQ(model.mean_m.size(), 4800U);
+  pipeline.set_background(model);
+  EXPECT_EQ(pipeline.unknown_background_share(), 0.0);
+  for (size_t i = 0; i < 600; ++i) model.mean_m[i] = 0.0F;
+  pipeline.set_background(model);
+  EXPECT_EQ(pipeline.unknown_background_share(), 0.125);
+}
+
+}  // namespace
+}  // namespace hrcsense

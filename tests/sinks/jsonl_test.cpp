@@ -74,6 +74,7 @@ TEST(JsonLinesSink, HeaderCarriesVersionSourceAndIntrinsics) {
   header.commit = "abc123";
   header.config_hash = "0123456789abcdef";
   header.robot_state = "udp_json";
+  header.unknown_background_share = 0.125;
   header.source.type = "sim";
   header.source.description = "a scene";
   header.source.frame_count = 400;
@@ -98,6 +99,7 @@ TEST(JsonLinesSink, HeaderCarriesVersionSourceAndIntrinsics) {
   EXPECT_EQ(h["commit"], "abc123");
   EXPECT_EQ(h["config_hash"], "0123456789abcdef");
   EXPECT_EQ(h["robot_state"], "udp_json");
+  EXPECT_EQ(h["unknown_background_share"].get<double>(), 0.125);
   EXPECT_EQ(h["source"]["type"], "sim");
   EXPECT_EQ(h["source"]["description"], "a scene");
   EXPECT_EQ(h["source"]["frame_count"], 400);
@@ -201,6 +203,7 @@ TEST(JsonLinesSink, SummaryHasEveryRunSummaryField) {
   s.timestamps.gaps = 4;
   s.timestamps.frames_skipped = 9;
   s.timestamps.jumps = 1;
+  s.unknown_background_share = 0.0625;
   s.robot_state.samples.accepted = 1000;
   s.robot_state.samples.rejected_non_finite = 1;
   s.robot_state.samples.rejected_backwards = 2;
@@ -237,6 +240,7 @@ TEST(JsonLinesSink, SummaryHasEveryRunSummaryField) {
   EXPECT_EQ(j["timestamp_gaps"], 4);
   EXPECT_EQ(j["frames_skipped_source"], 9);
   EXPECT_EQ(j["timestamp_jumps"], 1);
+  EXPECT_EQ(j["unknown_background_share"].get<double>(), 0.0625);
   const json& robot = j["robot_state"];
   EXPECT_EQ(robot["accepted"], 1000);
   EXPECT_EQ(robot["rejected_non_finite"], 1);
