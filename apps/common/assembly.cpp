@@ -5,6 +5,7 @@
 
 #include "hrcsense/io.hpp"
 #include "hrcsense/recordings.hpp"
+#include "hrcsense/rtde.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -61,10 +62,22 @@ std::unique_ptr<Source> make_source(const Config& config) {
   throw ConfigError(where + ": source.type '" + config.source.type + "': not built into this hrcsense");
 }
 
-std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config) {
-  const std::string& source = config.robot_state.source;
-  if (source == "fixed") return std::make_unique<FixedRobotState>(config.robot_state.joints_rad);
+std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock) {
+  const RobotStateConfig& state = config.robot_state;
+  const std::string& source = state.source;
+  if (source == "fixed") return std::make_unique<FixedRobotState>(state.joints_rad);
   const std::string where = config.file.empty() ? std::string("configuration") : config.file;
+  if (source == "rtde") {
+    if (state.host.empty()) throw ConfigError(where + ": robot.state.host: required for robot.state.source rtde");
+    RtdeParams params;
+    params.host = state.host;
+    params.port = state.port;
+    params.frequency_hz = state.frequency_hz;
+    params.history = state.history;
+    // The steady clock is stateless: run_pipeline's own (RunOptions::clock null) reads the same time.
+    static SteadyClock steady_clock;
+    return std::make_unique<RtdeRobotState>(params, clock != nullptr ? *clock : steady_clock);
+  }
   throw ConfigError(where + ": robot.state.source '" + source + "': not built into this hrcsense");
 }
 
