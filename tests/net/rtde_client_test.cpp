@@ -4,6 +4,8 @@
 // stalled stream, gives no valid state until good data resumes. Every wait has a deadline.
 #include "fake_rtde_controller.hpp"
 
+#include "common/assembly.hpp"
+#include "hrcsense/config.hpp"
 #include "hrcsense/rtde.hpp"
 
 #include <gtest/gtest.h>
@@ -255,6 +257,31 @@ TEST(RtdeClient, NoControllerIsAnErrorAndNoState) {
   RobotState state;
   EXPECT_FALSE(client.state_at(clock.now_ns(), state));
   EXPECT_EQ(client.stats().connections, 0);
+}
+
+// robot.state.source rtde: the assembly builds the client from robot.state.host, port and
+// frequency_hz, stamping with the given clock.
+TEST(RtdeAssembly, RobotStateSourceRtdeBuildsTheClient) {
+  FakeClock clock{1'000'000'000'000};
+  FakeRtdeScript script;
+  script.samples_per_connection = 20;
+  FakeRtdeController fake(script, clock);
+  const Config config = load_config("", {"robot.state.source=rtde", "robot.state.host=127.0.0.1",
+                                         "robot.state.port=" + std::to_string(fake.port()),
+                                         "robot.state.frequency_hz=500"});
+  std::unique_ptr<RobotStateSource> source = make_robot_state_source(config, &clock);
+  ASSERT_EQ(source->origin(), RobotStateOrigin::rtde);
+  auto* rtde = dynamic_cast<RtdeRobotState*>(source.get());
+  ASSERT_NE(rtde, nullptr);
+  std::atomic<bool> stopping{false};
+  fake.start([&](int64_t sent) { wait_until([&] { return stopping || rtde->status().data_packages >= sent; }); });
+  ASSERT_TRUE(wait_until([&] { return rtde->status().data_packages >= 20; }));
+  EXPECT_EQ(fake.frequencies(), std::vector<double>{500.0});
+  RobotState state;
+  EXPECT_TRUE(source->state_at(clock.now_ns(), state));
+  EXPECT_NEAR(state.q_rad[1], Rig::expected_q(clock.now_ns(), 1), 1e-9);
+  stopping = true;
+  fake.stop();
 }
 
 }  // namespace
