@@ -164,6 +164,14 @@ class FakeRtdeController {
       if (::poll(&p, 1, 20) > 0 && ::recv(fd, bytes, sizeof bytes, 0) <= 0) return;
     }
   }
+  // True when the client has closed its end (what it sent before is dropped).
+  static bool peer_closed(int fd) {
+    uint8_t bytes[256];
+    for (pollfd p{fd, POLLIN, 0}; ::poll(&p, 1, 0) > 0;) {
+      if (::recv(fd, bytes, sizeof bytes, 0) <= 0) return true;
+    }
+    return false;
+  }
   // After a refusal: waits for the client to close, then holds.
   void refuse_and_hold(int fd) {
     drain_until_closed(fd);
@@ -270,7 +278,10 @@ class FakeRtdeController {
         hold();
         return false;
       }
-      if (here && fault == RtdeFault::stall) hold();
+      if (here && fault == RtdeFault::stall) {
+        hold();
+        if (peer_closed(fd)) return true;  // the client gave up during the stall: serve its next connection
+      }
       if (here && fault == RtdeFault::unknown_type) send_all(fd, pack('X', {1, 2, 3, 4, 5}));
       if (!send_all(fd, package)) return true;
       if (after_send_) after_send_(++data_sent_);

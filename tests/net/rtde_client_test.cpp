@@ -171,6 +171,21 @@ TEST(RtdeClient, StallIsStaleThenValidWhenDataResumes) {
   EXPECT_EQ(rig.client->stats().disconnects, 0);
 }
 
+TEST(RtdeClient, StallLongerThanTheReceiveTimeoutReconnects) {
+  Rig rig(faulty(RtdeFault::stall), 500.0);
+  ASSERT_TRUE(wait_until([&] { return rig.fake.faulted(); }));
+  ASSERT_TRUE(rig.consumed(100));
+  rig.clock.advance(2'000'000'000);  // 2 s of silence: past the 1 s receive timeout
+  ASSERT_TRUE(wait_until([&] { return rig.client->stats().disconnects >= 1; }));
+  EXPECT_FALSE(rig.valid_now());
+  EXPECT_NE(rig.client->stats().last_problem.find("no data from the controller"), std::string::npos)
+      << rig.client->stats().last_problem;
+  rig.fake.release();
+  ASSERT_TRUE(rig.consumed(300));
+  EXPECT_TRUE(rig.matches_at(rig.clock.now_ns()));
+  EXPECT_EQ(rig.client->stats().connections, 2);
+}
+
 TEST(RtdeClient, TruncatedPackageAtCloseIsMalformedThenReconnects) {
   Rig rig(faulty(RtdeFault::truncated), 500.0);
   ASSERT_TRUE(wait_until([&] { return rig.fake.faulted() && rig.client->stats().disconnects >= 1; }));
