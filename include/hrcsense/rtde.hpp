@@ -201,7 +201,6 @@ class RtdeRobotState final : public RobotStateSource {
   const RtdeParams params_;
   RunClock& clock_;
   std::atomic<bool> stop_{false};
-  std::atomic<int> socket_{-1};  ///< the live socket, shut down by the destructor to wake the reader
   mutable std::mutex mutex_;     ///< guards everything below
   RobotStateHistory history_;
   RobotStateStats stats_;

@@ -107,9 +107,8 @@ RtdeRobotState::RtdeRobotState(RtdeParams params, RunClock& clock) : params_(std
 }
 
 RtdeRobotState::~RtdeRobotState() {
+  // Every wait of the reader (poll, connect, back-off) looks at stop_ at least every 20 ms.
   stop_ = true;
-  const int fd = socket_.load();
-  if (fd >= 0) ::shutdown(fd, SHUT_RDWR);  // wakes a blocked poll at once
   thread_.join();
 }
 
@@ -151,13 +150,11 @@ void RtdeRobotState::run() {
     std::string error;
     connection.fd = connect_to(params_, stop_, error);
     if (connection.fd >= 0) {
-      socket_ = connection.fd;
       {
         std::lock_guard<std::mutex> lock(mutex_);
         ++stats_.connections;
       }
       const bool streamed = session(connection);
-      socket_ = -1;
       ::close(connection.fd);
       error = connection.error;
       std::lock_guard<std::mutex> lock(mutex_);
