@@ -5,6 +5,7 @@
 
 #include "hrcsense/io.hpp"
 #include "hrcsense/recordings.hpp"
+#include "hrcsense/rtde.hpp"
 #include "hrcsense/udp_json.hpp"
 
 #include <spdlog/spdlog.h>
@@ -62,20 +63,31 @@ std::unique_ptr<Source> make_source(const Config& config) {
   throw ConfigError(where + ": source.type '" + config.source.type + "': not built into this hrcsense");
 }
 
-std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config) {
-  const std::string& source = config.robot_state.source;
-  if (source == "fixed") return std::make_unique<FixedRobotState>(config.robot_state.joints_rad);
+std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock) {
+  const RobotStateConfig& state = config.robot_state;
+  const std::string& source = state.source;
+  if (source == "fixed") return std::make_unique<FixedRobotState>(state.joints_rad);
   const std::string where = config.file.empty() ? std::string("configuration") : config.file;
+  // Arrival times on the run's clock: the steady clock, run_pipeline's default (RunOptions::clock
+  // null), unless the caller passes its own. SteadyClock has no state, so one shared instance
+  // reads the same time as the run's.
+  static SteadyClock steady_clock;
+  RunClock& run_clock = clock != nullptr ? *clock : steady_clock;
   if (source == "udp_json") {
     UdpJsonParams params;
-    params.listen = config.robot_state.listen;
-    params.history = config.robot_state.history;
-    // Arrival times on the steady clock, run_pipeline's default (RunOptions::clock null): the
-    // state is looked up at frame times on that clock. SteadyClock has no state, so one shared
-    // instance is as good as the run's own.
+    params.listen = state.listen;
+    params.history = state.history;
     // A bind failure (port in use, address not local) is a runtime error naming the address.
-    static SteadyClock steady;
-    return std::make_unique<UdpJsonRobotState>(params, steady);
+    return std::make_unique<UdpJsonRobotState>(params, run_clock);
+  }
+  if (source == "rtde") {
+    if (state.host.empty()) throw ConfigError(where + ": robot.state.host: required for robot.state.source rtde");
+    RtdeParams params;
+    params.host = state.host;
+    params.port = state.port;
+    params.frequency_hz = state.frequency_hz;
+    params.history = state.history;
+    return std::make_unique<RtdeRobotState>(params, run_clock);
   }
   throw ConfigError(where + ": robot.state.source '" + source + "': not built into this hrcsense");
 }

@@ -5,6 +5,7 @@
 // this build does not have is a ConfigError saying so.
 #pragma once
 
+#include "hrcsense/clock.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/robot_state.hpp"
@@ -29,8 +30,9 @@ Simulator make_simulator(const Config& config);
 std::unique_ptr<Source> make_source(const Config& config);
 
 /// The robot state source (robot.state.source); throws ConfigError for one this build does
-/// not have.
-std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config);
+/// not have, or for rtde without robot.state.host. A live source (rtde) stamps arrivals with
+/// `clock` (null: the steady clock, run_pipeline's default); it must outlive the source.
+std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock = nullptr);
 
 /// Loads background.path into `pipeline` when the file exists (checked against the filtered
 /// resolution: after decimation); false when there is nothing to load. Throws IoError for a
