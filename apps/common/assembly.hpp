@@ -21,15 +21,17 @@ namespace hrcsense {
 /// points.
 std::optional<SceneObject> robot_scene_object(const Config& config);
 
-/// The simulator described by a configuration (sim.*, scene.*, camera pose, robot).
+/// The simulator described by a configuration (sim.*, scene.*, camera pose, robot). With
+/// robot.trajectory the arm is the simulator's moving arm (Simulator::arm), not a scene object.
 Simulator make_simulator(const Config& config);
 
 /// The source the configuration names (source.type); throws ConfigError for a type this
 /// build does not have (naming it) or a recorded source without source.path.
 std::unique_ptr<Source> make_source(const Config& config);
 
-/// The robot state source (robot.state.source); throws ConfigError for one this build does
-/// not have.
+/// The robot state source (robot.state.source): fixed, or sim (SimRobotState on the trajectory,
+/// with robot.state.sim_latency_s / sim_jitter_s, seeded by source.seed); throws ConfigError
+/// for one this build does not have.
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config);
 
 /// Loads background.path into `pipeline` when the file exists (checked against the filtered
