@@ -43,7 +43,12 @@ Simulator make_simulator(const Config& config) {
   simulator.scene = config.scene;
   simulator.T_base_camera = config.pipeline.T_base_camera;
   simulator.robot = fixed_robot_model(config);
-  // The arm is part of the static scene: rendered, learnt as background, never foreground.
+  if (config.robot_state.trajectory) {
+    // A moving arm: rendered at each frame's time with its own label (robot.trajectory).
+    simulator.arm = SimArm{config.pipeline.robot, *config.robot_state.trajectory, std::nullopt};
+    return simulator;
+  }
+  // A fixed arm is part of the static scene: rendered, learnt as background, never foreground.
   if (auto arm = robot_scene_object(config)) simulator.scene.objects.push_back(*arm);
   return simulator;
 }
@@ -68,6 +73,16 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
   const std::string& source = state.source;
   if (source == "fixed") return std::make_unique<FixedRobotState>(state.joints_rad);
   const std::string where = config.file.empty() ? std::string("configuration") : config.file;
+  if (source == "sim") {
+    // Config requires the trajectory with the sim source; checked again for a hand-made Config.
+    if (!config.robot_state.trajectory) throw ConfigError(where + ": robot.trajectory: required for robot.state.source sim");
+    SimRobotState::Params params;
+    params.latency_s = config.robot_state.sim_latency_s;
+    params.jitter_s = config.robot_state.sim_jitter_s;
+    params.seed = config.source.seed;
+    params.history = config.robot_state.history;
+    return std::make_unique<SimRobotState>(*config.robot_state.trajectory, params);
+  }
   // Arrival times on the run's clock: the steady clock, run_pipeline's default (RunOptions::clock
   // null), unless the caller passes its own. SteadyClock has no state, so one shared instance
   // reads the same time as the run's.

@@ -22,16 +22,19 @@ namespace hrcsense {
 /// points.
 std::optional<SceneObject> robot_scene_object(const Config& config);
 
-/// The simulator described by a configuration (sim.*, scene.*, camera pose, robot).
+/// The simulator described by a configuration (sim.*, scene.*, camera pose, robot). With
+/// robot.trajectory the arm is the simulator's moving arm (Simulator::arm), not a scene object.
 Simulator make_simulator(const Config& config);
 
 /// The source the configuration names (source.type); throws ConfigError for a type this
 /// build does not have (naming it) or a recorded source without source.path.
 std::unique_ptr<Source> make_source(const Config& config);
 
-/// The robot state source (robot.state.source); throws ConfigError for one this build does
-/// not have, or for rtde without robot.state.host. A live source (rtde) stamps arrivals with
-/// `clock` (null: the steady clock, run_pipeline's default); it must outlive the source.
+/// The robot state source (robot.state.source): fixed; sim (SimRobotState on the trajectory,
+/// with robot.state.sim_latency_s / sim_jitter_s, seeded by source.seed); rtde; udp_json.
+/// Throws ConfigError for one this build does not have, or for rtde without
+/// robot.state.host. A live source (rtde, udp_json) stamps arrivals with `clock` (null: the
+/// steady clock, run_pipeline's default); it must outlive the source.
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock = nullptr);
 
 /// Loads background.path into `pipeline` when the file exists (checked against the filtered

@@ -5,6 +5,7 @@
 #include "common/assembly.hpp"
 #include "common/console_sink.hpp"
 #include "common/tee_sink.hpp"
+#include "common/truth_label_sink.hpp"
 
 #include "hrcsense/config.hpp"
 #include "hrcsense/sinks.hpp"
@@ -17,6 +18,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 
 namespace hrcsense::app {
 namespace {
@@ -79,7 +81,10 @@ int run_command(const CommandArgs& args) {
 
   JsonLinesSink jsonl(out, config.pipeline.backend);
   ConsoleSink console;
-  TeeSink sinks{&jsonl, &console};
+  // Simulated runs: truth.contact_label from the simulator's own labels (TruthLabelSink).
+  std::optional<TruthLabelSink> labelled;
+  if (config.source.type == "sim") labelled.emplace(make_simulator(config), jsonl);
+  TeeSink sinks{labelled ? static_cast<Sink*>(&*labelled) : &jsonl, &console};
 
   RunHeader header = make_run_header(config, info);
   header.unknown_background_share = pipeline.unknown_background_share();  // a loaded background's

@@ -48,6 +48,10 @@ struct RobotStateConfig {
   double camera_latency_s = 0.0;
   double sim_latency_s = 0.0;    ///< `robot.state.sim_latency_s`: the simulated state arrives this late
   double sim_jitter_s = 0.0;     ///< `robot.state.sim_jitter_s`: uniform jitter on that delay
+  /// `robot.trajectory`: the simulator's scripted arm motion (an arm only; required for the
+  /// sim source). Set: the simulator moves the arm along it instead of rendering it fixed at
+  /// robot.joints_rad.
+  std::optional<RobotTrajectory> trajectory;
 };
 
 struct Config {

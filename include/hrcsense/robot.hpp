@@ -125,6 +125,47 @@ RobotModel robot_model_at(const RobotParams& robot, const JointAngles& joints_ra
 RobotModel robot_render_capsules(const RobotDescription& description, const JointAngles& joints_rad,
                                  BaseFrame frame);
 
+/// Same, into `out`, reusing its buffer (no allocation once sized): the simulator's moving arm.
+void robot_render_capsules(const RobotDescription& description, const JointAngles& joints_rad, BaseFrame frame,
+                           RobotModel& out);
+
+/// One waypoint of a scripted arm motion (`robot.trajectory.waypoints[i]`).
+struct TrajectoryWaypoint {
+  double t_s = 0.0;       ///< source time, seconds (the simulator's frame index / fps)
+  JointAngles q_rad{};    ///< joint angles at t_s, joint 1 first
+};
+
+/// How joints_at() moves between waypoints.
+enum class TrajectoryInterpolation {
+  linear,  ///< piecewise linear: qd is the segment's slope (steps at the waypoints)
+  /// Cubic Hermite (C1): at an inner waypoint k the velocity is the central difference
+  /// (q[k+1] - q[k-1]) / (t[k+1] - t[k-1]) (a Catmull-Rom spline for non-uniform times); zero at
+  /// the first and last waypoint, so a looped cycle is C1 across the wrap too.
+  cubic,
+};
+
+/// A scripted arm motion (`robot.trajectory`, docs/CONFIG.md). Valid as config checks it: at
+/// least two waypoints, t_s strictly increasing, joints within the arm's limits; with `loop`
+/// the last waypoint's joints equal the first's (a closed cycle).
+struct RobotTrajectory {
+  TrajectoryInterpolation interpolation = TrajectoryInterpolation::linear;
+  /// true: time wraps over [first t_s, last t_s); false: the ends are held (qd 0) outside.
+  bool loop = false;
+  std::vector<TrajectoryWaypoint> waypoints;
+};
+
+/// Joint angles and velocities of a trajectory at one time.
+struct TrajectorySample {
+  JointAngles q_rad{};     ///< joint angles
+  JointAngles qd_rad_s{};  ///< joint velocities (the derivative of q_rad in t)
+};
+
+/// The trajectory's state at `t_s` (same clock as the waypoints). Pure and allocation-free.
+/// At a waypoint: its joints, with the velocity of the segment that starts there. Before the
+/// first waypoint or from the last on (without loop): that waypoint's joints, qd 0.
+/// Precondition: the trajectory is valid as RobotTrajectory says; an empty one gives zeros.
+TrajectorySample joints_at(const RobotTrajectory& trajectory, double t_s);
+
 /// The thesis's robot: one zero-length capsule per point (base frame), radius `padding_m`,
 /// link = the point's index.
 RobotModel robot_points(const std::vector<Eigen::Vector3f>& points_base, double padding_m);

@@ -5,11 +5,14 @@
 #pragma once
 
 #include "hrcsense/camera.hpp"
+#include "hrcsense/robot.hpp"
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/source.hpp"
 #include "hrcsense/types.hpp"
 
 #include <array>
 #include <cstdint>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <utility>
@@ -166,6 +169,19 @@ struct SimScratch {
   uint64_t correlated_key = 0;         ///< what correlated_px was computed for
   PointCloud points_base;          ///< noise-free non-static pixels, base frame (truth contact)
   PointCloud points_camera;        ///< the same points, camera frame
+  RobotModel arm_render;           ///< the moving arm's visual capsules this frame (SimArm)
+  RobotModel arm_searched;         ///< its searched capsules this frame, for the truth contact
+  std::vector<float> label_z_m;    ///< label_at()'s z-buffer
+  int64_t label_index = -1;        ///< the frame label_at() last cast (object_ids hold it); -1: none
+};
+
+/// An arm the simulator moves along a trajectory (`robot.trajectory`): rendered at each frame's
+/// time t = index / fps from joints_at(trajectory, t), with the label kRobotLabel.
+struct SimArm {
+  RobotParams robot;           ///< the arm (required), padding and base frame, as the pipeline's
+  RobotTrajectory trajectory;  ///< the motion, on the simulator's timeline (index / fps)
+  /// Flat colour in the colour image; unset: kSimPalette[scene object count % size].
+  std::optional<std::array<uint8_t, 3>> color_rgb;
 };
 
 /// Renders frames of a scene. Deterministic: frame i depends only on (params, scene, i).
@@ -173,7 +189,12 @@ struct Simulator {
   SimParams params;
   Scene scene;
   Pose T_base_camera = Pose::Identity();
-  RobotModel robot;  ///< for the ground-truth contact
+  RobotModel robot;  ///< for the ground-truth contact (without `arm`; with it, the arm's searched capsules)
+  /// A moving arm; unset: no moving arm (an arm at a fixed pose is a static scene object).
+  /// With it, GroundTruth::contact and analytic_contact measure against the arm's searched
+  /// capsules (robot_model_at of arm->robot) at the frame's exact time, and the arm's pixels
+  /// are neither static nor part of the contact.
+  std::optional<SimArm> arm;
   /// Reused buffers; because render() writes them, one Simulator must not render from two
   /// threads at once (copy it instead).
   mutable SimScratch scratch;
@@ -190,6 +211,59 @@ struct Simulator {
   /// and with params.color the colour image, its intrinsics and the depth → colour extrinsics).
   /// Reuses out's buffers, so rendering into the same Frame does not allocate.
   void render(int64_t index, Frame& out) const;
+  /// The truth label render() gives source pixel `pixel` (v * width + u) of frame `index`,
+  /// without rendering the rest: the same ray cast, so the same label. Casts the whole frame
+  /// once per index (scratch keeps it), so asking for several pixels of a frame is cheap.
+  /// kStaticLabel for a pixel outside the image.
+  uint16_t label_at(int64_t index, int pixel) const;
+  /// A label's name: "static", "robot" (kRobotLabel), or the name of the non-static scene
+  /// object with that label; "" for a label no object has.
+  const std::string& label_name(uint16_t label) const;
+  /// The moving arm's joints at frame `index` (joints_at at index / fps); requires `arm`.
+  TrajectorySample arm_joints(int64_t index) const;
+};
+
+/// `robot.state.source: sim`: the joints of the simulator's trajectory, on the *simulator's
+/// timeline*: state_at(t) answers for t = a frame's timestamp_ns (index / fps in ns), not for a
+/// time on the host clock. (The run loop is to pass the frame's host time, which for unpaced
+/// sim runs is that timestamp.) Origin `sim`.
+///
+/// Without latency and jitter the state is exact: joints_at(trajectory, t), stamped t. With
+/// them, samples are taken every `period_s` of the timeline (sample k holds k · period_s and is
+/// stamped with that true time, as a controller clock mapped to the host would stamp it) and
+/// each becomes known `latency_s` + a jitter later, the jitter uniform in [0, jitter_s) from
+/// `seed` and k (deterministic), in order (a sample is never known before the one before it).
+/// state_at(t) reads a RobotStateHistory of the samples known by t: the newest is about
+/// latency_s old, so the state lags the truth by the latency less the history's one-period
+/// extrapolation, and is stale (invalid) past history.max_age_s. An earlier t than the
+/// previous call starts afresh (a new run).
+class SimRobotState final : public RobotStateSource {
+ public:
+  struct Params {
+    double latency_s = 0.0;    ///< `robot.state.sim_latency_s`: how late each sample is known
+    double jitter_s = 0.0;     ///< `robot.state.sim_jitter_s`: extra delay, uniform in [0, jitter_s)
+    double period_s = 0.002;   ///< sample period with latency or jitter (500 Hz, an e-Series' rate)
+    uint64_t seed = 1;         ///< jitter seed (source.seed)
+    RobotStateHistoryParams history;  ///< `robot.state.max_age_s`
+  };
+  SimRobotState(RobotTrajectory trajectory, Params params);
+  RobotStateOrigin origin() const override { return RobotStateOrigin::sim; }
+  /// The state at `time_ns` on the simulator's timeline (a frame's timestamp_ns).
+  bool state_at(int64_t time_ns, RobotState& out) override;
+  RobotStateStats stats() const override;
+
+ private:
+  /// When sample k would become known before the in-order rule, nanoseconds.
+  int64_t raw_known_ns(int64_t k) const;
+
+  RobotTrajectory trajectory_;
+  Params params_;
+  int64_t period_ns_ = 2'000'000;
+  RobotStateHistory history_;
+  int64_t next_sample_ = 0;      ///< the first sample not yet added to history_
+  int64_t last_known_ns_ = 0;    ///< when the sample before next_sample_ became known
+  int64_t last_time_ns_ = 0;     ///< the previous state_at time
+  mutable std::mutex mutex_;     ///< stats() may be read while the run calls state_at()
 };
 
 /// A D435i colour camera's intrinsics (Inverse Brown-Conrady, zero coefficients, as the

@@ -71,6 +71,8 @@ struct ColorImage {
 
 /// Label 0 in GroundTruth::labels: the static scene (learnt as background).
 inline constexpr uint16_t kStaticLabel = 0;
+/// The simulator's moving arm in GroundTruth::labels (neither static nor a foreground object).
+inline constexpr uint16_t kRobotLabel = 0xFFFF;
 
 /// A contact between the foreground and the robot: the closest pair of points.
 struct Contact {
@@ -87,10 +89,13 @@ struct Contact {
 /// What the simulator knows exactly about a frame it rendered.
 struct GroundTruth {
   std::vector<float> depth_m;    ///< noise-free Z per pixel, metres; 0 where nothing was hit
-  std::vector<uint16_t> labels;  ///< object id per pixel; kStaticLabel for the static scene
-  /// Closest point over the noise-free rendered pixels of non-static objects (base frame).
+  /// Label per pixel: kStaticLabel for the static scene (and where nothing is hit), kRobotLabel
+  /// for the moving arm, 1 + index among the non-static scene objects otherwise.
+  std::vector<uint16_t> labels;
+  /// Closest point over the noise-free rendered pixels of non-static, non-robot objects (base
+  /// frame) to the robot's searched capsules.
   Contact contact;
-  /// Closest point over the analytic surfaces of non-static objects, visible or not.
+  /// Closest point over the analytic surfaces of non-static, non-robot objects, visible or not.
   Contact analytic_contact;
 };
 
@@ -243,6 +248,11 @@ struct FrameResult {
   /// Frame host time minus robot_state.sample_time_ns, ≥ 0; 0 for a state that ages not.
   double robot_state_age_ms = 0.0;
   std::optional<Contact> truth;  ///< simulated sources: ground-truth contact
+  /// Simulated sources: the truth label's name under the measured contact's source pixel
+  /// (`truth.contact_label`: "static", "robot" or the object's name); null when there is no
+  /// measured contact or nobody set it. The pipeline leaves it alone: the app's truth-label
+  /// sink (apps/common) sets it from the simulator; static text or owned by that sink.
+  const char* truth_contact_label = nullptr;
   double latency_us = 0.0;       ///< from the frame entering processing to the result
   /// The proximity backend that searched this frame (static name, e.g. "octree" when `auto`
   /// picked it); null when no search ran.

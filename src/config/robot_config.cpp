@@ -22,6 +22,13 @@ constexpr double kPi = 3.14159265358979323846;
 double rad_from_deg(double deg) { return (deg / 180.0) * kPi; }
 double deg_from_rad(double rad) { return (rad / kPi) * 180.0; }
 
+std::string limit_text(const JointLimit& limit) {
+  char text[96];
+  std::snprintf(text, sizeof text, "[%.6g, %.6g] rad ([%.6g, %.6g] deg)", limit.min_rad, limit.max_rad,
+                deg_from_rad(limit.min_rad), deg_from_rad(limit.max_rad));
+  return text;
+}
+
 // Errors name the field by its path in the description, e.g. links.forearm[1].radius_m.
 struct DescriptionReader : YamlTree {
   LinkCapsule capsule(const YAML::Node& node, const std::string& key) const {
@@ -143,6 +150,89 @@ YAML::Node per_link_node(const std::array<std::vector<LinkCapsule>, kArmLinkCoun
   return out;
 }
 
+// `robot.trajectory`: errors name the field below robot., e.g. robot.trajectory.waypoints[2].t_s.
+struct TrajectoryReader : YamlTree {
+  bool flag(const YAML::Node& node, const std::string& key) const {
+    bool value = false;
+    if (!node.IsScalar() || !YAML::convert<bool>::decode(node, value)) fail(key, "expected true or false");
+    return value;
+  }
+
+  JointAngles joints(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsSequence() || node.size() != kJointCount) {
+      fail(key, "expected 6 joint angles in radians, joint 1 (base) first");
+    }
+    JointAngles out{};
+    for (size_t j = 0; j < kJointCount; ++j) out[j] = number(node[j], key + "[" + std::to_string(j) + "]");
+    return out;
+  }
+
+  RobotTrajectory trajectory(const YAML::Node& map, const RobotDescription& arm) const {
+    const std::string key = "trajectory";
+    if (!map.IsMap()) fail(key, "expected a map {interpolation, loop, waypoints}");
+    only_keys(map, key, {"interpolation", "loop", "waypoints"});
+    RobotTrajectory out;
+    const YAML::Node interpolation = child(map, "interpolation");
+    if (interpolation.IsDefined()) {
+      const std::string name = interpolation.IsScalar() ? interpolation.Scalar() : std::string();
+      if (name == "cubic") {
+        out.interpolation = TrajectoryInterpolation::cubic;
+      } else if (name != "linear") {
+        fail(key + ".interpolation", "expected linear or cubic");
+      }
+    }
+    const YAML::Node loop = child(map, "loop");
+    if (loop.IsDefined()) out.loop = flag(loop, key + ".loop");
+    const YAML::Node waypoints = required(map, key, "waypoints");
+    if (!waypoints.IsSequence() || waypoints.size() < 2) {
+      fail(key + ".waypoints", "expected a list of at least 2 waypoints {t_s, joints_rad}");
+    }
+    for (size_t i = 0; i < waypoints.size(); ++i) {
+      const std::string item = key + ".waypoints[" + std::to_string(i) + "]";
+      only_keys(waypoints[i], item, {"t_s", "joints_rad"});
+      TrajectoryWaypoint point;
+      point.t_s = number(required(waypoints[i], item, "t_s"), item + ".t_s");
+      point.q_rad = joints(required(waypoints[i], item, "joints_rad"), item + ".joints_rad");
+      if (!out.waypoints.empty() && !(point.t_s > out.waypoints.back().t_s)) {
+        fail(item + ".t_s", "expected times strictly increasing (" + double_text(point.t_s) + " s after " +
+                                double_text(out.waypoints.back().t_s) + " s)");
+      }
+      const int outside = joint_outside_limits(arm, point.q_rad);
+      if (outside >= 0) {
+        const size_t j = static_cast<size_t>(outside);
+        fail(item + ".joints_rad", "joint " + std::to_string(outside + 1) + " (" + joint_name(outside) + ") is " +
+                                       double_text(point.q_rad[j]) + " rad, outside its limits " +
+                                       limit_text(arm.limits[j]));
+      }
+      out.waypoints.push_back(point);
+    }
+    // Looping from the last waypoint back to the first would make the arm jump.
+    if (out.loop && out.waypoints.back().q_rad != out.waypoints.front().q_rad) {
+      fail(key + ".waypoints[" + std::to_string(out.waypoints.size() - 1) + "].joints_rad",
+           "with loop: true the last waypoint's joints must equal the first's (a closed cycle)");
+    }
+    return out;
+  }
+};
+
+YAML::Node trajectory_node(const RobotTrajectory& trajectory) {
+  YAML::Node out(YAML::NodeType::Map);
+  out["interpolation"] = trajectory.interpolation == TrajectoryInterpolation::cubic ? "cubic" : "linear";
+  out["loop"] = trajectory.loop;
+  YAML::Node waypoints(YAML::NodeType::Sequence);
+  for (const TrajectoryWaypoint& point : trajectory.waypoints) {
+    YAML::Node item(YAML::NodeType::Map);
+    item.SetStyle(YAML::EmitterStyle::Flow);
+    item["t_s"] = double_text(point.t_s);
+    YAML::Node joints = flow_sequence();
+    for (const double q : point.q_rad) joints.push_back(double_text(q));
+    item["joints_rad"] = joints;
+    waypoints.push_back(item);
+  }
+  out["waypoints"] = waypoints;
+  return out;
+}
+
 // The description robot.model names: built in, or from robot.description (a file or inline).
 RobotDescription arm_description(KeyReader& r, const std::string& model, const YAML::Node& description) {
   if (model != "custom") {
@@ -186,12 +276,6 @@ void check_capsules(const KeyReader& r, const RobotModel& robot) {
   }
 }
 
-std::string limit_text(const JointLimit& limit) {
-  char text[96];
-  std::snprintf(text, sizeof text, "[%.6g, %.6g] rad ([%.6g, %.6g] deg)", limit.min_rad, limit.max_rad,
-                deg_from_rad(limit.min_rad), deg_from_rad(limit.max_rad));
-  return text;
-}
 
 }  // namespace
 
@@ -254,6 +338,7 @@ void read_robot(KeyReader& r, Config& c) {
   read_robot_state(r, c.robot_state);
   const YAML::Node description = r.raw("robot.description");
   const YAML::Node tool = r.raw("robot.tool");
+  const YAML::Node trajectory = r.raw("robot.trajectory");
   // Default: the 2020 thesis's robot point (-0.5, 0.5, 0.5) m, given there with y up.
   std::vector<Eigen::Vector3f> points_base{Eigen::Vector3f(-0.5F, -0.5F, 0.5F)};
   r.vec3_list("robot.points_base", points_base, kMaxCoordinateM);
@@ -268,6 +353,12 @@ void read_robot(KeyReader& r, Config& c) {
   if (c.robot_model == "points") {
     if (description.IsDefined()) r.fail("robot.description", "is only read with robot.model custom");
     if (tool.IsDefined()) r.fail("robot.tool", "is only read with an arm (robot.model ur5, ur5e, ur10e or custom)");
+    if (trajectory.IsDefined()) {
+      r.fail("robot.trajectory", "is only read with an arm (robot.model ur5, ur5e, ur10e or custom)");
+    }
+    if (c.robot_state.source == "sim") {
+      r.fail("robot.state.source", "sim moves an arm along robot.trajectory: it needs robot.model ur5, ur5e, ur10e or custom");
+    }
     r.number("robot.padding_m", robot.padding_m, Bound::non_negative, kMaxCoordinateM);
     // Without a robot every distance would be "infinite" and every verdict run: refuse.
     if (points_base.empty()) r.fail("robot.points_base", "expected at least one point [x, y, z] for robot.model points");
@@ -300,10 +391,21 @@ void read_robot(KeyReader& r, Config& c) {
                                    double_text(joints_rad[j]) + " rad, outside its limits " +
                                    limit_text(arm.limits[j]));
   }
+  if (trajectory.IsDefined()) {
+    const std::string prefix = "robot.";
+    c.robot_state.trajectory = TrajectoryReader{{r.where(), prefix}}.trajectory(trajectory, arm);
+    r.set_effective("robot.trajectory", trajectory_node(*c.robot_state.trajectory));
+  } else if (c.robot_state.source == "sim") {
+    r.fail("robot.trajectory", "is required for robot.state.source sim: {interpolation: linear | cubic, loop, "
+                               "waypoints: [{t_s, joints_rad}, ...]}");
+  }
   robot.points.capsules.clear();
   robot.arm = arm;
   // The capsules at the fixed pose must be sane too (within reach of the base frame).
   check_capsules(r, robot_model_at(robot, joints_rad));
+  if (c.robot_state.trajectory) {
+    for (const TrajectoryWaypoint& point : c.robot_state.trajectory->waypoints) check_capsules(r, robot_model_at(robot, point.q_rad));
+  }
 }
 
 }  // namespace config_detail

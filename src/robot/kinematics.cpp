@@ -179,8 +179,13 @@ RobotModel robot_render_capsules(const RobotDescription& description, const Join
   // No padding: the visual shapes are the real arm, which the searched capsules (link radius
   // plus padding) must contain.
   RobotModel model;
-  place_capsules(description, joints_rad, 0.0, frame, Geometry::visual, model);
+  robot_render_capsules(description, joints_rad, frame, model);
   return model;
+}
+
+void robot_render_capsules(const RobotDescription& description, const JointAngles& joints_rad, BaseFrame frame,
+                           RobotModel& out) {
+  place_capsules(description, joints_rad, 0.0, frame, Geometry::visual, out);
 }
 
 RobotModel robot_points(const std::vector<Eigen::Vector3f>& points_base, double padding_m) {

@@ -48,9 +48,22 @@ Shape translated(Shape s, const Eigen::Vector3f& offset_m) {
   return s;
 }
 
-/// The shapes that exist in frame `index`, moved along their paths, with their labels.
+/// The moving arm's capsules at frame `index`: the visual ones to render, the searched ones
+/// for the truth contact. Both reuse their buffers.
+void place_arm(const Simulator& sim, int64_t index, SimScratch& scratch) {
+  if (!sim.arm) return;
+  const SimArm& arm = *sim.arm;
+  const JointAngles q_rad = sim.arm_joints(index).q_rad;
+  robot_render_capsules(*arm.robot.arm, q_rad, arm.robot.base_frame, scratch.arm_render);
+  robot_model_at(arm.robot, q_rad, scratch.arm_searched);
+}
+
+/// The shapes that exist in frame `index`, moved along their paths, with their labels; the
+/// moving arm last, as object id objects.size() + 1.
 void place_shapes(const Simulator& sim, int64_t index, SimScratch& scratch) {
-  size_t total = 0;
+  place_arm(sim, index, scratch);
+  const size_t arm_shapes = sim.arm ? scratch.arm_render.capsules.size() : 0;
+  size_t total = arm_shapes;
   for (const SceneObject& object : sim.scene.objects) total += object.shapes.size();
   scratch.shapes_base.reserve(total);  // the first frame sizes for all, so later ones never grow
   scratch.shape_labels.reserve(total);
@@ -59,9 +72,10 @@ void place_shapes(const Simulator& sim, int64_t index, SimScratch& scratch) {
   scratch.shape_labels.clear();
   scratch.shape_ids.clear();
   // Per object id (0: nothing hit): its label and its material bits. Same size every frame.
-  scratch.label_of_id.assign(sim.scene.objects.size() + 1, kStaticLabel);
-  scratch.material_of_id.assign(sim.scene.objects.size() + 1, 0);
-  scratch.color_of_id.assign(sim.scene.objects.size() + 1, std::array<uint8_t, 3>{0, 0, 0});
+  const size_t ids = sim.scene.objects.size() + 1 + (sim.arm ? 1 : 0);
+  scratch.label_of_id.assign(ids, kStaticLabel);
+  scratch.material_of_id.assign(ids, 0);
+  scratch.color_of_id.assign(ids, std::array<uint8_t, 3>{0, 0, 0});
   const double t_s = static_cast<double>(index) / sim.params.fps;
   uint16_t next_label = 1;
   for (size_t k = 0; k < sim.scene.objects.size(); ++k) {
@@ -82,13 +96,30 @@ void place_shapes(const Simulator& sim, int64_t index, SimScratch& scratch) {
       scratch.shape_ids.push_back(id);
     }
   }
+  if (!sim.arm) return;
+  const size_t k = sim.scene.objects.size();
+  const auto id = static_cast<uint16_t>(k + 1);
+  scratch.label_of_id[id] = kRobotLabel;
+  scratch.color_of_id[id] = sim.arm->color_rgb.value_or(kSimPalette[k % kSimPalette.size()]);
+  for (const Capsule& capsule : scratch.arm_render.capsules) {
+    if (capsule.radius_m <= 0.0F) continue;  // a bare segment has no surface to see
+    scratch.shapes_base.push_back(Shape::capsule(capsule.a, capsule.b, capsule.radius_m));
+    scratch.shape_labels.push_back(kRobotLabel);
+    scratch.shape_ids.push_back(id);
+  }
 }
+
+/// What the truth contact measures against: the moving arm's searched capsules this frame, or
+/// the fixed robot.
+const RobotModel& truth_robot(const Simulator& sim) { return sim.arm ? sim.scratch.arm_searched : sim.robot; }
+
+bool is_foreground_label(uint16_t label) { return label != kStaticLabel && label != kRobotLabel; }
 
 /// Closest robot contact over the analytic surfaces of the existing non-static shapes.
 Contact analytic_contact(const SimScratch& scratch, const RobotModel& robot, const PoseF& T_camera_base) {
   Contact best;
   for (size_t k = 0; k < scratch.shapes_base.size(); ++k) {
-    if (scratch.shape_labels[k] == kStaticLabel) continue;
+    if (!is_foreground_label(scratch.shape_labels[k])) continue;
     for (const Capsule& capsule : robot.capsules) {
       const sim_detail::ClosestPair pair = sim_detail::closest_shape_capsule(scratch.shapes_base[k], capsule);
       if (best.valid && !(pair.distance_m < best.distance_m)) continue;
@@ -139,7 +170,7 @@ void fill_truth_contacts(const Simulator& sim, const PoseF& T_base_camera, Groun
       if (word != 0) break;
     }
     if (i == n) break;
-    if (labels[i] == kStaticLabel) continue;
+    if (!is_foreground_label(labels[i])) continue;
     const float z = depth_m[i];
     const Eigen::Vector3f p_camera(z * scratch.rays.x[i], z * scratch.rays.y[i], z);
     const Eigen::Vector3f p_base = T_base_camera.apply(p_camera);
@@ -152,8 +183,9 @@ void fill_truth_contacts(const Simulator& sim, const PoseF& T_base_camera, Groun
     truth.analytic_contact = Contact{};
     return;
   }
-  truth.contact = sim_detail::rendered_truth_contact(scratch.points_base, scratch.points_camera, sim.robot);
-  truth.analytic_contact = analytic_contact(scratch, sim.robot, T_base_camera.inverse());
+  const RobotModel& robot = truth_robot(sim);
+  truth.contact = sim_detail::rendered_truth_contact(scratch.points_base, scratch.points_camera, robot);
+  truth.analytic_contact = analytic_contact(scratch, robot, T_base_camera.inverse());
 }
 
 /// The colour camera's frame: the same placed shapes cast from the colour camera's pose, flat
@@ -236,10 +268,48 @@ void Simulator::render(int64_t index, Frame& out) const {
 
   sim_detail::cast_shapes(scratch.shapes_base, scratch.shape_ids, scratch.rays, T_base_camera_f, truth.depth_m.data(),
                           scratch.object_ids.data());
+  scratch.label_index = index;  // label_at() may read this frame's ids
   sim_detail::write_sensor_depth(params, in.fx, index, truth.depth_m.data(), scratch, out.depth);
   fill_truth_labels(scratch, truth);
   fill_truth_contacts(*this, T_base_camera_f, truth);
   render_color(*this, T_base_camera_f, out);
+}
+
+uint16_t Simulator::label_at(int64_t index, int pixel) const {
+  const Intrinsics in = intrinsics();
+  const size_t n = static_cast<size_t>(in.width) * in.height;
+  if (pixel < 0 || static_cast<size_t>(pixel) >= n) return kStaticLabel;
+  if (scratch.label_index != index) {
+    sim_detail::ensure_rays(scratch.rays, in);
+    place_shapes(*this, index, scratch);
+    PoseF T_base_camera_f;
+    T_base_camera_f.R = T_base_camera.linear().cast<float>();
+    T_base_camera_f.t = T_base_camera.translation().cast<float>();
+    scratch.label_z_m.resize(n);
+    scratch.object_ids.resize(n);
+    sim_detail::cast_shapes(scratch.shapes_base, scratch.shape_ids, scratch.rays, T_base_camera_f,
+                            scratch.label_z_m.data(), scratch.object_ids.data());
+    scratch.label_index = index;
+  }
+  return scratch.label_of_id[scratch.object_ids[static_cast<size_t>(pixel)]];
+}
+
+const std::string& Simulator::label_name(uint16_t label) const {
+  static const std::string static_name = "static";
+  static const std::string robot_name = "robot";
+  static const std::string none;
+  if (label == kStaticLabel) return static_name;
+  if (label == kRobotLabel) return robot_name;
+  uint16_t next_label = 1;  // as place_shapes numbers them
+  for (const SceneObject& object : scene.objects) {
+    if (object.is_static) continue;
+    if (next_label++ == label) return object.name;
+  }
+  return none;
+}
+
+TrajectorySample Simulator::arm_joints(int64_t index) const {
+  return joints_at(arm->trajectory, static_cast<double>(index) / params.fps);
 }
 
 }  // namespace hrcsense

@@ -267,6 +267,11 @@ void JsonLinesSink::frame(const FrameResult& result) {
     m.open("truth");
     m.number_or_null("distance_m", result.truth->valid, result.truth->distance_m);
     m.point_or_null("closest_base", result.truth->valid, result.truth->closest_base);
+    if (result.truth_contact_label != nullptr) {
+      m.text("contact_label", result.truth_contact_label);
+    } else {
+      m.null("contact_label");
+    }
     m.close();
   }
   line_ += "}\n";

@@ -156,3 +156,22 @@ TEST(SimulatorAllocations, NoneWhenRenderingAgain) {
 
 }  // namespace
 }  // namespace hrcsense
+
+namespace hrcsense {
+namespace {
+
+// The moving arm (robot.trajectory) is placed anew every frame into the simulator's buffers:
+// still no allocation once sized, with the person in view.
+TEST(SimulatorAllocations, NoneWhenRenderingTheMovingArm) {
+  const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml", {});
+  const Simulator sim = make_simulator(config);
+  ASSERT_TRUE(sim.arm.has_value());
+  Frame frame;
+  for (int i = 250; i < 260; ++i) sim.render(i, frame);
+  const long before = g_allocations.load();
+  for (int i = 260; i < 270; ++i) sim.render(i, frame);
+  EXPECT_EQ(g_allocations.load() - before, 0);
+}
+
+}  // namespace
+}  // namespace hrcsense

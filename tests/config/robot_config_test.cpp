@@ -396,3 +396,61 @@ TEST(RobotStateConfig, JointsAreRequiredOnlyForTheFixedSource) {
 
 }  // namespace
 }  // namespace hrcsense
+
+namespace hrcsense {
+namespace {
+
+const std::string kSimArm = "robot.model=ur5";
+const std::string kTwoPoints =
+    "robot.trajectory={interpolation: cubic, waypoints: [{t_s: 0, joints_rad: [0, -1, 1, 0, 0, 0]}, "
+    "{t_s: 2, joints_rad: [1, -1, 1, 0, 0, 0]}]}";
+
+TEST(RobotTrajectoryConfig, ReadsWaypointsAndAllowsTheSimSourceWithoutJoints) {
+  const Config c = load_config("", {kSimArm, "robot.state.source=sim", kTwoPoints});
+  ASSERT_TRUE(c.robot_state.trajectory.has_value());
+  const RobotTrajectory& t = *c.robot_state.trajectory;
+  EXPECT_EQ(t.interpolation, TrajectoryInterpolation::cubic);
+  EXPECT_FALSE(t.loop);
+  ASSERT_EQ(t.waypoints.size(), 2u);
+  EXPECT_EQ(t.waypoints[1].t_s, 2.0);
+  EXPECT_EQ(t.waypoints[1].q_rad[0], 1.0);
+  EXPECT_EQ(t.waypoints[0].q_rad[1], -1.0);
+  EXPECT_NE(c.canonical_yaml.find("trajectory"), std::string::npos);
+}
+
+TEST(RobotTrajectoryConfig, NoTrajectoryNoKeyInTheCanonicalConfig) {
+  const Config c = load_config("", {kSimArm, kZeroPose});
+  EXPECT_FALSE(c.robot_state.trajectory.has_value());
+  EXPECT_EQ(c.canonical_yaml.find("trajectory"), std::string::npos);
+}
+
+TEST(RobotTrajectoryConfig, ErrorsNameTheKeyAndTheWaypoint) {
+  expect_config_error("", {kSimArm, "robot.state.source=sim"}, {"robot.trajectory", "required", "sim"});
+  expect_config_error("", {"robot.state.source=sim"}, {"robot.state.source", "arm"});
+  expect_config_error("", {kTwoPoints}, {"robot.trajectory", "only read with an arm"});
+  expect_config_error("", {kSimArm, kZeroPose, "robot.trajectory={waypoints: [{t_s: 0, joints_rad: [0, 0, 0, 0, 0, 0]}]}"},
+                      {"robot.trajectory.waypoints", "at least 2"});
+  expect_config_error("", {kSimArm, kZeroPose,
+                           "robot.trajectory={waypoints: [{t_s: 1, joints_rad: [0, 0, 0, 0, 0, 0]}, "
+                           "{t_s: 1, joints_rad: [0, 0, 0, 0, 0, 0]}]}"},
+                      {"robot.trajectory.waypoints[1].t_s", "strictly increasing"});
+  expect_config_error("", {kSimArm, kZeroPose,
+                           "robot.trajectory={waypoints: [{t_s: 0, joints_rad: [0, 0, 0, 0, 0, 0]}, "
+                           "{t_s: 1, joints_rad: [0, 0, 7, 0, 0, 0]}]}"},
+                      {"robot.trajectory.waypoints[1].joints_rad", "joint 3 (elbow)", "outside its limits"});
+  expect_config_error("", {kSimArm, kZeroPose,
+                           "robot.trajectory={waypoints: [{t_s: 0, joints_rad: [0, 0, 0, 0, 0, 0]}, "
+                           "{t_s: 1, joints_rad: [0, 0, 0, 0, 0]}]}"},
+                      {"robot.trajectory.waypoints[1].joints_rad", "6 joint angles"});
+  expect_config_error("", {kSimArm, kZeroPose,
+                           "robot.trajectory={loop: true, waypoints: [{t_s: 0, joints_rad: [0, 0, 0, 0, 0, 0]}, "
+                           "{t_s: 1, joints_rad: [1, 0, 0, 0, 0, 0]}]}"},
+                      {"robot.trajectory.waypoints[1].joints_rad", "closed cycle"});
+  expect_config_error("", {kSimArm, kZeroPose, "robot.trajectory={interpolation: spline, waypoints: []}"},
+                      {"robot.trajectory.interpolation", "linear or cubic"});
+  expect_config_error("", {kSimArm, kZeroPose, "robot.trajectory={speed: 1, waypoints: []}"},
+                      {"robot.trajectory", "speed"});
+}
+
+}  // namespace
+}  // namespace hrcsense

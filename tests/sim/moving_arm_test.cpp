@@ -1,0 +1,229 @@
+// SPDX-License-Identifier: Apache-2.0
+// Tests of the simulator's moving arm (robot.trajectory) on config/cell-ur5-moving.yaml: the
+// scene's timeline from the simulator's own truth, the arm's label and motion, the tool speed,
+// the truth contact against the arm's searched capsules at each frame's time, and
+// truth.contact_label (label_at, source_pixel_of, TruthLabelSink).
+#include "common/assembly.hpp"
+#include "common/truth_label_sink.hpp"
+#include "hrcsense/camera.hpp"
+#include "hrcsense/config.hpp"
+#include "hrcsense/sim.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace hrcsense {
+namespace {
+
+Config moving_cell() {
+  return load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml",
+                     {"sim.noise=false", "sim.color=false"});
+}
+
+/// The flange (tool) position in the base frame at time t_s, by forward kinematics.
+Eigen::Vector3d flange_base(const Config& config, double t_s) {
+  const JointAngles q = joints_at(*config.robot_state.trajectory, t_s).q_rad;
+  return (T_base_base_link() * forward_kinematics(*config.pipeline.robot.arm, q).T_base_link_link[6]).translation();
+}
+
+size_t count_label(const std::vector<uint16_t>& labels, uint16_t label) {
+  return static_cast<size_t>(std::count(labels.begin(), labels.end(), label));
+}
+
+uint16_t label_named(const Simulator& sim, const std::string& name) {
+  for (uint16_t label = 1; label < 64; ++label) {
+    if (sim.label_name(label) == name) return label;
+  }
+  return kStaticLabel;
+}
+
+TEST(MovingArmScene, PersonVisibleInAtLeast150FramesBefore1000AndNotWhileLearning) {
+  const Config config = moving_cell();
+  ASSERT_EQ(config.sim.frames, 1000);
+  ASSERT_EQ(config.robot_state.source, "sim");
+  const Simulator sim = make_simulator(config);
+  const uint16_t person = label_named(sim, "person");
+  ASSERT_NE(person, kStaticLabel);
+  Frame frame;
+  int visible = 0;
+  int64_t first = -1;
+  int64_t last = -1;
+  for (int64_t i = 0; i < config.sim.frames; i += 1) {
+    sim.render(i, frame);
+    if (count_label(frame.truth->labels, person) < 50) continue;
+    ++visible;
+    if (first < 0) first = i;
+    last = i;
+  }
+  EXPECT_GE(visible, 150);
+  EXPECT_GE(first, config.pipeline.background.frames);  // nobody while the background is learnt
+  EXPECT_LT(last, 1000);
+}
+
+TEST(MovingArmScene, ArmPixelsCarryTheRobotLabelAndMove) {
+  const Config config = moving_cell();
+  const Simulator sim = make_simulator(config);
+  ASSERT_TRUE(sim.arm.has_value());
+  EXPECT_EQ(sim.label_name(kRobotLabel), "robot");
+  const Intrinsics in = sim.intrinsics();
+  Frame a;
+  Frame b;
+  sim.render(0, a);   // pick pose
+  sim.render(24, b);  // 0.8 s: halfway through the swing
+  EXPECT_GT(count_label(a.truth->labels, kRobotLabel), 2000u);
+  EXPECT_GT(count_label(b.truth->labels, kRobotLabel), 2000u);
+  size_t changed = 0;
+  for (size_t i = 0; i < a.truth->labels.size(); ++i) {
+    changed += (a.truth->labels[i] == kRobotLabel) != (b.truth->labels[i] == kRobotLabel) ? 1 : 0;
+  }
+  EXPECT_GT(changed, 1000u);
+  // The pixel the flange projects to, from the camera pose and forward kinematics, is the arm's
+  // (seen from above, the flange's own body covers it).
+  for (const int64_t index : {0, 24, 40}) {
+    Frame frame;
+    sim.render(index, frame);
+    const Eigen::Vector3d p_base = flange_base(config, static_cast<double>(index) / 30.0);
+    const Eigen::Vector3f p_camera = (config.pipeline.T_base_camera.inverse() * p_base).cast<float>();
+    const std::optional<Eigen::Vector2f> uv = project(in, p_camera);
+    ASSERT_TRUE(uv.has_value());
+    const int u = static_cast<int>(std::lround(uv->x()));
+    const int v = static_cast<int>(std::lround(uv->y()));
+    ASSERT_TRUE(u >= 0 && u < in.width && v >= 0 && v < in.height) << index;
+    EXPECT_EQ(frame.truth->labels[static_cast<size_t>(v) * in.width + u], kRobotLabel) << index;
+  }
+  // Before the person comes, nothing non-static but the arm: no truth contact.
+  EXPECT_FALSE(a.truth->contact.valid);
+}
+
+TEST(MovingArmScene, ToolMovesAtAboutOneMetrePerSecond) {
+  const Config config = moving_cell();
+  // Mid-swing (pick → place from 0.25 s to 1.35 s, back from 1.6 s to 2.7 s), and a cycle later.
+  for (const double t_s : {0.5, 0.8, 1.1, 2.0, 2.4, 0.8 + 2.7 * 5}) {
+    const double dt_s = 0.01;
+    const double speed = (flange_base(config, t_s + dt_s) - flange_base(config, t_s)).norm() / dt_s;
+    EXPECT_GT(speed, 0.9) << t_s;
+    EXPECT_LT(speed, 1.2) << t_s;
+  }
+  // At rest at the pick and place poses.
+  EXPECT_LT((flange_base(config, 0.2) - flange_base(config, 0.05)).norm(), 1e-9);
+  EXPECT_LT((flange_base(config, 1.55) - flange_base(config, 1.4)).norm(), 1e-9);
+}
+
+/// Point to capsule surface, double precision, written out here (not the simulator's code).
+double capsule_distance(const Eigen::Vector3d& p, const Capsule& c) {
+  const Eigen::Vector3d a = c.a.cast<double>();
+  const Eigen::Vector3d ab = c.b.cast<double>() - a;
+  const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+  return std::max(0.0, (p - (a + t * ab)).norm() - c.radius_m);
+}
+
+TEST(MovingArmScene, TruthContactIsThePersonAgainstTheSearchedArmAtTheFramesTime) {
+  const Config config = moving_cell();
+  const Simulator sim = make_simulator(config);
+  const uint16_t person = label_named(sim, "person");
+  const Intrinsics in = sim.intrinsics();
+  for (const int64_t index : {250, 263, 300}) {
+    Frame frame;
+    sim.render(index, frame);
+    const JointAngles q = joints_at(*config.robot_state.trajectory, static_cast<double>(index) / 30.0).q_rad;
+    const RobotModel searched = robot_model_at(config.pipeline.robot, q);
+    double best = std::numeric_limits<double>::infinity();
+    for (int v = 0; v < in.height; ++v) {
+      for (int u = 0; u < in.width; ++u) {
+        const size_t i = static_cast<size_t>(v) * in.width + u;
+        if (frame.truth->labels[i] != person) continue;
+        const Eigen::Vector3f p_camera = *deproject(in, Eigen::Vector2f(u, v), frame.truth->depth_m[i]);
+        const Eigen::Vector3d p_base = config.pipeline.T_base_camera * p_camera.cast<double>();
+        for (const Capsule& c : searched.capsules) best = std::min(best, capsule_distance(p_base, c));
+      }
+    }
+    ASSERT_TRUE(frame.truth->contact.valid) << index;
+    EXPECT_NEAR(frame.truth->contact.distance_m, best, 1e-4) << index;
+    EXPECT_EQ(frame.truth->labels[static_cast<size_t>(frame.truth->contact.pixel)], person) << index;
+  }
+}
+
+TEST(MovingArmScene, LabelAtAgreesWithTheRenderedLabels) {
+  const Config config = moving_cell();
+  const Simulator rendering = make_simulator(config);
+  const Simulator asking = make_simulator(config);
+  for (const int64_t index : {0, 250, 300}) {
+    Frame frame;
+    rendering.render(index, frame);
+    size_t mismatches = 0;
+    for (size_t i = 0; i < frame.truth->labels.size(); i += 7) {
+      mismatches += asking.label_at(index, static_cast<int>(i)) != frame.truth->labels[i] ? 1 : 0;
+    }
+    EXPECT_EQ(mismatches, 0u) << index;
+  }
+  EXPECT_EQ(asking.label_at(0, -1), kStaticLabel);
+  EXPECT_EQ(asking.label_name(kStaticLabel), "static");
+  EXPECT_EQ(asking.label_name(1), "person");
+  EXPECT_EQ(asking.label_name(2), "");
+}
+
+TEST(SourcePixelOf, MapsADecimatedPixelToTheFirstOfItsBlock) {
+  const Intrinsics source = *d435_depth_intrinsics(848, 480);
+  Intrinsics filtered = source;  // decimation by 2 as the SDK scales intrinsics
+  filtered.width = 424;
+  filtered.height = 240;
+  filtered.fx = source.fx / 2;
+  filtered.fy = source.fy / 2;
+  filtered.ppx = source.ppx / 2;
+  filtered.ppy = source.ppy / 2;
+  EXPECT_EQ(source_pixel_of(5 * 424 + 10, filtered, source), 10 * 848 + 20);
+  EXPECT_EQ(source_pixel_of(239 * 424 + 423, filtered, source), 478 * 848 + 846);
+  EXPECT_EQ(source_pixel_of(0, filtered, source), 0);
+  EXPECT_EQ(source_pixel_of(1234, source, source), 1234);
+  EXPECT_EQ(source_pixel_of(-1, filtered, source), -1);
+  EXPECT_EQ(source_pixel_of(424 * 240, filtered, source), -1);
+}
+
+/// Keeps the last frame result it was given.
+struct LastResultSink : Sink {
+  FrameResult last;
+  std::string label;
+  void header(const RunHeader&) override {}
+  void frame(const FrameResult& result) override {
+    last = result;
+    label = result.truth_contact_label ? result.truth_contact_label : "(null)";
+  }
+  void summary(const RunSummary&) override {}
+};
+
+TEST(TruthLabelSink, NamesTheObjectUnderTheMeasuredContact) {
+  const Config config = moving_cell();
+  const Simulator sim = make_simulator(config);
+  Frame frame;
+  sim.render(250, frame);
+  const Intrinsics in = sim.intrinsics();
+  LastResultSink out;
+  TruthLabelSink sink(make_simulator(config), out);
+  RunHeader header;
+  header.source.intrinsics = in;
+  header.filters.intrinsics = in;
+  sink.header(header);
+  FrameResult result;
+  result.frame = 250;
+  result.truth = frame.truth->contact;
+  // One pixel of each kind in the rendered labels stands in for the measured contact.
+  for (const uint16_t label : {kStaticLabel, kRobotLabel, uint16_t{1}}) {
+    const auto it = std::find(frame.truth->labels.begin(), frame.truth->labels.end(), label);
+    ASSERT_NE(it, frame.truth->labels.end());
+    result.contact.valid = true;
+    result.contact.pixel = static_cast<int>(it - frame.truth->labels.begin());
+    sink.frame(result);
+    EXPECT_EQ(out.label, label == kStaticLabel ? "static" : label == kRobotLabel ? "robot" : "person");
+  }
+  result.contact.valid = false;  // no measured contact: no label
+  sink.frame(result);
+  EXPECT_EQ(out.label, "(null)");
+}
+
+}  // namespace
+}  // namespace hrcsense
