@@ -103,9 +103,9 @@ struct RunOptions {
 /// process every frame (the source waits for processing); paced runs drop and count.
 /// Each frame gets the robot state `robot_states` has at the frame's host time minus
 /// camera_latency_s. The host time is the source's own (a live camera's capture time) when it
-/// sets Frame::host_time_ns; else the delivery time on the run's clock for paced runs and
-/// live robot states, and the source timestamp for unpaced runs with a `fixed` or `sim` state
-/// (docs/ROBOT.md, "Clocks").
+/// sets Frame::host_time_ns; else the source timestamp with a `sim` state and for unpaced runs
+/// with a `fixed` one, and the delivery time on the run's clock otherwise (docs/ROBOT.md,
+/// "Clocks").
 /// Writes header, every result and the summary to `sink`; returns the summary.
 RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline& pipeline, Sink& sink,
                         const RunOptions& options, const RunHeader& header);

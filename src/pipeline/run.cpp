@@ -306,11 +306,11 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
   std::string output_error;
 
   sink.header(header);
-  // Unpaced runs of files and the simulator against a fixed or simulated arm live on the
-  // source's timeline; anything paced or live on the host's.
+  // The simulated arm lives on the simulator's timeline, and so do unpaced runs against a fixed
+  // arm; paced runs and live robot states live on the host's.
   const RobotStateOrigin origin = robot_states.origin();
   const bool host_time_is_source_time =
-      !options.pace && (origin == RobotStateOrigin::fixed || origin == RobotStateOrigin::sim);
+      origin == RobotStateOrigin::sim || (!options.pace && origin == RobotStateOrigin::fixed);
   std::thread capture(
       [&] { capture_loop(source, options, clock, max_frame_age_s, host_time_is_source_time, frames, outcome); });
   std::thread processing(
