@@ -12,6 +12,10 @@
 
 namespace hrcsense {
 
+/// True when every joint value is finite (no NaN, no Inf): the one test of a joint vector
+/// before it is used, by the history and the pipeline alike.
+bool all_finite(const JointAngles& values);
+
 struct RobotStateHistoryParams {
   /// `robot.state.max_age_s`: a frame whose newest sample is older than this is a stop.
   double max_age_s = 0.05;

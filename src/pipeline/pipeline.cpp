@@ -120,10 +120,6 @@ const Frame& run_filters(FilterChain& chain, const Frame& frame, Frame& filtered
   return filtered;
 }
 
-bool all_finite(const JointAngles& q_rad) {
-  return std::all_of(q_rad.begin(), q_rad.end(), [](double q) { return std::isfinite(q); });
-}
-
 // Latency from the frame entering processing to its result.
 void finish(FrameResult& result, Clock::time_point start) { result.latency_us = elapsed_us(start); }
 

@@ -6,11 +6,12 @@
 #include <cmath>
 
 namespace hrcsense {
-namespace {
 
 bool all_finite(const JointAngles& values) {
   return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
 }
+
+namespace {
 
 double seconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
 
