@@ -7,11 +7,13 @@
 #include "hrcsense/camera.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/io.hpp"
+#include "hrcsense/pipeline.hpp"
 #include "hrcsense/recordings.hpp"
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <string>
 
 namespace hrcsense::app {
@@ -119,6 +121,62 @@ int print_recording(const std::string& path) {
   return 0;
 }
 
+// The background a `run` of this configuration starts with, and how much of it is unknown
+// (never measured, or moving far from the robot while learnt): loaded from background.path
+// when that file exists, else learnt from the source's first frames as `run` learns it (same
+// filters; motion judged near the robot at its fixed or simulated state). A live robot state
+// (rtde, udp_json) is not connected to from `info`: learning then judges motion everywhere,
+// which can only refuse more batches than `run` would. At most `max_frames` frames (-1: until
+// the source ends); nothing is saved.
+void print_background(const Config& config, int64_t max_frames) {
+  std::unique_ptr<Source> source = make_source(config);
+  const SourceInfo info = source->info();
+  Pipeline pipeline(config.pipeline);
+  const auto print_share = [&pipeline](const char* what) {
+    const BackgroundModel& model = pipeline.background();
+    const size_t pixels = model.mean_m.size();
+    const auto unknown = std::count_if(model.mean_m.begin(), model.mean_m.end(), [](float m) { return !(m > 0.0F); });
+    std::printf("background: %s, %dx%d; unknown_background_share %.4f (%lld of %zu px; %zu unsettled)\n", what,
+                model.width, model.height, pipeline.unknown_background_share(), static_cast<long long>(unknown),
+                pixels, pipeline.unsettled_background_pixels());
+  };
+  if (load_background_file(config, info, pipeline)) {
+    print_share(("loaded from " + config.background_path).c_str());
+    return;
+  }
+  const std::string& state_source = config.robot_state.source;
+  const bool placed = state_source == "fixed" || state_source == "sim";
+  std::unique_ptr<RobotStateSource> robot_states = placed ? make_robot_state_source(config) : nullptr;
+  Frame frame;
+  FrameResult result;
+  RobotState state;
+  int64_t frames = 0;
+  int64_t learnt = 0;  // frames the learner took (a frame with too little valid depth is not learnt)
+  while ((max_frames < 0 || frames < max_frames) && !pipeline.background_ready()) {
+    if (source->next(frame) != Source::Status::frame) break;
+    // As run_pipeline for unpaced fixed and sim states: the robot state at the source time.
+    state = RobotState{};
+    if (robot_states) robot_states->state_at(frame.timestamp_ns, state);
+    pipeline.process(frame, state, result);
+    ++frames;
+    learnt += result.verdict.code == ReasonCode::learning_background ? 1 : 0;
+  }
+  if (!placed) std::printf("background: robot.state.source %s not connected: motion counted everywhere\n", state_source.c_str());
+  // Every refused batch is background.frames learnt frames (a change of image size, which also
+  // restarts, cannot happen within one source).
+  const int64_t batch = std::max(config.pipeline.background.frames, 1);
+  const std::string& message = pipeline.background_message();
+  if (!pipeline.background_ready()) {
+    std::printf("background: not learnt in %lld frame(s), %lld batch(es) refused%s%s\n", static_cast<long long>(frames),
+                static_cast<long long>(learnt / batch), message.empty() ? "" : "; last: ", message.c_str());
+    return;
+  }
+  char what[96];
+  std::snprintf(what, sizeof what, "learnt by frame %lld (%lld batch(es) refused before)",
+                static_cast<long long>(frame.index), static_cast<long long>(learnt / batch - 1));
+  print_share(what);
+}
+
 }  // namespace
 
 int info_command(const CommandArgs& args) {
@@ -137,12 +195,17 @@ int info_command(const CommandArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
   if (config.source.type == "folder" || config.source.type == "bag") {
     if (config.source.path.empty()) make_source(config);  // throws: source.path is required
-    return print_recording(config.source.path);
+    const int status = print_recording(config.source.path);
+    if (status == 0) print_background(config, args.frames);
+    return status;
   }
   if (config.source.type != "sim") {
     make_source(config);  // throws the "not available in this build yet" error
   }
-  return print_sim(config);
+  const int status = print_sim(config);
+  std::fflush(stdout);
+  if (status == 0) print_background(config, args.frames);
+  return status;
 }
 
 }  // namespace hrcsense::app

@@ -68,6 +68,9 @@ class Pipeline {
   double unknown_background_share() const;
   /// Why the background learning last restarted; empty if it never did.
   const std::string& background_message() const { return learner_.message(); }
+  /// Pixels of the learnt background left unknown because they moved far from the robot while
+  /// it was learnt (BackgroundLearner::unsettled_pixels); 0 for a loaded background.
+  size_t unsettled_background_pixels() const { return preset_background_ ? 0 : learner_.unsettled_pixels(); }
 
  private:
   PipelineParams params_;
