@@ -11,12 +11,14 @@
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/safety.hpp"
 #include "hrcsense/segmentation.hpp"
+#include "hrcsense/self_filter.hpp"
 #include "hrcsense/sink.hpp"
 #include "hrcsense/source.hpp"
 #include "hrcsense/types.hpp"
 
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -35,6 +37,9 @@ struct PipelineParams {
   RobotParams robot;  ///< the arm (capsules from each frame's robot state) or fixed points
   BackgroundParams background;
   ForegroundParams foreground;
+  /// The arm's own pixels (arms only; robot.model points have no body to render). The learner
+  /// masks them whatever self_filter.enabled says.
+  SelfFilterParams self_filter;
   SafetyParams safety;
   /// `proximity.backend`: brute, kdtree, octree or auto (depth_space later); the pipeline throws
   /// std::invalid_argument for another name.
@@ -62,6 +67,8 @@ class Pipeline {
   void process(const Frame& frame, const RobotState& robot_state, FrameResult& result);
   /// The robot's capsules of the last frame that got as far as the search (base frame).
   const RobotModel& robot() const { return robot_; }
+  /// The self-filter with the last frame's rendered robot (empty for robot.model points).
+  const SelfFilter& self_filter() const { return self_filter_; }
   const Foreground& foreground() const { return foreground_; }
   /// Share of the background's pixels whose depth is unknown (never measured, or never settled
   /// while learning: BackgroundLearner::unsettled_pixels), 0..1; -1 before a background exists.
@@ -84,9 +91,13 @@ class Pipeline {
   ProximitySearch proximity_;  ///< params_.backend with its reusable search buffers
   Frame filtered_;       ///< the filtered copy of the current frame (buffers reused)
   RobotModel robot_;     ///< params_.robot at the current frame's robot state (buffer reused)
+  SelfFilter self_filter_;  ///< the arm's remembered poses rendered into the filtered frame
   BackgroundCheck check_;  ///< of a loaded background against the first frames
 
   bool enough_valid_depth(const Frame& frame, FrameResult& result) const;
+  /// Remembers robot_ and renders the remembered poses into `frame`; the robot's pixels, or none
+  /// when there is no arm to render.
+  std::optional<RobotPixels> render_robot(const Frame& frame, FrameResult& result);
   bool background_checked(const Frame& frame, FrameResult& result);
 };
 

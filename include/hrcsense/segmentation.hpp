@@ -3,6 +3,7 @@
 // speckle removal by physical size, and deprojection of the foreground into point clouds.
 #pragma once
 
+#include "hrcsense/self_filter.hpp"
 #include "hrcsense/types.hpp"
 
 #include <cstdint>
@@ -59,8 +60,9 @@ struct BackgroundParams {
   /// Stereo noise model used for σ_model(z) (subpixel RMS in px; baseline from the frame).
   float subpixel_rms_px = 0.08F;
   /// `background.motion_max_distance_m`: with a MotionRegion, motion counts only where the
-  /// moving pixel's mean lies within this distance of the robot's capsules (and inside the
-  /// workspace): what matters for safety is motion near the robot, not at the far wall.
+  /// moving pixel's mean or its nearest sample of the batch lies within this distance of the
+  /// robot's capsules (and inside the workspace): what matters for safety is motion near the
+  /// robot, not at the far wall.
   float motion_max_distance_m = 2.0F;
   /// A background loaded from a file is compared with this many first frames before it is
   /// trusted (BackgroundCheck); 0 trusts it at once (tests only).
@@ -99,8 +101,11 @@ struct BackgroundLearner {
 
   /// Adds one frame. Returns `restarted` (with `message()` saying why) when the batch just
   /// completed showed motion, `ready` once `model()` is usable.
-  /// With `region`, motion counts only inside it (see MotionRegion).
-  Status add(const Frame& frame, const MotionRegion* region = nullptr);
+  /// With `region`, motion counts only inside it (see MotionRegion). With `robot`
+  /// (SelfFilter::robot_pixels(), the frame's size), the robot's own pixels are no samples:
+  /// the background behind the arm is learnt from the frames where the arm is elsewhere, and
+  /// the arm's motion is never the scene's.
+  Status add(const Frame& frame, const MotionRegion* region = nullptr, const RobotPixels* robot = nullptr);
   /// Pixels whose background is unknown because they moved outside the motion region in the
   /// batch that was learnt (0 before).
   size_t unsettled_pixels() const { return unsettled_; }
@@ -117,6 +122,7 @@ struct BackgroundLearner {
   std::vector<double> sum_, sum_sq_;
   size_t unsettled_ = 0;
   std::vector<uint32_t> valid_count_;
+  std::vector<uint16_t> nearest_raw_;  ///< per pixel: the batch's nearest valid sample, 0 for none
   int count_ = 0;
   bool ready_ = false;
   double noise_per_z2_ = 0.0;
@@ -174,6 +180,9 @@ struct Foreground {
   std::vector<uint8_t> mask;  ///< 1 = foreground pixel (after speckle removal)
   PointCloud points_camera;   ///< camera frame, metres
   PointCloud points_base;     ///< robot base frame, metres
+  /// Pixels that passed the background test but were the robot's own (SelfFilter), removed
+  /// before speckle removal.
+  size_t self_filtered_pixels = 0;
 };
 
 /// Extracts the foreground. set_background() solves the background test once per pixel into
@@ -198,7 +207,9 @@ struct ForegroundExtractor {
   /// Fills `out` from `frame` against the prepared background, with `T_base_camera` for the
   /// base frame. Returns false, with an empty mask and clouds, when !prepared_for(frame): the
   /// caller must then treat the frame as unusable (a stop), never as free of foreground.
-  bool extract(const Frame& frame, const Pose& T_base_camera, Foreground& out);
+  /// With `robot` (SelfFilter::robot_pixels(), the frame's size), the robot's own pixels leave
+  /// the foreground.
+  bool extract(const Frame& frame, const Pose& T_base_camera, Foreground& out, const RobotPixels* robot = nullptr);
 
  private:
   // What set_background() was called with; prepared_for() compares frames and params to it.

@@ -238,6 +238,8 @@ struct FrameResult {
   Verdict verdict;
   Contact contact;            ///< contact.valid false when there is no foreground
   size_t foreground_points = 0;
+  /// Pixels the self-filter removed from the foreground (the robot's own); 0 without an arm.
+  size_t self_filtered_pixels = 0;
   size_t invalid_pixels = 0;  ///< raw zeros in the source frame, before any filter
   /// Share of valid (non-zero) pixels in the filtered image, 0..1 (safety.min_valid_share);
   /// 0 when the frame was not filtered (no valid depth at all, or no source frame).

@@ -122,6 +122,13 @@ void read_segmentation(KeyReader& r, Config& c) {
   if ((fg.workspace_base.min.array() > fg.workspace_base.max.array()).any()) {
     r.fail_pair("foreground.workspace_base.min", "foreground.workspace_base.max", "expected min <= max on every axis");
   }
+
+  // The arm's own pixels (docs/ROBOT.md, "Self-filter"); robot.model points have no body to render.
+  SelfFilterParams& sf = c.pipeline.self_filter;
+  r.flag("self_filter.enabled", sf.enabled);
+  r.number("self_filter.margin_m", sf.margin_m, Bound::non_negative, 1.0F);
+  r.integer("self_filter.dilate_px", sf.dilate_px, 0, 64);
+  r.integer("self_filter.memory_frames", sf.memory_frames, 1, 30);
 }
 
 void read_robot_and_safety(KeyReader& r, Config& c) {

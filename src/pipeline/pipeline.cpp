@@ -68,6 +68,7 @@ void begin_result(const Frame& frame, const RobotState& robot_state, FrameResult
   result.contact = Contact{};
   result.backend = nullptr;
   result.foreground_points = 0;
+  result.self_filtered_pixels = 0;
   result.invalid_pixels = 0;
   result.valid_share = 0.0F;
   result.timings.clear();  // keeps its capacity: one entry per filter block and stage after the first frame
@@ -89,9 +90,10 @@ void set_learning(Verdict& verdict, int frames_seen, int frames_total, const std
 
 // Adds a frame to the learner and sets the learning verdict. The frame that completes the
 // model is a learning frame too, so it stays invalid like the ones before it.
-void learn_background(BackgroundLearner& learner, const Frame& frame, const MotionRegion* region, Verdict& verdict) {
+void learn_background(BackgroundLearner& learner, const Frame& frame, const MotionRegion* region,
+                      const RobotPixels* robot, Verdict& verdict) {
   const int frames_total = learner.params.frames;
-  const bool completed = learner.add(frame, region) == BackgroundLearner::Status::ready;
+  const bool completed = learner.add(frame, region, robot) == BackgroundLearner::Status::ready;
   set_learning(verdict, completed ? frames_total : learner.frames_seen(), frames_total, learner.message());
 }
 
@@ -102,11 +104,11 @@ bool same_size(const BackgroundModel& model, const DepthImage& depth) {
 // The foreground against the background. Prepares the extractor's per-pixel tables first when
 // the background or the camera changed: once per background, a few milliseconds at 848x480.
 bool extract_foreground(ForegroundExtractor& extractor, const BackgroundModel& background, const Frame& frame,
-                        const Pose& T_base_camera, Foreground& out) {
+                        const Pose& T_base_camera, const RobotPixels* robot, Foreground& out) {
   if (!extractor.prepared_for(frame)) {
     extractor.set_background(background, frame.intrinsics.fx, frame.stereo_baseline_mm, frame.depth.depth_scale_m);
   }
-  return extractor.extract(frame, T_base_camera, out);
+  return extractor.extract(frame, T_base_camera, out, robot);
 }
 
 // The depth filters, one timing per block named after it; the source frame itself when the
@@ -142,6 +144,18 @@ Pipeline::Pipeline(PipelineParams params)
   learner_.params = params_.background;
   extractor_.params = params_.foreground;
   filters_.params = params_.filters;
+  self_filter_.params = params_.self_filter;
+}
+
+std::optional<RobotPixels> Pipeline::render_robot(const Frame& frame, FrameResult& result) {
+  if (!params_.robot.arm) return std::nullopt;
+  const SelfFilterNoise noise{params_.foreground.k_sigma, params_.foreground.min_margin_m,
+                              params_.foreground.subpixel_rms_px};
+  timed(result, "self_filter", [&] {
+    self_filter_.add_pose(robot_);
+    self_filter_.render(frame, params_.T_base_camera, noise);
+  });
+  return self_filter_.robot_pixels();
 }
 
 void Pipeline::set_background(BackgroundModel model, std::string origin) {
@@ -180,12 +194,19 @@ void Pipeline::process(const Frame& source_frame, const RobotState& robot_state,
   const Frame& frame = run_filters(filters_, source_frame, filtered_, result);
   if (!enough_valid_depth(frame, result)) return finish(result, start);
   if (!background_ready()) {
+    // Motion counts near the robot where it is now, and the robot's own pixels are no samples;
+    // without a usable state, motion counts everywhere.
+    const bool placed = robot_state.valid && all_finite(robot_state.q_rad);
+    std::optional<RobotPixels> robot_pixels;
+    if (placed) {
+      robot_model_at(params_.robot, robot_state.q_rad, robot_);
+      robot_pixels = render_robot(frame, result);
+    } else {
+      self_filter_.clear_poses();
+    }
     timed(result, "background", [&] {
-      // Motion counts near the robot where it is now; without a usable state, everywhere.
-      const bool placed = robot_state.valid && all_finite(robot_state.q_rad);
-      if (placed) robot_model_at(params_.robot, robot_state.q_rad, robot_);
       const MotionRegion region{params_.T_base_camera, placed ? &robot_ : nullptr, params_.foreground.workspace_base};
-      learn_background(learner_, frame, &region, result.verdict);
+      learn_background(learner_, frame, &region, robot_pixels ? &*robot_pixels : nullptr, result.verdict);
     });
     return finish(result, start);
   }
@@ -193,6 +214,7 @@ void Pipeline::process(const Frame& source_frame, const RobotState& robot_state,
     return finish_stop(result, ReasonCode::background_mismatch, "background size mismatch", start);
   }
   if (!background_checked(frame, result)) return finish(result, start);
+  if (!robot_state.valid || !all_finite(robot_state.q_rad)) self_filter_.clear_poses();  // its poses are history
   if (!robot_state.valid) {
     // A state with a sample time had samples that are now too old; one without never had any.
     if (robot_state.sample_time_ns > 0) {
@@ -207,10 +229,13 @@ void Pipeline::process(const Frame& source_frame, const RobotState& robot_state,
   }
   robot_model_at(params_.robot, robot_state.q_rad, robot_);
   if (robot_.capsules.empty()) return finish_stop(result, ReasonCode::no_robot_model, "no robot model", start);
+  const std::optional<RobotPixels> robot_pixels = render_robot(frame, result);
+  const RobotPixels* self_filter = params_.self_filter.enabled && robot_pixels ? &*robot_pixels : nullptr;
   bool extracted = false;
   timed(result, "foreground", [&] {
-    extracted = extract_foreground(extractor_, background(), frame, params_.T_base_camera, foreground_);
+    extracted = extract_foreground(extractor_, background(), frame, params_.T_base_camera, self_filter, foreground_);
   });
+  result.self_filtered_pixels = foreground_.self_filtered_pixels;
   if (!extracted) {
     return finish_stop(result, ReasonCode::foreground_failed, "foreground extraction failed", start);
   }

@@ -239,22 +239,35 @@ float distance_to_capsules(const RobotModel& robot, const Eigen::Vector3f& p) {
 // max_distance_m from the robot, or outside the workspace) and marks them in `outside`.
 // Returns how many were cleared. A pixel that cannot be placed (no mean, a failed
 // deprojection) stays moving: only motion known to be far away is forgiven.
+// The nearer of two raw samples, 0 ("no sample") losing to any valid one.
+uint16_t nearer_sample(uint16_t a, uint16_t b) {
+  const uint16_t a_key = static_cast<uint16_t>(a - 1U);  // 0 wraps to 65535, the farthest
+  const uint16_t b_key = static_cast<uint16_t>(b - 1U);
+  return static_cast<uint16_t>((a_key < b_key ? a_key : b_key) + 1U);
+}
+
 size_t keep_motion_near_robot(const BackgroundModel& model, const Intrinsics& intrinsics, const MotionRegion& region,
-                              float max_distance_m, uint8_t* moving, uint8_t* outside) {
+                              float max_distance_m, const uint16_t* nearest_raw, float depth_scale_m, uint8_t* moving,
+                              uint8_t* outside) {
   size_t cleared = 0;
   const size_t n = model.mean_m.size();
   const Eigen::Matrix3f R = region.T_base_camera.linear().cast<float>();
   const Eigen::Vector3f t = region.T_base_camera.translation().cast<float>();
+  // Near when the pixel's mean or its nearest sample is near: a person crossing a pixel in a
+  // few frames barely moves its mean, which stays at the wall behind them.
+  const auto near_at = [&](const Eigen::Vector2f& pixel, float z_m) {
+    const std::optional<Eigen::Vector3f> p_camera = deproject(intrinsics, pixel, z_m);
+    if (!p_camera) return true;  // cannot be placed: not known to be far
+    const Eigen::Vector3f p_base = R * *p_camera + t;
+    return region.workspace_base.contains(p_base) && distance_to_capsules(*region.robot, p_base) <= max_distance_m;
+  };
   for (size_t i = 0; i < n; ++i) {
     outside[i] = 0;
     if (moving[i] == 0 || !(model.mean_m[i] > 0.0F)) continue;
     const Eigen::Vector2f pixel(static_cast<float>(i % static_cast<size_t>(model.width)),
                                 static_cast<float>(i / static_cast<size_t>(model.width)));
-    const std::optional<Eigen::Vector3f> p_camera = deproject(intrinsics, pixel, model.mean_m[i]);
-    if (!p_camera) continue;
-    const Eigen::Vector3f p_base = R * *p_camera + t;
-    const bool near = region.workspace_base.contains(p_base) && distance_to_capsules(*region.robot, p_base) <= max_distance_m;
-    if (near) continue;
+    if (near_at(pixel, model.mean_m[i])) continue;
+    if (nearest_raw[i] != 0 && near_at(pixel, static_cast<float>(nearest_raw[i]) * depth_scale_m)) continue;
     moving[i] = 0;
     outside[i] = 1;
     ++cleared;
@@ -264,7 +277,8 @@ size_t keep_motion_near_robot(const BackgroundModel& model, const Intrinsics& in
 
 }  // namespace
 
-BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const MotionRegion* region) {
+BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const MotionRegion* region,
+                                                 const RobotPixels* robot) {
   if (ready_) return Status::ready;
   const DepthImage& depth = frame.depth;
   const size_t n = static_cast<size_t>(depth.width) * static_cast<size_t>(depth.height);
@@ -281,6 +295,7 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
     sum_.assign(n, 0.0);
     sum_sq_.assign(n, 0.0);
     valid_count_.assign(n, 0U);
+    nearest_raw_.assign(n, 0);
     model_.width = depth.width;
     model_.height = depth.height;
     model_.mean_m.assign(n, 0.0F);
@@ -298,15 +313,29 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
     std::fill(sum_.begin(), sum_.end(), 0.0);
     std::fill(sum_sq_.begin(), sum_sq_.end(), 0.0);
     std::fill(valid_count_.begin(), valid_count_.end(), 0U);
+    std::fill(nearest_raw_.begin(), nearest_raw_.end(), uint16_t{0});
   }
 
   // Raw units are integers, so the sums stay exact in double (65535² · 2^20 < 2^53).
   const uint16_t* raw = depth.pixels.data();
-  for (size_t i = 0; i < n; ++i) {
-    const double r = raw[i];
-    sum_[i] += r;
-    sum_sq_[i] += r * r;
-    valid_count_[i] += raw[i] != 0 ? 1U : 0U;
+  if (robot == nullptr) {
+    for (size_t i = 0; i < n; ++i) {
+      const double r = raw[i];
+      sum_[i] += r;
+      sum_sq_[i] += r * r;
+      valid_count_[i] += raw[i] != 0 ? 1U : 0U;
+      nearest_raw_[i] = nearer_sample(nearest_raw_[i], raw[i]);
+    }
+  } else {
+    // The robot's own pixels are no samples, as if invalid.
+    for (size_t i = 0; i < n; ++i) {
+      const uint16_t sample = robot->contains(i, raw[i]) ? uint16_t{0} : raw[i];
+      const double r = sample;
+      sum_[i] += r;
+      sum_sq_[i] += r * r;
+      valid_count_[i] += sample != 0 ? 1U : 0U;
+      nearest_raw_[i] = nearer_sample(nearest_raw_[i], sample);
+    }
   }
   ++count_;
   if (count_ < std::max(params.frames, 1)) return status;
@@ -323,8 +352,9 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
                                  static_cast<double>(params.max_noise_per_z2));
   const size_t reliable = mark_moving(model_, params, noise_per_z2_, moving_.data());
   const bool gated = region != nullptr && region->robot != nullptr && !region->robot->capsules.empty();
-  const size_t unsettled = gated ? keep_motion_near_robot(model_, frame.intrinsics, *region,
-                                                          params.motion_max_distance_m, moving_.data(), outside_.data())
+  const size_t unsettled = gated ? keep_motion_near_robot(model_, frame.intrinsics, *region, params.motion_max_distance_m,
+                                                          nearest_raw_.data(), depth.depth_scale_m, moving_.data(),
+                                                          outside_.data())
                                  : 0;
   const size_t moving = count_wide_motion(moving_.data(), depth.width, depth.height, params.motion_min_width_px,
                                           eroded_.data());

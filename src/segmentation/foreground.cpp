@@ -306,7 +306,9 @@ bool ForegroundExtractor::prepared_for(const Frame& frame) const {
          params.subpixel_rms_px == prepared_params_.subpixel_rms_px;
 }
 
-bool ForegroundExtractor::extract(const Frame& frame, const Pose& T_base_camera, Foreground& out) {
+bool ForegroundExtractor::extract(const Frame& frame, const Pose& T_base_camera, Foreground& out,
+                                  const RobotPixels* robot) {
+  out.self_filtered_pixels = 0;
   if (!prepared_for(frame)) {
     out.mask.clear();
     out.points_camera.clear();
@@ -346,6 +348,18 @@ bool ForegroundExtractor::extract(const Frame& frame, const Pose& T_base_camera,
   });
   for (size_t v = 0; v < height; ++v) {
     if ((row_states_[v] & kUnknown) != 0) row_states_[v] |= kCandidate;
+  }
+  // The robot's own pixels go before speckle removal, so that the fringe the self-filter leaves
+  // around the arm is judged by its own size, not as part of the arm's blob.
+  if (robot != nullptr) {
+    size_t removed = 0;
+    for_each_marked_in_rows(mask, row_states_.data(), width, 0, height, kCandidate, [&](size_t i) {
+      if (robot->contains(i, depth.pixels[i])) {
+        mask[i] = kNone;
+        ++removed;
+      }
+    });
+    out.self_filtered_pixels = removed;
   }
 
   const Kept kept = remove_speckles(frame, jump_limit_raw_.data(), params.min_object_mm, row_states_.data(), mask,

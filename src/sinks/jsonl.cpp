@@ -243,6 +243,7 @@ void JsonLinesSink::frame(const FrameResult& result) {
   // The backend that searched (auto's pick), else the configured one.
   m.text("backend", result.backend != nullptr ? result.backend : backend_.c_str());
   m.integer("foreground_points", static_cast<int64_t>(result.foreground_points));
+  m.integer("self_filtered_pixels", static_cast<int64_t>(result.self_filtered_pixels));
   m.integer("invalid_pixels", static_cast<int64_t>(result.invalid_pixels));
   m.number("valid_share", result.valid_share);
   m.integer("host_time_ns", result.host_time_ns);

@@ -254,16 +254,12 @@ TEST(LearningScenes, PersonWalkingBehindTheRobotRestartsLearningWithoutARobotSta
   EXPECT_EQ(run.restarts, 2);
 }
 
-// DISABLED: the learner accepts the first batch (ready at frame 29) while this person walks
-// 0.8 m behind the robot base, within 1 m of its capsules, in view from frame 0. The motion
-// region places each moving pixel at its batch *mean* depth; a pixel the walker covers in a
-// few of the 30 frames and the wall 1.7 m behind them in the rest has its mean near the wall,
-// more than background.motion_max_distance_m from the capsules, so the motion is forgiven as
-// far away (those pixels become unknown: unknown_background_share 0.037 against 0.010 for the
-// empty cell). Without a robot state the same frames restart learning (the test above).
-// Placing a moving pixel at its nearest sample of the batch would count it. For the learner's
-// owner (src/segmentation/background.cpp, keep_motion_near_robot).
-TEST(LearningScenes, DISABLED_PersonWalkingBehindTheRobotKeepsLearningUntilTheyLeave) {
+// A person walking 0.8 m behind the robot base, within 1 m of its capsules, with a wall 1.7 m
+// behind them. A pixel the walker covers in a few of the batch's frames has its mean near the
+// wall, beyond background.motion_max_distance_m; its nearest sample is the walker, near the
+// robot, and that is what must count (placing pixels at their mean alone accepted the first
+// batch at frame 29 while the walker was in view until frame 100).
+TEST(LearningScenes, PersonWalkingBehindTheRobotKeepsLearningUntilTheyLeave) {
   Config config = cell_config(-2.5F);
   add_walker(config, -0.8F, -1.8F, 1.0F, -3.5F, 2.0);
   const LearningRun run = learn(config, 200);

@@ -1,0 +1,215 @@
+// SPDX-License-Identifier: Apache-2.0
+// The self-filter on a pinhole camera small enough to work out by hand. The expected depths
+// come from the geometry written in the comments (a ray's distance to a capsule's axis solved
+// as a quadratic in the ray's depth), not from the filter's ray-capsule code, and the rules from
+// self_filter.hpp: a pixel is the robot's when its depth lies in [nearest padded surface −
+// max(margin_m, min_margin_m, k_sigma · σ(z)), farthest padded surface], over the union of the
+// remembered poses, with the silhouette dilated by dilate_px.
+
+#include "hrcsense/self_filter.hpp"
+
+#include "hrcsense/segmentation.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace hrcsense {
+namespace {
+
+constexpr int kSize = 101;        // 101 x 101 pixels, the optical axis through pixel (50, 50)
+constexpr float kFocalPx = 100.0F;
+
+Frame camera_frame(float baseline_mm = 0.0F) {
+  Frame frame;
+  frame.depth.resize(kSize, kSize);
+  frame.depth.depth_scale_m = 0.001F;
+  frame.intrinsics = Intrinsics{kSize, kSize, kFocalPx, kFocalPx, 50.0F, 50.0F, Distortion::none, {}};
+  frame.stereo_baseline_mm = baseline_mm;
+  return frame;
+}
+
+/// A horizontal bar 2 m in front of the camera: axis from x = −0.2 to 0.2 m at y = 0, z = z_m
+/// (camera frame = base frame here), radius 0.1 m.
+RobotModel bar_at(float z_m, float y_m = 0.0F) {
+  RobotModel robot;
+  Capsule c;
+  c.a = Eigen::Vector3f(-0.2F, y_m, z_m);
+  c.b = Eigen::Vector3f(0.2F, y_m, z_m);
+  c.radius_m = 0.1F;
+  robot.capsules.push_back(c);
+  return robot;
+}
+
+size_t index(int u, int v) { return static_cast<size_t>(v) * kSize + static_cast<size_t>(u); }
+
+/// Depths where the ray through pixel (50, v) meets the cylinder of radius r about the line
+/// y = 0, z = z_axis: with y = t·(v − 50)/f and z = t, (t·s)² + (t − z_axis)² = r², s = (v − 50)/f.
+std::pair<double, double> ray_meets_bar(int v, double z_axis, double r) {
+  const double s = (v - 50) / static_cast<double>(kFocalPx);
+  const double a = 1.0 + s * s, b = -2.0 * z_axis, c = z_axis * z_axis - r * r;
+  const double disc = b * b - 4.0 * a * c;
+  return {(-b - std::sqrt(disc)) / (2.0 * a), (-b + std::sqrt(disc)) / (2.0 * a)};
+}
+
+SelfFilter filter_with(int dilate_px, float margin_m = 0.03F, int memory = 1) {
+  SelfFilter filter;
+  filter.params.dilate_px = dilate_px;
+  filter.params.margin_m = margin_m;
+  filter.params.memory_frames = memory;
+  return filter;
+}
+
+TEST(SelfFilter, CentrePixelSpansTheBarFromItsFrontToItsBack) {
+  SelfFilter filter = filter_with(0);
+  filter.add_pose(bar_at(2.0F));
+  filter.render(camera_frame(), Pose::Identity(), SelfFilterNoise{});
+  // The optical axis meets the bar's front at 2.0 − 0.1 and its back at 2.0 + 0.1.
+  EXPECT_NEAR(filter.surface_depth_m()[index(50, 50)], 1.9, 1e-5);
+  const RobotPixels robot = filter.robot_pixels();
+  // Without a baseline the margin is max(margin_m 0.03, min_margin_m 0.02): from 1.87 m.
+  EXPECT_NEAR(robot.from_raw[index(50, 50)], 1870, 1);
+  EXPECT_NEAR(robot.to_raw[index(50, 50)], 2100, 1);
+  EXPECT_TRUE(robot.contains(index(50, 50), 1900));  // the arm's own surface
+  EXPECT_TRUE(robot.contains(index(50, 50), 1880));  // within the margin in front
+  EXPECT_FALSE(robot.contains(index(50, 50), 1800)); // a hand 10 cm in front of the arm
+  EXPECT_FALSE(robot.contains(index(50, 50), 2150)); // something beyond the padded body
+  EXPECT_FALSE(robot.contains(index(50, 50), 0));    // no data is never the robot's
+}
+
+TEST(SelfFilter, OffAxisPixelsFollowTheCylindersCurve) {
+  SelfFilter filter = filter_with(0);
+  filter.add_pose(bar_at(2.0F));
+  filter.render(camera_frame(), Pose::Identity(), SelfFilterNoise{});
+  for (int v : {47, 52, 54}) {
+    const auto [front, back] = ray_meets_bar(v, 2.0, 0.1);
+    EXPECT_NEAR(filter.surface_depth_m()[index(50, v)], front, 1e-4) << "v = " << v;
+    EXPECT_NEAR(filter.robot_pixels().to_raw[index(50, v)], std::floor(back * 1000.0), 1.0) << "v = " << v;
+  }
+  // The silhouette's half-height: tan(asin(0.1 / 2)) · f = 5.006 px, so rows 45..55 only.
+  EXPECT_NE(filter.robot_pixels().from_raw[index(50, 55)], 0);
+  EXPECT_EQ(filter.robot_pixels().from_raw[index(50, 56)], 0);
+  EXPECT_EQ(filter.robot_pixels().from_raw[index(50, 44)], 0);
+  // Column 90 looks 0.8 m beside the optical axis at 2 m, far past the bar's end at x = 0.3.
+  EXPECT_EQ(filter.robot_pixels().from_raw[index(90, 50)], 0);
+  EXPECT_EQ(filter.silhouette_pixels(), static_cast<size_t>(std::count_if(
+                                            filter.robot_pixels().from_raw, filter.robot_pixels().from_raw + kSize * kSize,
+                                            [](uint16_t x) { return x != 0; })));
+}
+
+TEST(SelfFilter, DilationGrowsTheSilhouetteWithTheNeighboursDepths) {
+  SelfFilter filter = filter_with(2);
+  filter.add_pose(bar_at(2.0F));
+  filter.render(camera_frame(), Pose::Identity(), SelfFilterNoise{});
+  // Rows 56 and 57 are within 2 px of row 55, the last one inside; each takes the nearest front
+  // of the 5x5 square around it: rows 55..59 hold only row 55's, rows 54..58 also row 54's,
+  // which is nearer (closer to the axis).
+  const double front_55 = ray_meets_bar(55, 2.0, 0.1).first;
+  const double front_54 = ray_meets_bar(54, 2.0, 0.1).first;
+  // Row 55 grazes the bar, where float's square root of a small discriminant leaves ~0.1 mm.
+  EXPECT_NEAR(filter.surface_depth_m()[index(50, 57)], front_55, 5e-4);
+  EXPECT_NEAR(filter.surface_depth_m()[index(50, 56)], front_54, 5e-4);
+  EXPECT_EQ(filter.robot_pixels().from_raw[index(50, 58)], 0);
+  EXPECT_TRUE(std::isinf(filter.surface_depth_m()[index(50, 58)]));
+}
+
+TEST(SelfFilter, MarginIsNeverBelowTheForegroundsNoiseTest) {
+  // With a D435-like baseline the stereo σ at 2 m is z² · 0.08 / (f · B) = 4 · 0.08 / (100 ·
+  // 0.05) = 0.064 m; k_sigma 4 makes the margin 0.256 m, far above margin_m.
+  SelfFilter filter = filter_with(0);
+  filter.add_pose(bar_at(2.0F));
+  filter.render(camera_frame(50.0F), Pose::Identity(), SelfFilterNoise{4.0F, 0.02F, 0.08F});
+  const double front = 1.9;
+  const double sigma = front * front * 0.08 / (kFocalPx * 0.05);
+  EXPECT_NEAR(filter.robot_pixels().from_raw[index(50, 50)], std::ceil((front - 4.0 * sigma) * 1000.0), 1.0);
+}
+
+TEST(SelfFilter, RemembersTheUnionOfTheLastPoses) {
+  // The arm moves away from the camera, 2 cm a frame: the filtered image still shows it where it
+  // was (the temporal filter's lag), so the nearest remembered front counts.
+  SelfFilter filter = filter_with(0, 0.03F, 3);
+  const float depths[] = {2.00F, 2.02F, 2.04F, 2.06F};
+  for (float z : depths) filter.add_pose(bar_at(z));
+  filter.render(camera_frame(), Pose::Identity(), SelfFilterNoise{});
+  EXPECT_EQ(filter.poses(), 3);
+  // Remembered: 2.02, 2.04, 2.06 (the oldest, 2.00, forgotten): front 1.92, back 2.16.
+  EXPECT_NEAR(filter.surface_depth_m()[index(50, 50)], 1.92, 1e-5);
+  EXPECT_NEAR(filter.robot_pixels().to_raw[index(50, 50)], 2160, 1);
+  // Where the arm was two frames ago (2.02 − 0.1 = 1.92) is still the robot's.
+  EXPECT_TRUE(filter.robot_pixels().contains(index(50, 50), 1925));
+  filter.clear_poses();
+  filter.render(camera_frame(), Pose::Identity(), SelfFilterNoise{});
+  EXPECT_EQ(filter.robot_pixels().from_raw[index(50, 50)], 0);
+  EXPECT_EQ(filter.silhouette_pixels(), 0U);
+}
+
+TEST(SelfFilter, ARenderForgetsTheLastOnesPixels) {
+  SelfFilter filter = filter_with(1);
+  filter.add_pose(bar_at(2.0F, 0.3F));  // up in the image: rows around 50 + 0.3 / 2 · 100 = 65
+  filter.render(camera_frame(), Pose::Identity(), SelfFilterNoise{});
+  EXPECT_NE(filter.robot_pixels().from_raw[index(50, 65)], 0);
+  filter.add_pose(bar_at(2.0F, -0.3F));  // memory 1: only this pose, rows around 35
+  filter.render(camera_frame(), Pose::Identity(), SelfFilterNoise{});
+  EXPECT_EQ(filter.robot_pixels().from_raw[index(50, 65)], 0);
+  EXPECT_TRUE(std::isinf(filter.surface_depth_m()[index(50, 65)]));
+  EXPECT_NE(filter.robot_pixels().from_raw[index(50, 35)], 0);
+}
+
+TEST(SelfFilter, CameraPoseMovesTheArmIntoTheCameraFrame) {
+  // The bar given in a base frame whose origin is 1 m behind the camera along its axis.
+  SelfFilter filter = filter_with(0);
+  filter.add_pose(bar_at(3.0F));
+  Pose T_base_camera = Pose::Identity();
+  T_base_camera.translation() = Eigen::Vector3d(0.0, 0.0, 1.0);  // the camera at z = 1 in the base
+  filter.render(camera_frame(), T_base_camera, SelfFilterNoise{});
+  EXPECT_NEAR(filter.surface_depth_m()[index(50, 50)], 1.9, 1e-5);
+}
+
+// The foreground keeps a hand 10 cm in front of the arm and drops the arm itself.
+TEST(SelfFilter, ForegroundKeepsAHandInFrontOfTheArmAndDropsTheArm) {
+  SelfFilter filter = filter_with(1);
+  filter.add_pose(bar_at(2.0F));
+  Frame frame = camera_frame();
+  filter.render(frame, Pose::Identity(), SelfFilterNoise{});
+  // Background: a wall at 3 m. The bar's own rows 45..55 at the bar's depth, and a 10 x 10 px
+  // hand 10 cm in front of the bar's front at columns 40..49, rows 46..55.
+  BackgroundModel background;
+  background.width = background.height = kSize;
+  background.mean_m.assign(kSize * kSize, 3.0F);
+  background.spread_m.assign(kSize * kSize, 0.005F);
+  background.valid_ratio.assign(kSize * kSize, 1.0F);
+  frame.depth.pixels.assign(kSize * kSize, 3000);
+  for (int v = 45; v <= 55; ++v) {
+    for (int u = 0; u < kSize; ++u) {
+      const double front = filter.surface_depth_m()[index(u, v)];
+      if (std::isfinite(front)) frame.depth.pixels[index(u, v)] = static_cast<uint16_t>(std::lround(front * 1000.0 + 10.0));
+    }
+  }
+  for (int v = 46; v <= 55; ++v) {
+    for (int u = 40; u <= 49; ++u) frame.depth.pixels[index(u, v)] = 1800;
+  }
+  ForegroundExtractor extractor;
+  extractor.params.min_object_mm = 0.0F;
+  extractor.set_background(background, kFocalPx, 0.0F, 0.001F);
+  Foreground fg;
+  const RobotPixels robot = filter.robot_pixels();
+  ASSERT_TRUE(extractor.extract(frame, Pose::Identity(), fg, &robot));
+  EXPECT_EQ(fg.points_camera.size(), 100U);  // the hand, nothing of the arm
+  for (size_t k = 0; k < fg.points_camera.size(); ++k) EXPECT_NEAR(fg.points_camera.z[k], 1.8F, 1e-4F);
+  // Every other pixel of the bar's rows was the arm's: removed and counted.
+  size_t arm = 0;
+  for (int v = 45; v <= 55; ++v) {
+    for (int u = 0; u < kSize; ++u) arm += frame.depth.pixels[index(u, v)] != 3000 && frame.depth.pixels[index(u, v)] != 1800;
+  }
+  EXPECT_EQ(fg.self_filtered_pixels, arm);
+  // Without the self-filter the arm is foreground too.
+  ASSERT_TRUE(extractor.extract(frame, Pose::Identity(), fg));
+  EXPECT_EQ(fg.points_camera.size(), 100U + arm);
+  EXPECT_EQ(fg.self_filtered_pixels, 0U);
+}
+
+}  // namespace
+}  // namespace hrcsense
