@@ -8,6 +8,7 @@
 #include "hrcsense/camera.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -52,34 +53,116 @@ struct RayInterval {
 /// of pixels vectorises.
 inline RayInterval capsule_interval(float x, float y, const CapsuleRayTerms& c) {
   const float dd = x * x + y * y + 1.0F;
+  const float inv_dd = 1.0F / dd;
   const float da = x * c.a.x() + y * c.a.y() + c.a.z();
   const float db = x * c.b.x() + y * c.b.y() + c.b.z();
   const float dba = db - da;
   // Cylinder about the axis: t² (|ba|² dd − dba²) + 2 t (dba a·ba − |ba|² da) + cylinder_c = 0.
   const float quad = std::max(c.ba_ba * dd - dba * dba, 1e-12F);
+  const float inv_quad = 1.0F / quad;
   const float half = dba * c.a_ba - c.ba_ba * da;
   const float disc = half * half - quad * c.cylinder_c;
   const float root = std::sqrt(std::max(disc, 0.0F));
-  const float t_in = (-half - root) / quad;
-  const float t_out = (-half + root) / quad;
+  const float t_in = (-half - root) * inv_quad;
+  const float t_out = (-half + root) * inv_quad;
   const float along_in = t_in * dba - c.a_ba;  // (hit − a) · (b − a)
   const float along_out = t_out * dba - c.a_ba;
-  const bool in_hit = disc >= 0.0F && along_in > 0.0F && along_in < c.ba_ba && t_in > 0.0F;
-  const bool out_hit = disc >= 0.0F && along_out > 0.0F && along_out < c.ba_ba && t_out > 0.0F;
+  // Non-short-circuit &: no branches, so that the loop over a row vectorises.
+  const bool cylinder = disc >= 0.0F;
+  const bool in_hit = cylinder & (along_in > 0.0F) & (along_in < c.ba_ba) & (t_in > 0.0F);
+  const bool out_hit = cylinder & (along_out > 0.0F) & (along_out < c.ba_ba) & (t_out > 0.0F);
   // End spheres: t² dd − 2 t (d·centre) + |centre|² − r² = 0.
   const float disc_a = da * da - dd * c.a_c;
   const float root_a = std::sqrt(std::max(disc_a, 0.0F));
   const float disc_b = db * db - dd * c.b_c;
   const float root_b = std::sqrt(std::max(disc_b, 0.0F));
-  const bool a_hit = disc_a >= 0.0F && da + root_a > 0.0F;
-  const bool b_hit = disc_b >= 0.0F && db + root_b > 0.0F;
-  float entry = in_hit ? t_in : kInf;
-  entry = a_hit ? std::min(entry, (da - root_a) / dd) : entry;
-  entry = b_hit ? std::min(entry, (db - root_b) / dd) : entry;
-  float exit = out_hit ? t_out : 0.0F;
-  exit = a_hit ? std::max(exit, (da + root_a) / dd) : exit;
-  exit = b_hit ? std::max(exit, (db + root_b) / dd) : exit;
-  return {entry, exit};
+  const bool a_hit = (disc_a >= 0.0F) & (da + root_a > 0.0F);
+  const bool b_hit = (disc_b >= 0.0F) & (db + root_b > 0.0F);
+  const float entry_a = a_hit ? (da - root_a) * inv_dd : kInf;
+  const float entry_b = b_hit ? (db - root_b) * inv_dd : kInf;
+  const float exit_a = a_hit ? (da + root_a) * inv_dd : 0.0F;
+  const float exit_b = b_hit ? (db + root_b) * inv_dd : 0.0F;
+  const float entry_cyl = in_hit ? t_in : kInf;
+  const float exit_cyl = out_hit ? t_out : 0.0F;
+  return {std::min(entry_cyl, std::min(entry_a, entry_b)), std::max(exit_cyl, std::max(exit_a, exit_b))};
+}
+
+/// A convex polygon in the image (pixels), for the rows a capsule can cover.
+struct ImageHull {
+  bool valid = false;
+  int count = 0;
+  std::array<Eigen::Vector2f, 8> points;  ///< counter-clockwise
+  float v_min = 0.0F, v_max = 0.0F;
+
+  /// The hull's [lo, hi] on the row at height v; false when the row misses it.
+  bool row_span(float v, float& lo, float& hi) const {
+    if (v < v_min || v > v_max) return false;
+    lo = std::numeric_limits<float>::infinity();
+    hi = -lo;
+    for (int i = 0; i < count; ++i) {
+      const Eigen::Vector2f& p = points[static_cast<size_t>(i)];
+      const Eigen::Vector2f& q = points[static_cast<size_t>((i + 1) % count)];
+      if ((p.y() - v) * (q.y() - v) > 0.0F) continue;  // the edge lies above or below the row
+      const float u = p.y() == q.y() ? p.x() : p.x() + (v - p.y()) * (q.x() - p.x()) / (q.y() - p.y());
+      lo = std::min({lo, u, p.y() == q.y() ? q.x() : u});
+      hi = std::max({hi, u, p.y() == q.y() ? q.x() : u});
+    }
+    return lo <= hi;
+  }
+};
+
+float cross(const Eigen::Vector2f& o, const Eigen::Vector2f& a, const Eigen::Vector2f& b) {
+  return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+}
+
+/// The image hull of the capsule a–b of radius r (camera frame): the convex hull of the corners
+/// of its two end spheres' projected bounding boxes. Invalid when a box reaches within 1 mm of
+/// the camera plane or behind it.
+ImageHull capsule_hull(const Eigen::Vector3f& a, const Eigen::Vector3f& b, float r, const Intrinsics& intr) {
+  ImageHull hull;
+  std::array<Eigen::Vector2f, 8> corners;
+  int n = 0;
+  for (const Eigen::Vector3f& c : {a, b}) {
+    if (c.z() - r <= 1e-3F) return hull;
+    float u_min = std::numeric_limits<float>::infinity(), u_max = -u_min, v_min = u_min, v_max = -u_min;
+    for (int corner = 0; corner < 8; ++corner) {
+      const float x = c.x() + ((corner & 1) != 0 ? r : -r);
+      const float y = c.y() + ((corner & 2) != 0 ? r : -r);
+      const float z = c.z() + ((corner & 4) != 0 ? r : -r);
+      const float u = intr.fx * x / z + intr.ppx;
+      const float v = intr.fy * y / z + intr.ppy;
+      u_min = std::min(u_min, u), u_max = std::max(u_max, u);
+      v_min = std::min(v_min, v), v_max = std::max(v_max, v);
+    }
+    corners[static_cast<size_t>(n++)] = {u_min, v_min};
+    corners[static_cast<size_t>(n++)] = {u_max, v_min};
+    corners[static_cast<size_t>(n++)] = {u_max, v_max};
+    corners[static_cast<size_t>(n++)] = {u_min, v_max};
+  }
+  // Andrew's monotone chain over the 8 corners.
+  std::sort(corners.begin(), corners.end(), [](const Eigen::Vector2f& p, const Eigen::Vector2f& q) {
+    return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y());
+  });
+  std::array<Eigen::Vector2f, 16> chain;
+  int k = 0;
+  for (int i = 0; i < 8; ++i) {  // lower hull
+    while (k >= 2 && cross(chain[static_cast<size_t>(k - 2)], chain[static_cast<size_t>(k - 1)], corners[static_cast<size_t>(i)]) <= 0.0F) --k;
+    chain[static_cast<size_t>(k++)] = corners[static_cast<size_t>(i)];
+  }
+  for (int i = 6, lower = k + 1; i >= 0; --i) {  // upper hull
+    while (k >= lower && cross(chain[static_cast<size_t>(k - 2)], chain[static_cast<size_t>(k - 1)], corners[static_cast<size_t>(i)]) <= 0.0F) --k;
+    chain[static_cast<size_t>(k++)] = corners[static_cast<size_t>(i)];
+  }
+  hull.count = std::min(k - 1, 8);  // the last point repeats the first
+  hull.v_min = std::numeric_limits<float>::infinity();
+  hull.v_max = -hull.v_min;
+  for (int i = 0; i < hull.count; ++i) {
+    hull.points[static_cast<size_t>(i)] = chain[static_cast<size_t>(i)];
+    hull.v_min = std::min(hull.v_min, chain[static_cast<size_t>(i)].y());
+    hull.v_max = std::max(hull.v_max, chain[static_cast<size_t>(i)].y());
+  }
+  hull.valid = hull.count >= 3;
+  return hull;
 }
 
 bool same_intrinsics(const Intrinsics& x, const Intrinsics& y) {
@@ -222,47 +305,49 @@ void SelfFilter::render(const Frame& frame, const Pose& T_base_camera, const Sel
       const Eigen::Vector3f a = R * capsule.a + t;
       const Eigen::Vector3f b = R * capsule.b + t;
       const float r = capsule.radius_m;
-      // The image box of the capsule's bounding box (the capsule is convex and inside it, so
-      // its silhouette is inside the projected corners' box); the whole image when a corner is
-      // at or behind the camera, or when the distortion makes the pinhole box unreliable.
-      Rect box{0, 0, width_, height_};
-      const Eigen::Vector3f lo = a.cwiseMin(b).array() - r;
-      const Eigen::Vector3f hi = a.cwiseMax(b).array() + r;
-      if (hi.z() <= 0.0F) continue;  // entirely behind the camera
-      if (pinhole_ && lo.z() > 1e-3F) {
-        float u_min = kInf, u_max = -kInf, v_min = kInf, v_max = -kInf;
-        for (int corner = 0; corner < 8; ++corner) {
-          const float x = (corner & 1) != 0 ? hi.x() : lo.x();
-          const float y = (corner & 2) != 0 ? hi.y() : lo.y();
-          const float z = (corner & 4) != 0 ? hi.z() : lo.z();
-          const float u = intr.fx * x / z + intr.ppx;
-          const float v = intr.fy * y / z + intr.ppy;
-          u_min = std::min(u_min, u), u_max = std::max(u_max, u);
-          v_min = std::min(v_min, v), v_max = std::max(v_max, v);
-        }
-        // One pixel of slack each side for the float rounding of the projection.
-        box.u0 = static_cast<int>(std::clamp(std::floor(u_min) - 1.0F, 0.0F, static_cast<float>(width_)));
-        box.u1 = static_cast<int>(std::clamp(std::ceil(u_max) + 2.0F, 0.0F, static_cast<float>(width_)));
-        box.v0 = static_cast<int>(std::clamp(std::floor(v_min) - 1.0F, 0.0F, static_cast<float>(height_)));
-        box.v1 = static_cast<int>(std::clamp(std::ceil(v_max) + 2.0F, 0.0F, static_cast<float>(height_)));
-      }
-      if (box.empty()) continue;
+      // A bare segment has no surface to see; nothing behind the camera is in the image.
+      if (!(r > 0.0F) || std::max(a.z(), b.z()) + r <= 0.0F) continue;
+      // Which pixels of each row the capsule can cover: the row's span of the convex hull of
+      // its end spheres' projected bounding boxes (the capsule is the hull of the spheres, each
+      // inside its box, and projection keeps hulls). The whole image when a box reaches behind
+      // the camera or a distortion makes the pinhole projection unreliable.
+      const ImageHull hull = pinhole_ ? capsule_hull(a, b, r, intr) : ImageHull{};
       const CapsuleRayTerms terms = ray_terms(a, b, r);
-      for (int v = box.v0; v < box.v1; ++v) {
+      const int v_begin = hull.valid ? std::max(static_cast<int>(std::floor(hull.v_min)) - 1, 0) : 0;
+      const int v_end = hull.valid ? std::min(static_cast<int>(std::ceil(hull.v_max)) + 2, height_) : height_;
+      for (int v = v_begin; v < v_end; ++v) {
+        int u0 = 0, u1 = width_;
+        if (hull.valid) {
+          float lo_u = 0.0F, hi_u = 0.0F;
+          if (!hull.row_span(static_cast<float>(v), lo_u, hi_u)) continue;
+          // One pixel of slack each side for the float rounding of the projection.
+          u0 = static_cast<int>(std::clamp(std::floor(lo_u) - 1.0F, 0.0F, static_cast<float>(width_)));
+          u1 = static_cast<int>(std::clamp(std::ceil(hi_u) + 2.0F, 0.0F, static_cast<float>(width_)));
+          if (u0 >= u1) continue;
+        }
         float* __restrict entry = entry_m_.data() + static_cast<size_t>(v) * w;
         float* __restrict exit = exit_m_.data() + static_cast<size_t>(v) * w;
-        const float* __restrict xs = ray_x_.data() + (pinhole_ ? 0 : static_cast<size_t>(v) * w);
-        const float* __restrict ys = pinhole_ ? nullptr : ray_y_.data() + static_cast<size_t>(v) * w;
-        const float y_row = pinhole_ ? ray_y_[static_cast<size_t>(v)] : 0.0F;
-        for (int u = box.u0; u < box.u1; ++u) {
-          // NaN rays (a distortion without inverse) compare false: no hit.
-          const RayInterval in = capsule_interval(xs[u], ys != nullptr ? ys[u] : y_row, terms);
-          entry[u] = in.entry < entry[u] ? in.entry : entry[u];
-          exit[u] = in.exit > exit[u] ? in.exit : exit[u];
+        if (pinhole_) {
+          const float* __restrict xs = ray_x_.data();
+          const float y = ray_y_[static_cast<size_t>(v)];
+          for (int u = u0; u < u1; ++u) {
+            const RayInterval in = capsule_interval(xs[u], y, terms);
+            entry[u] = std::min(entry[u], in.entry);
+            exit[u] = std::max(exit[u], in.exit);
+          }
+        } else {
+          const float* __restrict xs = ray_x_.data() + static_cast<size_t>(v) * w;
+          const float* __restrict ys = ray_y_.data() + static_cast<size_t>(v) * w;
+          for (int u = u0; u < u1; ++u) {
+            // NaN rays (a distortion without inverse) compare false: no hit.
+            const RayInterval in = capsule_interval(xs[u], ys[u], terms);
+            entry[u] = in.entry < entry[u] ? in.entry : entry[u];
+            exit[u] = in.exit > exit[u] ? in.exit : exit[u];
+          }
         }
+        drawn.u0 = std::min(drawn.u0, u0), drawn.u1 = std::max(drawn.u1, u1);
+        drawn.v0 = std::min(drawn.v0, v), drawn.v1 = std::max(drawn.v1, v + 1);
       }
-      drawn.u0 = std::min(drawn.u0, box.u0), drawn.u1 = std::max(drawn.u1, box.u1);
-      drawn.v0 = std::min(drawn.v0, box.v0), drawn.v1 = std::max(drawn.v1, box.v1);
     }
   }
   if (drawn.empty()) return;
@@ -276,9 +361,10 @@ void SelfFilter::render(const Frame& frame, const Pose& T_base_camera, const Sel
   // min_margin_m, k_sigma · σ(z)), σ(z) = z² · subpixel / (fx · baseline) (no stereo term
   // without a baseline).
   const float floor_m = std::max(params.margin_m, noise.min_margin_m);
+  const float fx = noise.sensor_fx_px > 0.0F ? noise.sensor_fx_px : intr.fx;
   const float sigma_per_z2 =
-      frame.stereo_baseline_mm > 0.0F && intr.fx > 0.0F
-          ? static_cast<float>(stereo_depth_sigma_m(1.0, intr.fx, frame.stereo_baseline_mm, noise.subpixel_rms_px))
+      frame.stereo_baseline_mm > 0.0F && fx > 0.0F
+          ? static_cast<float>(stereo_depth_sigma_m(1.0, fx, frame.stereo_baseline_mm, noise.subpixel_rms_px))
           : 0.0F;
   const float k_sigma_per_z2 = noise.k_sigma * sigma_per_z2;
   const float units_per_m = 1.0F / frame.depth.depth_scale_m;

@@ -412,10 +412,16 @@ TEST(BackgroundMotionRegion, MotionNearTheRobotStillRestarts) {
   BackgroundLearner near;
   near.params.frames = 4;
   EXPECT_EQ(learn_batch(near, &region), Status::restarted);
-  // A shorter reach (1.3 m) puts the same block out of it.
+  // Judged by its mean (2.4 m, 1.40 m from the robot) the block would be out of a 1.3 m reach;
+  // its nearest sample (2.0 m: (−0.0725, −0.0475, 2.0), 1.004 m from the robot) is inside it.
+  BackgroundLearner mean_outside;
+  mean_outside.params.frames = 4;
+  mean_outside.params.motion_max_distance_m = 1.3F;
+  EXPECT_EQ(learn_batch(mean_outside, &region), Status::restarted);
+  // A reach of 0.9 m puts both out of it.
   BackgroundLearner short_reach;
   short_reach.params.frames = 4;
-  short_reach.params.motion_max_distance_m = 1.3F;
+  short_reach.params.motion_max_distance_m = 0.9F;
   EXPECT_EQ(learn_batch(short_reach, &region), Status::ready);
   // Without a robot (no state, no region) motion counts everywhere, as before.
   BackgroundLearner everywhere;
@@ -429,11 +435,11 @@ TEST(BackgroundMotionRegion, MotionNearTheRobotStillRestarts) {
 }
 
 TEST(BackgroundMotionRegion, MotionOutsideTheWorkspaceDoesNotCount) {
-  // Near the robot, but the workspace ends at z = 2 m in front of the camera: the block (2.4 m)
-  // is outside it.
+  // Near the robot, but the workspace ends at z = 1.9 m in front of the camera: the block (its
+  // mean 2.4 m, its nearest sample 2.0 m) is outside it.
   const RobotModel robot = robot_point_at({0.0F, 0.0F, 1.0F});
   AlignedBox workspace;
-  workspace.max.z() = 2.0F;
+  workspace.max.z() = 1.9F;
   const MotionRegion region{Pose::Identity(), &robot, workspace};
   BackgroundLearner learner;
   learner.params.frames = 4;
