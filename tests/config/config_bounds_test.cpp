@@ -136,5 +136,25 @@ TEST(ConfigBounds, SimulatorTimingAndNoiseKeepTimestampsAndCountsInRange) {
   EXPECT_EQ(c.sim.disparity_step_px, 0.0F);
 }
 
+TEST(ConfigBounds, SelfFilterKeysAreReadAndBounded) {
+  // Defaults as docs/CONFIG.md states them, and each key reaches the pipeline's parameters.
+  const Config defaults = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml", {});
+  EXPECT_TRUE(defaults.pipeline.self_filter.enabled);
+  EXPECT_FLOAT_EQ(defaults.pipeline.self_filter.margin_m, 0.03F);
+  EXPECT_EQ(defaults.pipeline.self_filter.dilate_px, 2);
+  EXPECT_EQ(defaults.pipeline.self_filter.memory_frames, 3);
+  const Config set = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml",
+                                 {"self_filter.enabled=false", "self_filter.margin_m=0.05", "self_filter.dilate_px=0",
+                                  "self_filter.memory_frames=1"});
+  EXPECT_FALSE(set.pipeline.self_filter.enabled);
+  EXPECT_FLOAT_EQ(set.pipeline.self_filter.margin_m, 0.05F);
+  EXPECT_EQ(set.pipeline.self_filter.dilate_px, 0);
+  EXPECT_EQ(set.pipeline.self_filter.memory_frames, 1);
+  for (const std::string bad : {"self_filter.margin_m=-0.01", "self_filter.margin_m=2", "self_filter.dilate_px=65",
+                                "self_filter.memory_frames=0", "self_filter.enabled=maybe"}) {
+    expect_config_error("", {bad}, {"key '" + bad.substr(0, bad.find('=')) + "'"});
+  }
+}
+
 }  // namespace
 }  // namespace hrcsense
