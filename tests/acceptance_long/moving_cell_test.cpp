@@ -91,9 +91,9 @@ TEST(MovingCellAcceptance, LearningFinishesWhileTheArmMovesWithoutFilters) {
 }
 
 // The same cell with the swing 2.75 times as fast (1.1 s → 0.4 s: the flange at about 2.9 m/s).
-// Moving up to about 10 cm a frame, largely along the view, the arm's depth changes by less than the
-// temporal filter's delta, so the filtered image shows it where it was, blended over about 1.5
-// frames: one pose is not enough, the default three are.
+// Moving up to about 10 cm a frame, largely along the view, the arm's depth changes by less
+// than the temporal filter's delta, so the filtered image shows it where it was, blended over
+// about 1.5 frames: one pose is not enough, the default three are.
 TEST(MovingCellAcceptance, AFastArmNeedsThePosesOfThePastFrames) {
   std::ifstream in(moving_cell_path());
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
