@@ -95,9 +95,9 @@ class Pipeline {
   BackgroundCheck check_;  ///< of a loaded background against the first frames
 
   bool enough_valid_depth(const Frame& frame, FrameResult& result) const;
-  /// Remembers robot_ and renders the remembered poses into the filtered `frame` (its noise
-  /// margin from the source's focal length); the robot's pixels, or none without an arm.
-  std::optional<RobotPixels> render_robot(const Frame& frame, float sensor_fx_px, FrameResult& result);
+  /// Remembers robot_ and renders the remembered poses into the filtered `frame`; the robot's
+  /// pixels, or none without an arm.
+  std::optional<RobotPixels> render_robot(const Frame& frame, FrameResult& result);
   bool background_checked(const Frame& frame, FrameResult& result);
 };
 

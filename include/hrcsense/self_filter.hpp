@@ -37,10 +37,6 @@ struct SelfFilterNoise {
   float k_sigma = 4.0F;
   float min_margin_m = 0.02F;
   float subpixel_rms_px = 0.08F;
-  /// The focal length (px) the stereo matcher worked at: the source frame's, before any
-  /// decimation (a decimated frame's halved fx would double σ, but averaging 2x2 pixels does not
-  /// make depth noisier). 0: the rendered frame's own.
-  float sensor_fx_px = 0.0F;
 };
 
 /// Which raw depths of each pixel are the robot's: [from_raw[i], to_raw[i]] (both inclusive);

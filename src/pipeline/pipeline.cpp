@@ -147,10 +147,11 @@ Pipeline::Pipeline(PipelineParams params)
   self_filter_.params = params_.self_filter;
 }
 
-std::optional<RobotPixels> Pipeline::render_robot(const Frame& frame, float sensor_fx_px, FrameResult& result) {
+std::optional<RobotPixels> Pipeline::render_robot(const Frame& frame, FrameResult& result) {
   if (!params_.robot.arm) return std::nullopt;
+  // The foreground test's own noise model, on the filtered frame's focal length as it is.
   const SelfFilterNoise noise{params_.foreground.k_sigma, params_.foreground.min_margin_m,
-                              params_.foreground.subpixel_rms_px, sensor_fx_px};
+                              params_.foreground.subpixel_rms_px};
   timed(result, "self_filter", [&] {
     self_filter_.add_pose(robot_);
     self_filter_.render(frame, params_.T_base_camera, noise);
@@ -200,7 +201,7 @@ void Pipeline::process(const Frame& source_frame, const RobotState& robot_state,
     std::optional<RobotPixels> robot_pixels;
     if (placed) {
       robot_model_at(params_.robot, robot_state.q_rad, robot_);
-      robot_pixels = render_robot(frame, source_frame.intrinsics.fx, result);
+      robot_pixels = render_robot(frame, result);
     } else {
       self_filter_.clear_poses();
     }
@@ -229,7 +230,7 @@ void Pipeline::process(const Frame& source_frame, const RobotState& robot_state,
   }
   robot_model_at(params_.robot, robot_state.q_rad, robot_);
   if (robot_.capsules.empty()) return finish_stop(result, ReasonCode::no_robot_model, "no robot model", start);
-  const std::optional<RobotPixels> robot_pixels = render_robot(frame, source_frame.intrinsics.fx, result);
+  const std::optional<RobotPixels> robot_pixels = render_robot(frame, result);
   const RobotPixels* self_filter = params_.self_filter.enabled && robot_pixels ? &*robot_pixels : nullptr;
   bool extracted = false;
   timed(result, "foreground", [&] {

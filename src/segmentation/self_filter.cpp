@@ -361,7 +361,8 @@ void SelfFilter::render(const Frame& frame, const Pose& T_base_camera, const Sel
   // min_margin_m, k_sigma · σ(z)), σ(z) = z² · subpixel / (fx · baseline) (no stereo term
   // without a baseline).
   const float floor_m = std::max(params.margin_m, noise.min_margin_m);
-  const float fx = noise.sensor_fx_px > 0.0F ? noise.sensor_fx_px : intr.fx;
+  // The frame's own focal length, as the foreground test takes it (after decimation too).
+  const float fx = intr.fx;
   const float sigma_per_z2 =
       frame.stereo_baseline_mm > 0.0F && fx > 0.0F
           ? static_cast<float>(stereo_depth_sigma_m(1.0, fx, frame.stereo_baseline_mm, noise.subpixel_rms_px))
