@@ -102,6 +102,7 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
     params.port = state.port;
     params.frequency_hz = state.frequency_hz;
     params.history = state.history;
+    params.arm = config.pipeline.robot.arm;  // the forward kinematics actual_TCP_pose is checked against
     return std::make_unique<RtdeRobotState>(params, run_clock);
   }
   throw ConfigError(where + ": robot.state.source '" + source + "': not built into this hrcsense");
@@ -138,6 +139,10 @@ RunHeader make_run_header(const Config& config, const SourceInfo& info) {
   header.config_hash = config_hash(config);
   header.source = info;
   header.robot_state = config.robot_state.source;
+  if (config.robot_state.source == "rtde") {
+    header.robot_state_reports.push_back("robot_status");
+    if (config.pipeline.robot.arm) header.robot_state_reports.push_back("tcp_pose_check");
+  }
   RunHeader::Filters& filters = header.filters;
   const FilterChainParams& chain = config.pipeline.filters;
   filters.preset = config.filters_preset;

@@ -2,6 +2,7 @@
 // hrcsense CLI — progress on stderr: one line per second of wall time, then the summary.
 #include "common/console_sink.hpp"
 
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/safety.hpp"
 
 #include <spdlog/spdlog.h>
@@ -20,6 +21,28 @@ constexpr int64_t kMaxTimestampWarnings = 10;
 
 }  // namespace
 
+void ConsoleSink::log_robot_status(const FrameResult& result) {
+  const RobotStatus& now = result.robot_state.status;
+  if (!now.known) return;  // no report (another source, or no valid state): nothing changed that we know of
+  const RobotStatus& before = last_status_;
+  if (!before.known) {
+    spdlog::info("frame {}: robot controller reports robot_mode {} ({}), safety_mode {} ({}), speed_scaling {:.2f}",
+                 result.frame, now.robot_mode, robot_mode_name(now.robot_mode), now.safety_mode,
+                 safety_mode_name(now.safety_mode), now.speed_scaling);
+  } else if (robot_mode_changed(before, now)) {
+    spdlog::warn("frame {}: robot controller: robot_mode {} -> {}, safety_mode {} -> {} (reported only; the "
+                 "verdict does not use it)", result.frame, robot_mode_name(before.robot_mode),
+                 robot_mode_name(now.robot_mode), safety_mode_name(before.safety_mode), safety_mode_name(now.safety_mode));
+  }
+  if (now.tcp_pose_mismatch && !before.tcp_pose_mismatch) {
+    spdlog::warn("frame {}: the controller's actual_TCP_pose disagrees with the forward kinematics of its joints: "
+                 "wrong robot.model or base frame? (details: the summary's robot_state.last_problem)", result.frame);
+  } else if (!now.tcp_pose_mismatch && before.tcp_pose_mismatch) {
+    spdlog::info("frame {}: the controller's actual_TCP_pose agrees with the forward kinematics again", result.frame);
+  }
+  last_status_ = now;
+}
+
 ConsoleSink::ConsoleSink() : start_(Clock::now()), window_start_(start_) {
   window_latency_us_.reserve(kWindowCapacity);
 }
@@ -37,6 +60,7 @@ void ConsoleSink::frame(const FrameResult& result) {
     spdlog::warn("frame {}: {} (timestamp_ns {}){}", result.frame, result.timestamp_warning, result.timestamp_ns,
                  timestamp_warnings_ == kMaxTimestampWarnings ? "; further ones are counted in the summary only" : "");
   }
+  log_robot_status(result);
   ++window_frames_;
   if (window_latency_us_.size() < kWindowCapacity) window_latency_us_.push_back(result.latency_us);
   const Clock::time_point now = Clock::now();
@@ -78,6 +102,13 @@ void ConsoleSink::summary(const RunSummary& s) {
     spdlog::warn("summary: source timestamps out of order: {} backwards, {} repeated, {} gaps ({} frames skipped), "
                  "{} jumps beyond max_frame_age_s", t.backwards, t.repeated, t.gaps, t.frames_skipped, t.jumps);
   }
+  const RobotStatusCounts& r = s.robot_status;
+  if (r.frames_reported > 0) {
+    spdlog::info("summary: robot controller: {} of {} frames not running, {} in a protective or safeguard stop, "
+                 "{} mode changes, {} with a TCP pose mismatch", r.frames_not_running, r.frames_reported,
+                 r.frames_protective_stop, r.mode_changes, r.frames_tcp_pose_mismatch);
+  }
+  if (!s.robot_state.last_problem.empty()) spdlog::info("summary: robot state: {}", s.robot_state.last_problem);
 }
 
 }  // namespace hrcsense::app

@@ -129,6 +129,51 @@ RobotModel robot_render_capsules(const RobotDescription& description, const Join
 void robot_render_capsules(const RobotDescription& description, const JointAngles& joints_rad, BaseFrame frame,
                            RobotModel& out);
 
+/// Limits of the check of a controller's reported TCP pose against the forward kinematics of its
+/// joints (check_tcp_pose; docs/ROBOT.md, "TCP pose check").
+struct TcpPoseCheckParams {
+  /// The reported TCP may lie at most this far from the flange, metres: the controller's active
+  /// TCP offset (the tool), which the RTDE outputs hrcsense reads do not give.
+  double max_tcp_offset_m = 0.5;
+  /// The flange → TCP offset implied by a sample may differ from the reference's (the first
+  /// plausible sample of the connection) by this much, metres: the offset is fixed to the
+  /// flange, and the controller's calibrated kinematics differ from the nominal DH table by
+  /// millimetres only.
+  double offset_tolerance_m = 0.02;
+  /// ...and by this rotation, radians (2°).
+  double offset_tolerance_rad = 0.035;
+};
+
+/// The result of one check_tcp_pose.
+struct TcpPoseCheck {
+  bool consistent = false;   ///< within every limit (false for non-finite input)
+  /// The flange → TCP transform the reported pose implies: T_base_flange(q)⁻¹ · T_base_tcp.
+  Pose T_flange_tcp = Pose::Identity();
+  double offset_m = 0.0;     ///< |translation of T_flange_tcp|: the implied tool length
+  double drift_m = 0.0;      ///< translation between T_flange_tcp and the reference's; 0 without one
+  double drift_rad = 0.0;    ///< rotation angle between them; 0 without one
+  /// |translation| of the implied offset if the reported pose were in the frame turned π about
+  /// z (base_link rather than base): small where offset_m is not points at a base frame mix-up.
+  double offset_turned_m = 0.0;
+};
+
+/// UR's pose vector [x, y, z (m), rx, ry, rz (rotation vector: axis times angle, rad)] as a Pose.
+Pose pose_from_ur_vector(const std::array<double, 6>& pose);
+
+/// Compares `tcp_pose_base` (UR's actual_TCP_pose: in the pendant's base frame, `base`,
+/// with the controller's active TCP offset applied) with the forward kinematics of `q_rad`:
+/// consistent when the implied flange → TCP offset is at most max_tcp_offset_m long and, with
+/// a `reference` (an earlier sample's T_flange_tcp), within the offset tolerances of it.
+/// robot.base_frame does not enter: both sides are taken in the pendant's frame.
+TcpPoseCheck check_tcp_pose(const RobotDescription& description, const JointAngles& q_rad,
+                            const std::array<double, 6>& tcp_pose_base, const Pose* reference,
+                            const TcpPoseCheckParams& params);
+
+/// A failed check for people: "disagrees with the `robot` forward kinematics of the joints: " what
+/// is off by how much against which limit, and the likely cause (a base/base_link mix-up when
+/// the turned reading fits, else a wrong description or frame).
+std::string tcp_pose_problem(const std::string& robot, const TcpPoseCheck& check, const TcpPoseCheckParams& limits);
+
 /// One waypoint of a scripted arm motion (`robot.trajectory.waypoints[i]`).
 struct TrajectoryWaypoint {
   double t_s = 0.0;       ///< source time, seconds (the simulator's frame index / fps)

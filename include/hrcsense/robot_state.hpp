@@ -15,6 +15,35 @@ namespace hrcsense {
 /// `robot.state.source` as a name: fixed, sim, rtde, udp_json, recorded.
 const char* robot_state_origin_name(RobotStateOrigin origin);
 
+/// UR's robot_mode as a snake_case name: no_controller (-1), disconnected, confirm_safety,
+/// booting, power_off, power_on, idle, backdrive, running (7), updating_firmware (8);
+/// "unknown" for other values.
+const char* robot_mode_name(int32_t robot_mode);
+/// UR's safety_mode as a snake_case name: normal (1), reduced, protective_stop (3), recovery,
+/// safeguard_stop (5), system_emergency_stop, robot_emergency_stop, violation, fault (9);
+/// "unknown" for other values (newer software has more).
+const char* safety_mode_name(int32_t safety_mode);
+/// The controller reports its arm running (robot_mode 7).
+bool robot_running(const RobotStatus& status);
+/// The controller reports a protective stop (safety_mode 3) or a safeguard stop (5).
+bool in_protective_stop(const RobotStatus& status);
+/// Both statuses are known and their robot_mode or safety_mode differ.
+bool robot_mode_changed(const RobotStatus& before, const RobotStatus& after);
+
+/// The controller's status over the frames of a run (FrameResult::robot_state.status), for the
+/// summary. Frames without a known status (other sources, no valid state) count in none.
+struct RobotStatusCounts {
+  int64_t frames_reported = 0;         ///< frames with a known status
+  int64_t frames_not_running = 0;      ///< robot_mode other than running
+  int64_t frames_protective_stop = 0;  ///< safety_mode protective stop or safeguard stop
+  int64_t mode_changes = 0;            ///< robot_mode or safety_mode differs from the last frame that had a status
+  int64_t frames_tcp_pose_mismatch = 0;  ///< RobotStatus::tcp_pose_mismatch
+  RobotStatus last;                    ///< the last known status (for mode_changes)
+
+  /// Counts one frame's status.
+  void add(const RobotStatus& status);
+};
+
 /// What a robot state source says about itself over a run (the summary's counters).
 struct RobotStateStats {
   RobotStateCounts samples;   ///< samples accepted and rejected (RobotStateHistory)

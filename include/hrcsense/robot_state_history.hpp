@@ -56,8 +56,9 @@ class RobotStateHistory {
   bool add(const RobotState& sample);
   /// The state at `host_time_ns`: linear interpolation of q and qd between the samples that
   /// bracket it; past the newest sample, q extrapolated with its qd for at most one sample
-  /// period; before the oldest, the oldest. No sample: no_robot_state. Newest sample older than
-  /// max_age_s: robot_state_stale.
+  /// period; before the oldest, the oldest. RobotState::status is that of the latest sample not
+  /// later than `host_time_ns` (the oldest before it). No sample: no_robot_state. Newest sample
+  /// older than max_age_s: robot_state_stale (status unknown).
   RobotStateLookup at(int64_t host_time_ns) const;
   void clear() { size_ = 0; }
   size_t size() const { return size_; }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "hrcsense/clock.hpp"
+#include "hrcsense/robot.hpp"
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/robot_state_history.hpp"
 #include "hrcsense/types.hpp"
@@ -14,6 +15,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -148,6 +150,10 @@ struct RtdeParams {
   double connect_timeout_s = 1.0;  ///< TCP connect, real time
   double backoff_initial_s = 0.1;  ///< first wait before reconnecting (run clock), doubling...
   double backoff_max_s = 5.0;      ///< ...up to this
+  /// The arm whose forward kinematics each sample's actual_TCP_pose is checked against
+  /// (robot.model); none (robot.model points): no check.
+  std::optional<RobotDescription> arm;
+  TcpPoseCheckParams tcp_check;
 };
 
 /// What the RTDE client knows of the controller, beyond RobotStateStats.
@@ -162,6 +168,7 @@ struct RtdeStatus {
   int64_t data_packages = 0;          ///< DATA_PACKAGEs read, good or not
   int64_t skipped_packages = 0;       ///< unknown or unexpected package types, skipped by size
   int64_t text_messages = 0;          ///< TEXT_MESSAGEs from the controller
+  int64_t tcp_pose_mismatches = 0;    ///< data packages whose actual_TCP_pose failed the check
   std::string last_text_message;      ///< "source: message"
 };
 
@@ -171,7 +178,10 @@ struct RtdeStatus {
 /// controller's timestamp through a SenderClockMap, arrival times from `clock`). A lost or bad
 /// connection is closed, the history cleared (no valid state until new data), and the thread
 /// reconnects with exponential back-off, requesting the same frequency. Bad packages are
-/// counted in stats() and never crash or stop the thread. Thread-safe.
+/// counted in stats() and never crash or stop the thread. Each sample carries the controller's
+/// RobotStatus; with an arm, its actual_TCP_pose is checked against the forward kinematics of
+/// its actual_q (check_tcp_pose, the reference taken afresh on each connection), and the
+/// start of a mismatch is stats().last_problem. Thread-safe.
 class RtdeRobotState final : public RobotStateSource {
  public:
   /// Starts the reader thread; `clock` must outlive this object.

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace hrcsense {
 
@@ -19,6 +20,10 @@ struct RunHeader {
   std::string config_hash;
   SourceInfo source;
   std::string robot_state;  ///< `robot.state.source` (fixed, sim, rtde, udp_json); empty: not written
+  /// What the robot state source delivers beyond time-stamped joints: "robot_status" (frames
+  /// carry the controller's robot_status) and "tcp_pose_check" (its actual_TCP_pose is checked
+  /// against the forward kinematics); empty: nothing more (or not written: robot_state empty).
+  std::vector<std::string> robot_state_reports;
   /// Pipeline::unknown_background_share of a background loaded before the run; < 0 (null):
   /// not known yet (it is learnt during the run; the summary has it then).
   double unknown_background_share = -1.0;
@@ -61,6 +66,7 @@ struct RunSummary {
   std::string error;
   TimestampCounts timestamps;     ///< source timestamps out of order
   RobotStateStats robot_state;    ///< the robot state source's counters
+  RobotStatusCounts robot_status; ///< the controller's status over the frames written
   double unknown_background_share = -1.0;  ///< Pipeline::unknown_background_share at the end; < 0: no background
 };
 

@@ -32,6 +32,8 @@ class JsonLinesSink : public Sink {
   std::ostream& out_;
   std::string backend_;
   std::string line_;  ///< reused per frame
+  /// The header said the frames carry robot_status: a frame without one writes null.
+  bool robot_status_announced_ = false;
 };
 
 }  // namespace hrcsense

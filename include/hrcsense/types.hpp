@@ -162,6 +162,20 @@ using JointAngles = std::array<double, kJointCount>;
 /// Where a robot state came from (`robot.state.source`).
 enum class RobotStateOrigin { fixed, sim, rtde, udp_json, recorded };
 
+/// What the robot controller says of itself at a robot state's time: UR RTDE's robot_mode,
+/// safety_mode and speed_scaling (../shared/specs/ur-rtde.md) and the check of its
+/// actual_TCP_pose. Reported in the output, never part of the verdict: the robot's own safety
+/// system acts on these modes, and hrcsense's verdict is about the people in the cell.
+struct RobotStatus {
+  bool known = false;          ///< the source reports it (rtde) for this state; else the rest is unset
+  int32_t robot_mode = -1;     ///< UR robot_mode: 7 running, 5 idle, 3 power off...; robot_mode_name()
+  int32_t safety_mode = 0;     ///< UR safety_mode: 1 normal, 3 protective stop, 5 safeguard stop...; safety_mode_name()
+  double speed_scaling = 0.0;  ///< the controller's trajectory speed scaling, 0..1
+  /// actual_TCP_pose disagrees with the forward kinematics of actual_q (a wrong robot.model, or
+  /// a base frame turned; docs/ROBOT.md, "TCP pose check"). False when not checked.
+  bool tcp_pose_mismatch = false;
+};
+
 /// The arm's joint state at one instant: what a RobotStateSource delivers for a frame, and
 /// what Pipeline::process builds the robot's capsules from.
 struct RobotState {
@@ -174,6 +188,7 @@ struct RobotState {
   JointAngles qd_rad_s{};     ///< joint velocities
   bool valid = false;         ///< false: no state (never measured, lost, rejected); the frame is a stop
   RobotStateOrigin origin = RobotStateOrigin::fixed;
+  RobotStatus status;         ///< the controller's report at this time, where the source has one (rtde)
 };
 
 /// The robot as the proximity search sees it: capsules in the base frame.

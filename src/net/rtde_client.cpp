@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <utility>
 
@@ -81,6 +82,10 @@ struct RtdeRobotState::Connection {
   rtde::OutputRecipe recipe;
   SenderClockMap clock_map;
   std::string error;  // why next_frame failed
+  // The TCP pose check: the implied flange → TCP offset of the first plausible sample of this
+  // connection (the controller's TCP may differ on the next), and whether the last one failed.
+  std::optional<Pose> tcp_reference;
+  bool tcp_mismatch = false;
 
   // Sends all of `bytes`; false on a socket error.
   bool send(const std::vector<uint8_t>& bytes) {
@@ -345,6 +350,22 @@ void RtdeRobotState::on_data(const rtde::Frame& frame, Connection& c) {
   std::string error;
   const bool parsed = rtde::parse_data_package(frame, c.recipe, data, error);
   const int64_t arrival_ns = clock_.now_ns();
+  // The forward kinematics check, outside the lock (the reader alone owns the connection).
+  bool tcp_mismatch = false;
+  std::string tcp_problem;  // set when a mismatch starts
+  if (parsed && params_.arm && all_finite(data.q)) {
+    const Pose* reference = c.tcp_reference ? &*c.tcp_reference : nullptr;
+    const TcpPoseCheck check = check_tcp_pose(*params_.arm, data.q, data.tcp_pose, reference, params_.tcp_check);
+    tcp_mismatch = !check.consistent;
+    if (check.consistent && !c.tcp_reference) c.tcp_reference = check.T_flange_tcp;
+    if (tcp_mismatch && !c.tcp_mismatch) {
+      char when[64];
+      std::snprintf(when, sizeof when, "%.3f", data.timestamp_s);
+      tcp_problem = std::string("RTDE: actual_TCP_pose at controller time ") + when + " s " +
+                    tcp_pose_problem(params_.arm->name, check, params_.tcp_check);
+    }
+    c.tcp_mismatch = tcp_mismatch;
+  }
   // A timestamp that is not a finite, non-negative number of seconds (or beyond int64 ns) cannot
   // be placed on the host clock.
   const bool timestamp_ok = parsed && std::isfinite(data.timestamp_s) && data.timestamp_s >= 0.0 &&
@@ -357,6 +378,8 @@ void RtdeRobotState::on_data(const rtde::Frame& frame, Connection& c) {
                                        " s is not a time" : "RTDE: " + error;
     return;
   }
+  if (tcp_mismatch) ++status_.tcp_pose_mismatches;
+  if (!tcp_problem.empty()) stats_.last_problem = tcp_problem;
   status_.robot_mode = data.robot_mode;
   status_.safety_mode = data.safety_mode;
   status_.speed_scaling = data.speed_scaling;
@@ -366,6 +389,11 @@ void RtdeRobotState::on_data(const rtde::Frame& frame, Connection& c) {
   state.qd_rad_s = data.qd;
   state.valid = true;
   state.origin = RobotStateOrigin::rtde;
+  state.status.known = true;
+  state.status.robot_mode = data.robot_mode;
+  state.status.safety_mode = data.safety_mode;
+  state.status.speed_scaling = data.speed_scaling;
+  state.status.tcp_pose_mismatch = tcp_mismatch;
   if (!history_.add(state)) {
     stats_.last_problem = "RTDE: DATA_PACKAGE at controller time " + std::to_string(data.timestamp_s) +
                           " s rejected (non-finite joints, not later than the previous one, or a jump)";

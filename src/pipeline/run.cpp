@@ -227,6 +227,7 @@ void tally(RunSummary& summary, const FrameResult& result) {
     case VerdictState::slow: ++summary.verdict_slow; break;
     case VerdictState::stop: ++summary.verdict_stop; break;
   }
+  summary.robot_status.add(result.robot_state.status);  // reported only: the verdict is made without it
   if (result.contact.valid && (summary.min_distance_m < 0.0F || result.contact.distance_m < summary.min_distance_m)) {
     summary.min_distance_m = result.contact.distance_m;
   }

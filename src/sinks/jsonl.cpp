@@ -4,7 +4,9 @@
 #include "hrcsense/sinks.hpp"
 
 #include "hrcsense/camera.hpp"
+#include "hrcsense/robot_state.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -184,7 +186,18 @@ void JsonLinesSink::header(const RunHeader& header) {
   m.text("version", header.version.empty() ? HRCSENSE_VERSION : header.version);
   m.text("commit", header.commit.empty() ? HRCSENSE_COMMIT : header.commit);
   m.text("config_hash", header.config_hash);
-  if (!header.robot_state.empty()) m.text("robot_state", header.robot_state);
+  if (!header.robot_state.empty()) {
+    m.text("robot_state", header.robot_state);
+    put_key(line_, "robot_state_reports");
+    line_ += '[';
+    for (size_t i = 0; i < header.robot_state_reports.size(); ++i) {
+      if (i > 0) line_ += ',';
+      put_string(line_, header.robot_state_reports[i]);
+    }
+    line_ += ']';
+  }
+  robot_status_announced_ = std::find(header.robot_state_reports.begin(), header.robot_state_reports.end(),
+                                      "robot_status") != header.robot_state_reports.end();
   m.number_or_null("unknown_background_share", header.unknown_background_share >= 0.0,
                    header.unknown_background_share);
 
@@ -260,6 +273,21 @@ void JsonLinesSink::frame(const FrameResult& result) {
     line_ += "null";
   }
   m.number("robot_state_age_ms", result.robot_state_age_ms);
+  // The controller's own report (rtde): present where the source has one, null in frames
+  // without a valid state from such a source, absent for sources that have none.
+  const RobotStatus& status = result.robot_state.status;
+  if (status.known) {
+    m.open("robot_status");
+    m.integer("robot_mode", status.robot_mode);
+    m.text("robot_mode_name", robot_mode_name(status.robot_mode));
+    m.integer("safety_mode", status.safety_mode);
+    m.text("safety_mode_name", safety_mode_name(status.safety_mode));
+    m.number("speed_scaling", status.speed_scaling);
+    m.boolean("tcp_pose_mismatch", status.tcp_pose_mismatch);
+    m.close();
+  } else if (robot_status_announced_) {
+    m.null("robot_status");
+  }
   m.number("latency_us", result.latency_us);
   m.open("timings_us");
   for (const StageTiming& timing : result.timings) m.number(timing.stage, timing.us);
@@ -319,6 +347,12 @@ void JsonLinesSink::summary(const RunSummary& summary) {
   m.integer("connections", robot.connections);
   m.integer("disconnects", robot.disconnects);
   m.integer("malformed", robot.malformed);
+  const RobotStatusCounts& status = summary.robot_status;
+  m.integer("frames_with_status", status.frames_reported);
+  m.integer("frames_not_running", status.frames_not_running);
+  m.integer("frames_protective_stop", status.frames_protective_stop);
+  m.integer("mode_changes", status.mode_changes);
+  m.integer("frames_tcp_pose_mismatch", status.frames_tcp_pose_mismatch);
   if (robot.last_problem.empty()) {
     m.null("last_problem");
   } else {

@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -35,17 +36,31 @@ namespace hrcsense::test {
 enum class RtdeFault { none, close, stall, truncated, oversized, unknown_type, wrong_recipe, nan_joints,
                        not_found, protocol1_only };
 
+/// The fake's default trajectory at controller time t_s: joint j = 0.5 sin(2π·0.2·t + j) + 0.1 j.
+inline double fake_q(double t_s, int j) { return 0.5 * std::sin(2.0 * M_PI * 0.2 * t_s + j) + 0.1 * j; }
+inline double fake_qd(double t_s, int j) { return 0.5 * 2.0 * M_PI * 0.2 * std::cos(2.0 * M_PI * 0.2 * t_s + j); }
+
+/// What the fake's controller says of itself in one data package.
+struct FakeModes {
+  int32_t robot_mode = 7;   ///< running
+  int32_t safety_mode = 1;  ///< normal
+  double speed_scaling = 1.0;
+};
+
 struct FakeRtdeScript {
   uint32_t major = 5, minor = 12;          ///< controller version (major < 5: a CB3)
   int64_t samples_per_connection = 200;    ///< then silent, connection kept open
   RtdeFault fault = RtdeFault::none;       ///< on the first connection only
   int64_t fault_at = 100;                  ///< data package index of the fault
   double controller_offset_s = 1234.5;     ///< controller clock = FakeClock + this
+  /// actual_q and actual_qd at controller time t_s; empty: fake_q and fake_qd.
+  std::function<void(double t_s, JointAngles& q, JointAngles& qd)> joints;
+  /// actual_TCP_pose (x, y, z m, rotation vector rad) for the joints q; empty: 0.1·j.
+  std::function<std::array<double, 6>(const JointAngles& q)> tcp_pose;
+  /// robot_mode, safety_mode and speed_scaling of data package k (from 0, per connection);
+  /// empty: running, normal, 1.0.
+  std::function<FakeModes(int64_t k)> modes;
 };
-
-/// The fake's trajectory at controller time t_s: joint j = 0.5 sin(2π·0.2·t + j) + 0.1 j.
-inline double fake_q(double t_s, int j) { return 0.5 * std::sin(2.0 * M_PI * 0.2 * t_s + j) + 0.1 * j; }
-inline double fake_qd(double t_s, int j) { return 0.5 * 2.0 * M_PI * 0.2 * std::cos(2.0 * M_PI * 0.2 * t_s + j); }
 
 class FakeRtdeController {
  public:
@@ -258,16 +273,28 @@ class FakeRtdeController {
       const double t_s = static_cast<double>(t_ns) * 1e-9 + script_.controller_offset_s;
       const bool here = k == script_.fault_at;
       std::vector<uint8_t> payload{static_cast<uint8_t>(here && fault == RtdeFault::wrong_recipe ? 7 : 1)};
+      JointAngles q{}, qd{};
+      if (script_.joints) {
+        script_.joints(t_s, q, qd);
+      } else {
+        for (int j = 0; j < 6; ++j) {
+          q[static_cast<size_t>(j)] = fake_q(t_s, j);
+          qd[static_cast<size_t>(j)] = fake_qd(t_s, j);
+        }
+      }
+      std::array<double, 6> tcp{0.0, 0.1, 0.2, 0.3, 0.4, 0.5};
+      if (script_.tcp_pose) tcp = script_.tcp_pose(q);
+      const FakeModes modes = script_.modes ? script_.modes(k) : FakeModes{};
       for (const std::string& name : names) {
         if (name == "timestamp") be_double(payload, t_s);
-        if (name == "speed_scaling") be_double(payload, 1.0);
-        if (name == "robot_mode") be32(payload, 7);
-        if (name == "safety_mode") be32(payload, 1);
-        for (int j = 0; j < 6; ++j) {
+        if (name == "speed_scaling") be_double(payload, modes.speed_scaling);
+        if (name == "robot_mode") be32(payload, static_cast<uint32_t>(modes.robot_mode));
+        if (name == "safety_mode") be32(payload, static_cast<uint32_t>(modes.safety_mode));
+        for (size_t j = 0; j < 6; ++j) {
           const bool nan = here && fault == RtdeFault::nan_joints && j == 2;
-          if (name == "actual_q") be_double(payload, nan ? std::nan("") : fake_q(t_s, j));
-          if (name == "actual_qd") be_double(payload, fake_qd(t_s, j));
-          if (name == "actual_TCP_pose") be_double(payload, 0.1 * j);
+          if (name == "actual_q") be_double(payload, nan ? std::nan("") : q[j]);
+          if (name == "actual_qd") be_double(payload, qd[j]);
+          if (name == "actual_TCP_pose") be_double(payload, tcp[j]);
         }
       }
       if (here && fault == RtdeFault::oversized) payload.insert(payload.end(), 8, 0xAB);

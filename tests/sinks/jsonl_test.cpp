@@ -331,5 +331,67 @@ TEST(JsonLinesSink, VerdictWithoutSourceFrameHasItsOwnType) {
   EXPECT_EQ(lines[0]["verdict_reason"], "source ended");
 }
 
+// The controller's status (rtde): announced in the header, one object per frame that has it,
+// null in one that has not, and its counters in the summary's robot_state.
+TEST(JsonLinesSink, RobotStatusInHeaderFramesAndSummary) {
+  std::ostringstream out;
+  JsonLinesSink sink(out, "brute");
+  RunHeader header;
+  header.robot_state = "rtde";
+  header.robot_state_reports = {"robot_status", "tcp_pose_check"};
+  sink.header(header);
+  FrameResult result;
+  result.robot_state.valid = true;
+  result.robot_state.status.known = true;
+  result.robot_state.status.robot_mode = 7;
+  result.robot_state.status.safety_mode = 3;
+  result.robot_state.status.speed_scaling = 0.25;
+  result.robot_state.status.tcp_pose_mismatch = true;
+  sink.frame(result);
+  result.robot_state = RobotState{};  // stale: no status
+  sink.frame(result);
+  RunSummary summary;
+  summary.robot_status.frames_reported = 10;
+  summary.robot_status.frames_not_running = 4;
+  summary.robot_status.frames_protective_stop = 3;
+  summary.robot_status.mode_changes = 2;
+  summary.robot_status.frames_tcp_pose_mismatch = 1;
+  sink.summary(summary);
+
+  const std::vector<json> lines = parse_lines(out.str());
+  ASSERT_EQ(lines.size(), 4U);
+  EXPECT_EQ(lines[0]["robot_state"], "rtde");
+  EXPECT_EQ(lines[0]["robot_state_reports"], json::array({"robot_status", "tcp_pose_check"}));
+  const json& status = lines[1]["robot_status"];
+  EXPECT_EQ(status["robot_mode"], 7);
+  EXPECT_EQ(status["robot_mode_name"], "running");
+  EXPECT_EQ(status["safety_mode"], 3);
+  EXPECT_EQ(status["safety_mode_name"], "protective_stop");
+  EXPECT_EQ(status["speed_scaling"].get<double>(), 0.25);
+  EXPECT_EQ(status["tcp_pose_mismatch"], true);
+  ASSERT_TRUE(lines[2].contains("robot_status"));
+  EXPECT_TRUE(lines[2]["robot_status"].is_null());
+  const json& robot = lines[3]["robot_state"];
+  EXPECT_EQ(robot["frames_with_status"], 10);
+  EXPECT_EQ(robot["frames_not_running"], 4);
+  EXPECT_EQ(robot["frames_protective_stop"], 3);
+  EXPECT_EQ(robot["mode_changes"], 2);
+  EXPECT_EQ(robot["frames_tcp_pose_mismatch"], 1);
+}
+
+// A source without a status (fixed, sim, udp_json) writes no robot_status key at all.
+TEST(JsonLinesSink, NoRobotStatusKeyForSourcesWithoutOne) {
+  std::ostringstream out;
+  JsonLinesSink sink(out, "brute");
+  RunHeader header;
+  header.robot_state = "sim";
+  sink.header(header);
+  sink.frame(FrameResult{});
+  const std::vector<json> lines = parse_lines(out.str());
+  ASSERT_EQ(lines.size(), 2U);
+  EXPECT_EQ(lines[0]["robot_state_reports"], json::array());
+  EXPECT_FALSE(lines[1].contains("robot_status"));
+}
+
 }  // namespace
 }  // namespace hrcsense
