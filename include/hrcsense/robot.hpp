@@ -57,8 +57,8 @@ struct RobotDescription {
 
 /// Which frame robot capsules, camera.T_base_camera and all base-frame outputs refer to.
 enum class BaseFrame {
-  base,       ///< as on the UR pendant and ROS's `base`: base_link rotated π about z
-  base_link,  ///< UR's DH frame 0 (ROS's `base_link`)
+  base,       ///< UR's DH frame 0: as on the UR pendant (actual_TCP_pose) and ROS's `base`
+  base_link,  ///< ROS's `base_link`: base rotated π about z, +x along the arm at q = 0
 };
 
 /// The robot the pipeline measures against (PipelineParams::robot): an arm whose capsules
@@ -70,10 +70,11 @@ struct RobotParams {
   RobotModel points;                    ///< without an arm: the capsules as they are (base frame)
 };
 
-/// Pose of every link's DH frame in base_link: frames[0] is the identity (the fixed base),
-/// frames[i] the frame after joint i; frames[6] is the tool flange.
+/// Pose of every link's DH frame in DH frame 0, which is UR's (and hrcsense's) `base`:
+/// T_base_link[0] is the identity (the fixed base), T_base_link[i] the frame after joint i;
+/// T_base_link[6] is the tool flange.
 struct LinkFrames {
-  std::array<Pose, kArmLinkCount> T_base_link_link;
+  std::array<Pose, kArmLinkCount> T_base_link;
 };
 
 /// The built-in arms: "ur5" (CB3), "ur5e", "ur10e".
@@ -97,10 +98,11 @@ std::string description_problem(const RobotDescription& description);
 /// outside.
 int joint_outside_limits(const RobotDescription& description, const JointAngles& joints_rad);
 
-/// T_base_base_link: the pendant/ROS `base` frame from UR's DH frame (a rotation of π about z).
+/// T_base_base_link: the pendant/ROS `base` frame (UR's DH frame 0) from ROS's `base_link` (a
+/// rotation of π about z; its own inverse).
 Pose T_base_base_link();
 
-/// Forward kinematics: every link frame in base_link for the joint state.
+/// Forward kinematics: every link frame in `base` (DH frame 0) for the joint state.
 LinkFrames forward_kinematics(const RobotDescription& description, const JointAngles& joints_rad);
 
 /// The capsules the proximity search uses, in `frame`: every link and tool capsule moved by
@@ -152,8 +154,8 @@ struct TcpPoseCheck {
   double offset_m = 0.0;     ///< |translation of T_flange_tcp|: the implied tool length
   double drift_m = 0.0;      ///< translation between T_flange_tcp and the reference's; 0 without one
   double drift_rad = 0.0;    ///< rotation angle between them; 0 without one
-  /// |translation| of the implied offset if the reported pose were in the frame turned π about
-  /// z (base_link rather than base): small where offset_m is not points at a base frame mix-up.
+  /// |translation| of the implied offset if the kinematics were turned π about z (a description
+  /// in base_link taken for base): small where offset_m is not points at a base frame mix-up.
   double offset_turned_m = 0.0;
 };
 

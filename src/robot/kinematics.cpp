@@ -22,8 +22,9 @@ Pose dh_transform(const DhRow& row, double theta_rad) {
   return T;
 }
 
-Pose T_frame_base_link(BaseFrame frame) {
-  return frame == BaseFrame::base ? T_base_base_link() : Pose::Identity();
+// The configured frame from DH frame 0 (= base): base_link is base turned π about z.
+Pose frame_from_base(BaseFrame frame) {
+  return frame == BaseFrame::base_link ? T_base_base_link().inverse(Eigen::Isometry) : Pose::Identity();
 }
 
 bool finite(const Eigen::Vector3d& v) { return v.allFinite(); }
@@ -62,17 +63,17 @@ enum class Geometry { collision, visual };
 void place_capsules(const RobotDescription& description, const JointAngles& joints_rad, double padding_m,
                     BaseFrame frame, Geometry geometry, RobotModel& out) {
   const LinkFrames frames = forward_kinematics(description, joints_rad);
-  const Pose T_out_base_link = T_frame_base_link(frame);
+  const Pose T_frame_base = frame_from_base(frame);
   out.capsules.clear();
   for (int link = 0; link < kArmLinkCount; ++link) {
     const size_t i = static_cast<size_t>(link);
     const bool visual = geometry == Geometry::visual && !description.visual[i].empty();
-    const Pose T_frame_link = T_out_base_link * frames.T_base_link_link[i];
+    const Pose T_frame_link = T_frame_base * frames.T_base_link[i];
     for (const LinkCapsule& capsule : visual ? description.visual[i] : description.links[i]) {
       out.capsules.push_back(moved(capsule, T_frame_link, padding_m, link));
     }
   }
-  const Pose T_frame_flange = T_out_base_link * frames.T_base_link_link[kArmLinkCount - 1];
+  const Pose T_frame_flange = T_frame_base * frames.T_base_link[kArmLinkCount - 1];
   for (const LinkCapsule& capsule : description.tool) {
     out.capsules.push_back(moved(capsule, T_frame_flange, padding_m, kToolLink));
   }
@@ -140,10 +141,10 @@ Pose T_base_base_link() {
 
 LinkFrames forward_kinematics(const RobotDescription& description, const JointAngles& joints_rad) {
   LinkFrames frames;
-  frames.T_base_link_link[0] = Pose::Identity();
+  frames.T_base_link[0] = Pose::Identity();
   for (int j = 0; j < kJointCount; ++j) {
     const size_t i = static_cast<size_t>(j);
-    frames.T_base_link_link[i + 1] = frames.T_base_link_link[i] * dh_transform(description.dh[i], joints_rad[i]);
+    frames.T_base_link[i + 1] = frames.T_base_link[i] * dh_transform(description.dh[i], joints_rad[i]);
   }
   return frames;
 }

@@ -27,13 +27,13 @@ TcpPoseCheck check_tcp_pose(const RobotDescription& description, const JointAngl
   for (double v : q_rad) finite = finite && std::isfinite(v);
   for (double v : tcp_pose_base) finite = finite && std::isfinite(v);
   if (!finite) return out;
-  const Pose T_base_link_flange = forward_kinematics(description, q_rad).T_base_link_link[kArmLinkCount - 1];
+  const Pose T_base_flange = forward_kinematics(description, q_rad).T_base_link[kArmLinkCount - 1];
   const Pose T_base_tcp = pose_from_ur_vector(tcp_pose_base);
-  // The pendant's frame is hrcsense's `base`; the same numbers read in base_link (turned π about
-  // z) are the diagnosis of a frame mix-up.
-  out.T_flange_tcp = (T_base_base_link() * T_base_link_flange).inverse(Eigen::Isometry) * T_base_tcp;
+  // The pendant's frame is UR's DH frame 0, hrcsense's `base`; the kinematics turned π about z
+  // (base_link) are the diagnosis of a frame mix-up.
+  out.T_flange_tcp = T_base_flange.inverse(Eigen::Isometry) * T_base_tcp;
   out.offset_m = out.T_flange_tcp.translation().norm();
-  out.offset_turned_m = (T_base_link_flange.inverse(Eigen::Isometry) * T_base_tcp).translation().norm();
+  out.offset_turned_m = ((T_base_base_link() * T_base_flange).inverse(Eigen::Isometry) * T_base_tcp).translation().norm();
   out.consistent = out.offset_m <= params.max_tcp_offset_m;
   if (reference != nullptr) {
     out.drift_m = (out.T_flange_tcp.translation() - reference->translation()).norm();

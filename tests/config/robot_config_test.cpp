@@ -46,23 +46,24 @@ TEST(RobotConfig, Ur5CapsulesFollowTheJointsAndTheFrame) {
   ASSERT_TRUE(c.pipeline.robot.arm.has_value());
   EXPECT_EQ(c.pipeline.robot.arm->name, "ur5");
   ASSERT_EQ(fixed_robot_model(c).capsules.size(), 8U);
-  // Default frame `base`: the flange (end of wrist 3) at (0.81725, 0.19145, −0.005491).
+  // Default frame `base` (UR's DH frame 0, the pendant's): the flange (end of wrist 3) at
+  // (a2 + a3, −(d4 + d6), d1 − d5) = (−0.81725, −0.19145, −0.005491).
   const Capsule wrist_3 = fixed_robot_model(c).capsules.back();
   EXPECT_EQ(wrist_3.link, 6);
-  EXPECT_LT((wrist_3.b - Eigen::Vector3f(0.81725F, 0.19145F, -0.005491F)).norm(), 1e-6F);
+  EXPECT_LT((wrist_3.b - Eigen::Vector3f(-0.81725F, -0.19145F, -0.005491F)).norm(), 1e-6F);
   EXPECT_FLOAT_EQ(wrist_3.radius_m, 0.045F);  // the built-in's wrist radius, no padding by default
 
   const Config link = load_config("", {"robot.model=ur5", kZeroPose, "robot.base_frame=base_link",
                                        "robot.padding_m=0.05"});
   EXPECT_EQ(link.pipeline.robot.base_frame, BaseFrame::base_link);
   const Capsule flange = fixed_robot_model(link).capsules.back();
-  EXPECT_LT((flange.b - Eigen::Vector3f(-0.81725F, -0.19145F, -0.005491F)).norm(), 1e-6F);
+  EXPECT_LT((flange.b - Eigen::Vector3f(0.81725F, 0.19145F, -0.005491F)).norm(), 1e-6F);  // x, y negated
   EXPECT_FLOAT_EQ(flange.radius_m, 0.095F);
   EXPECT_DOUBLE_EQ(link.pipeline.robot.padding_m, 0.05);
 
-  // Joint 1 at +90° turns the whole arm about z: in base, Rz(90°)(0.81725, 0.19145) = (−0.19145, 0.81725).
+  // Joint 1 at +90° turns the whole arm about z: in base, Rz(90°)(−0.81725, −0.19145) = (0.19145, −0.81725).
   const Config turned = load_config("", {"robot.model=ur5", "robot.joints_rad=[1.5707963267948966, 0, 0, 0, 0, 0]"});
-  EXPECT_LT((fixed_robot_model(turned).capsules.back().b - Eigen::Vector3f(-0.19145F, 0.81725F, -0.005491F)).norm(), 1e-6F);
+  EXPECT_LT((fixed_robot_model(turned).capsules.back().b - Eigen::Vector3f(0.19145F, -0.81725F, -0.005491F)).norm(), 1e-6F);
 }
 
 TEST(RobotConfig, EveryBuiltinArmLoads) {
@@ -116,9 +117,9 @@ TEST(RobotConfig, ShippedDescriptionFilesEqualTheBuiltins) {
 }
 
 TEST(RobotConfig, ToolKeyPutsAGripperOnABuiltinArm) {
-  // A 15 cm gripper of radius 4 cm: at q = 0 the flange's z points along −y of base_link from
-  // the flange at (a2 + a3, −(d4 + d6), d1 − d5), so the tool ends 0.15 m further along −y.
-  const Config c = load_config("", {"robot.model=ur5", kZeroPose, "robot.base_frame=base_link",
+  // A 15 cm gripper of radius 4 cm: at q = 0 the flange's z points along −y of base from the
+  // flange at (a2 + a3, −(d4 + d6), d1 − d5), so the tool ends 0.15 m further along −y.
+  const Config c = load_config("", {"robot.model=ur5", kZeroPose,
                                     "robot.tool=[{a_m: [0, 0, 0], b_m: [0, 0, 0.15], radius_m: 0.04}]"});
   ASSERT_EQ(fixed_robot_model(c).capsules.size(), 9U);
   const Capsule tool = fixed_robot_model(c).capsules.back();
@@ -135,8 +136,8 @@ TEST(RobotConfig, ToolKeyPutsAGripperOnABuiltinArm) {
 TEST(RobotConfig, CustomArmFromAFileOrInline) {
   TempDir dir;
   const std::string arm = dir.write("post.yaml", kPostArm);
-  // Joint 1 at 90°: the shoulder capsule turns from +x to +y of base_link; in `base` (x and y
-  // negated) it runs from (0, 0, 1) to (0, −0.5, 1). The arm's own padding (0.02) is the default.
+  // Joint 1 at 90°: the shoulder capsule turns from +x to +y of the DH frame 0, which is `base`:
+  // it runs from (0, 0, 1) to (0, 0.5, 1). The arm's own padding (0.02) is the default.
   const Config c = load_config("", {"robot.model=custom", "robot.description=" + arm,
                                     "robot.joints_rad=[1.5707963267948966, 0, 0, 0, 0, 0]"});
   ASSERT_EQ(fixed_robot_model(c).capsules.size(), 2U);
@@ -144,7 +145,7 @@ TEST(RobotConfig, CustomArmFromAFileOrInline) {
   const Capsule shoulder = fixed_robot_model(c).capsules[1];
   EXPECT_EQ(shoulder.link, 1);
   EXPECT_LT((shoulder.a - Eigen::Vector3f(0, 0, 1)).norm(), 1e-6F);
-  EXPECT_LT((shoulder.b - Eigen::Vector3f(0, -0.5F, 1)).norm(), 1e-6F);
+  EXPECT_LT((shoulder.b - Eigen::Vector3f(0, 0.5F, 1)).norm(), 1e-6F);
   EXPECT_FLOAT_EQ(shoulder.radius_m, 0.07F);
   EXPECT_FLOAT_EQ(fixed_robot_model(c).capsules[0].radius_m, 0.12F);
   // robot.padding_m replaces the arm's own padding.

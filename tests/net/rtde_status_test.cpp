@@ -120,12 +120,10 @@ Pose flange_dh(const JointAngles& q) {
   return T;
 }
 
-// hrcsense's `base`, the pendant's frame: DH frame 0 turned π about z (docs/ROBOT.md, "Frames").
-Pose pendant_from_dh() {
-  Pose T = Pose::Identity();
-  T.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  return T;
-}
+// hrcsense's `base`, the pendant's frame, is UR's DH frame 0 itself: with UR's table (a2, a3 < 0)
+// the arm at q = 0 reaches along −x, as the pendant shows it, while ROS's base_link, turned π
+// about z, has it along +x (ur_description, "Robot Frames"; docs/ROBOT.md, "Frames").
+Pose pendant_from_dh() { return Pose::Identity(); }
 
 // A gripper's TCP: 0.15 m out along the flange's z, turned 30° about it.
 Pose tool() {
@@ -233,7 +231,9 @@ TEST(TcpPoseCheck, ImpliedOffsetIsTheToolAndATurnedFrameIsNot) {
   // y: from the flange (a2 + a3, -(d4 + d6), d1 - d5) that is (-2 (a2 + a3), 2 (d4 + d6) + 0.15, 0).
   EXPECT_NEAR(good.offset_turned_m, std::hypot(2.0 * (kA2 + kA3), 2.0 * (kD4 + kD6) + 0.15), 1e-9);
 
-  const TcpPoseCheck turned = check_tcp_pose(ur5, zero, ur_vector(pendant_from_dh() * reported), nullptr, {});
+  Pose half_turn = Pose::Identity();  // the pose as it would read in base_link
+  half_turn.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const TcpPoseCheck turned = check_tcp_pose(ur5, zero, ur_vector(half_turn * reported), nullptr, {});
   EXPECT_FALSE(turned.consistent);
   EXPECT_NEAR(turned.offset_turned_m, 0.15, 1e-9);
 

@@ -24,7 +24,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 // A one-link "arm": every DH row zero, so each joint turns about the base z axis (the fake
 // camera's optical axis) and link 1's frame is Rz(q1). Its only capsule lies on link 1's x
-// axis from 0.5 m to 1 m, radius 0. Base frame base_link: no extra rotation.
+// axis from 0.5 m to 1 m, radius 0. Base frame base (DH frame 0): no extra rotation.
 PipelineParams stick_params() {
   PipelineParams params = fake_params();
   params.robot.points.capsules.clear();
@@ -32,7 +32,7 @@ PipelineParams stick_params() {
   stick.name = "stick";
   stick.links[1].push_back(LinkCapsule{Eigen::Vector3d(0.5, 0.0, 0.0), Eigen::Vector3d(1.0, 0.0, 0.0), 0.0});
   params.robot.arm = stick;
-  params.robot.base_frame = BaseFrame::base_link;
+  params.robot.base_frame = BaseFrame::base;
   params.robot.padding_m = 0.0;
   return params;
 }

@@ -64,13 +64,13 @@ TEST(RobotCapsules, ConsecutiveLinksMeetAtTheJoints) {
 TEST(RobotCapsules, ChainEndsAtTheBaseAndTheFlange) {
   const RobotDescription& ur5 = builtin_robot("ur5");
   const JointAngles q{0.4, -1.2, 1.0, -0.3, 0.9, 0.2};
-  const RobotModel model = robot_capsules(ur5, q, 0.0, BaseFrame::base_link);
+  const RobotModel model = robot_capsules(ur5, q, 0.0, BaseFrame::base);
   EXPECT_LT(first_of(model, 0).a.norm(), 1e-6F);  // on the mounting face, at the base origin
-  const Eigen::Vector3f flange = forward_kinematics(ur5, q).T_base_link_link[6].translation().cast<float>();
+  const Eigen::Vector3f flange = forward_kinematics(ur5, q).T_base_link[6].translation().cast<float>();
   EXPECT_LT((last_of(model, 6).b - flange).norm(), 1e-6F);
   // The upper arm runs beside the DH line by the shoulder offset, parallel to it: at q = 0
   // from (0, −0.13585, d1) to (a2, −0.13585, d1).
-  const RobotModel zero = robot_capsules(ur5, JointAngles{}, 0.0, BaseFrame::base_link);
+  const RobotModel zero = robot_capsules(ur5, JointAngles{}, 0.0, BaseFrame::base);
   EXPECT_LT((first_of(zero, 2).a - Eigen::Vector3f(0.0F, -0.13585F, 0.089159F)).norm(), 1e-6F);
   EXPECT_LT((first_of(zero, 2).b - Eigen::Vector3f(-0.425F, -0.13585F, 0.089159F)).norm(), 1e-6F);
 }
@@ -115,7 +115,7 @@ TEST(RobotCapsules, ToolHangsOffTheFlange) {
   arm.tool.push_back(LinkCapsule{Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.15), 0.04});
   // At q = 0 the flange's z is −y of base_link (see kinematics_test), so the tool tip is
   // 0.15 m further along −y: (a2 + a3, −(d4 + d6) − 0.15, d1 − d5).
-  const RobotModel model = robot_capsules(arm, JointAngles{}, 0.01, BaseFrame::base_link);
+  const RobotModel model = robot_capsules(arm, JointAngles{}, 0.01, BaseFrame::base);
   const Capsule& tool = model.capsules.back();
   EXPECT_EQ(tool.link, kToolLink);
   EXPECT_LT((tool.a - Eigen::Vector3f(-0.81725F, -0.19145F, -0.005491F)).norm(), 1e-6F);

@@ -26,10 +26,13 @@ constexpr double kTolerance_m = 1e-6;
 // UR5 (CB3) DH values, from UR's published table, independent of the built-in description.
 constexpr double d1 = 0.089159, a2 = -0.425, a3 = -0.39225, d4 = 0.10915, d5 = 0.09465, d6 = 0.0823;
 
-Eigen::Vector3d flange(const std::string& arm, JointAngles q_deg, BaseFrame frame = BaseFrame::base_link) {
+// UR's DH frame 0 is the pendant's `base` (ROS's `base`; its `base_link` is turned π about z,
+// +x along the arm at q = 0: ur_description's "Robot Frames").
+Eigen::Vector3d flange(const std::string& arm, JointAngles q_deg, BaseFrame frame = BaseFrame::base) {
   for (double& q : q_deg) q *= kDeg;
   const LinkFrames frames = forward_kinematics(builtin_robot(arm), q_deg);
-  const Pose T = frame == BaseFrame::base ? T_base_base_link() * frames.T_base_link_link[6] : frames.T_base_link_link[6];
+  const Pose T_base_link_base = T_base_base_link().inverse(Eigen::Isometry);
+  const Pose T = frame == BaseFrame::base_link ? T_base_link_base * frames.T_base_link[6] : frames.T_base_link[6];
   return T.translation();
 }
 
@@ -44,14 +47,14 @@ TEST(ForwardKinematics, Ur5ZeroPosePutsTheFlangeWhereTheDhTableSays) {
   expect_near(flange("ur5", {0, 0, 0, 0, 0, 0}), {-0.81725, -0.19145, -0.005491});
   // The DH frame 0 is base_link; every frame's origin at q = 0, one by one.
   const LinkFrames frames = forward_kinematics(builtin_robot("ur5"), JointAngles{});
-  expect_near(frames.T_base_link_link[0].translation(), {0, 0, 0});
-  expect_near(frames.T_base_link_link[1].translation(), {0, 0, d1});
-  expect_near(frames.T_base_link_link[2].translation(), {a2, 0, d1});
-  expect_near(frames.T_base_link_link[3].translation(), {a2 + a3, 0, d1});
-  expect_near(frames.T_base_link_link[4].translation(), {a2 + a3, -d4, d1});
-  expect_near(frames.T_base_link_link[5].translation(), {a2 + a3, -d4, d1 - d5});
+  expect_near(frames.T_base_link[0].translation(), {0, 0, 0});
+  expect_near(frames.T_base_link[1].translation(), {0, 0, d1});
+  expect_near(frames.T_base_link[2].translation(), {a2, 0, d1});
+  expect_near(frames.T_base_link[3].translation(), {a2 + a3, 0, d1});
+  expect_near(frames.T_base_link[4].translation(), {a2 + a3, -d4, d1});
+  expect_near(frames.T_base_link[5].translation(), {a2 + a3, -d4, d1 - d5});
   // The flange's z (the tool direction) points along −y at q = 0 (z6 = z5 = y4 = z3 = −y0).
-  expect_near(frames.T_base_link_link[6].linear().col(2), {0, -1, 0});
+  expect_near(frames.T_base_link[6].linear().col(2), {0, -1, 0});
 }
 
 TEST(ForwardKinematics, Ur5EachJointAtNinetyDegreesByHand) {
@@ -75,7 +78,7 @@ TEST(ForwardKinematics, Ur5EachJointAtNinetyDegreesByHand) {
   // turns about −y by −90°, i.e. Ry(+90°)(1, 0, 0) = (0, 0, −1).
   expect_near(flange("ur5", {0, 0, 0, 0, 0, -90}), {a2 + a3, -(d4 + d6), d1 - d5});
   const LinkFrames frames = forward_kinematics(builtin_robot("ur5"), JointAngles{0, 0, 0, 0, 0, -90 * kDeg});
-  expect_near(frames.T_base_link_link[6].linear().col(0), {0, 0, -1});
+  expect_near(frames.T_base_link[6].linear().col(0), {0, 0, -1});
 }
 
 TEST(ForwardKinematics, Ur5CombinedJointsByHand) {
@@ -89,19 +92,22 @@ TEST(ForwardKinematics, Ur5CombinedJointsByHand) {
 }
 
 TEST(ForwardKinematics, BaseIsBaseLinkTurnedHalfAroundZ) {
-  // The value: the same flange is (0.81725, 0.19145, −0.005491) in `base`.
-  expect_near(flange("ur5", {0, 0, 0, 0, 0, 0}, BaseFrame::base), {0.81725, 0.19145, -0.005491});
+  // At q = 0 the pendant shows the flange at (a2 + a3, −(d4 + d6), d1 − d5) = (−0.81725,
+  // −0.19145, −0.005491) in `base`; in ROS's base_link, where the arm points along +x, at
+  // (0.81725, 0.19145, −0.005491).
+  expect_near(flange("ur5", {0, 0, 0, 0, 0, 0}, BaseFrame::base), {-0.81725, -0.19145, -0.005491});
+  expect_near(flange("ur5", {0, 0, 0, 0, 0, 0}, BaseFrame::base_link), {0.81725, 0.19145, -0.005491});
   const JointAngles q{0.3, -1.1, 0.7, -0.2, 1.4, 2.0};
-  const Eigen::Vector3d in_base_link = forward_kinematics(builtin_robot("ur5"), q).T_base_link_link[6].translation();
-  const Eigen::Vector3d in_base = T_base_base_link() * in_base_link;
-  expect_near(in_base, {-in_base_link.x(), -in_base_link.y(), in_base_link.z()});
+  const Eigen::Vector3d in_base = forward_kinematics(builtin_robot("ur5"), q).T_base_link[6].translation();
+  const Eigen::Vector3d in_base_link = T_base_base_link().inverse(Eigen::Isometry) * in_base;
+  expect_near(in_base_link, {-in_base.x(), -in_base.y(), in_base.z()});
 }
 
 TEST(ForwardKinematics, EseriesZeroPoses) {
   // (a2 + a3, −(d4 + d6), d1 − d5) with UR's e-Series tables.
   expect_near(flange("ur5e", {0, 0, 0, 0, 0, 0}), {-0.425 - 0.3922, -(0.1333 + 0.0996), 0.1625 - 0.0997});
   expect_near(flange("ur10e", {0, 0, 0, 0, 0, 0}), {-0.6127 - 0.57155, -(0.17415 + 0.11655), 0.1807 - 0.11985});
-  expect_near(flange("ur10e", {0, 0, 0, 0, 0, 0}, BaseFrame::base), {1.18425, 0.2907, 0.06085});
+  expect_near(flange("ur10e", {0, 0, 0, 0, 0, 0}, BaseFrame::base_link), {1.18425, 0.2907, 0.06085});
   // UR10e joint 2 −90°: upright, as for the UR5: (−d5, −(d4 + d6), d1 − (a2 + a3)).
   expect_near(flange("ur10e", {0, -90, 0, 0, 0, 0}), {-0.11985, -0.2907, 0.1807 + 1.18425});
 }
@@ -109,7 +115,7 @@ TEST(ForwardKinematics, EseriesZeroPoses) {
 TEST(ForwardKinematics, FramesStayRigid) {
   // Rotations stay orthonormal for an arbitrary state (a broken DH product would shear them).
   const LinkFrames frames = forward_kinematics(builtin_robot("ur10e"), JointAngles{1, 2, -2.5, 0.4, -3, 5});
-  for (const Pose& T : frames.T_base_link_link) {
+  for (const Pose& T : frames.T_base_link) {
     EXPECT_TRUE((T.linear() * T.linear().transpose()).isIdentity(1e-12));
     EXPECT_NEAR(T.linear().determinant(), 1.0, 1e-12);
   }

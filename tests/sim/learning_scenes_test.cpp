@@ -37,8 +37,9 @@ constexpr int kLearnFrames = 30;  // background.frames
 Config cell_config(float wall_x_m) {
   Config config = load_config("", {"sim.width=424", "sim.height=240", "sim.color=false", "source.seed=3",
                                    "background.frames=" + std::to_string(kLearnFrames), "filters.preset=none",
-                                   // Pan -1.2 rad: the arm reaches away from the seat, to the left.
-                                   "robot.model=ur5", "robot.joints_rad=[-1.2, -1.5, 1.4, -1.5, -1.5708, 0.0]",
+                                   // Pan 1.94 rad (the arm along -x of base at pan 0): it reaches
+                                   // away from the seat, to the left.
+                                   "robot.model=ur5", "robot.joints_rad=[1.941593, -1.5, 1.4, -1.5, -1.5708, 0.0]",
                                    "camera.T_base_camera={translation_m: [2.0, 1.5, 1.2], "
                                    "rotation_rpy_deg: [-110, 0, 90]}"});
   SceneObject room;

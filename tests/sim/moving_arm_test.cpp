@@ -28,7 +28,7 @@ Config moving_cell() {
 /// The flange (tool) position in the base frame at time t_s, by forward kinematics.
 Eigen::Vector3d flange_base(const Config& config, double t_s) {
   const JointAngles q = joints_at(*config.robot_state.trajectory, t_s).q_rad;
-  return (T_base_base_link() * forward_kinematics(*config.pipeline.robot.arm, q).T_base_link_link[6]).translation();
+  return forward_kinematics(*config.pipeline.robot.arm, q).T_base_link[6].translation();  // DH frame 0 = base
 }
 
 size_t count_label(const std::vector<uint16_t>& labels, uint16_t label) {
