@@ -43,13 +43,11 @@ void BM_SelfFilter(benchmark::State& state) {
   }
   SelfFilter filter;
   filter.params = config.pipeline.self_filter;
-  const SelfFilterNoise noise{config.pipeline.foreground.k_sigma, config.pipeline.foreground.min_margin_m,
-                              config.pipeline.foreground.subpixel_rms_px};
   size_t i = 0;
   size_t silhouette = 0;
   for (auto _ : state) {
     filter.add_pose(poses[i++ % poses.size()]);
-    filter.render(frame, config.pipeline.T_base_camera, noise);
+    filter.render(frame, config.pipeline.T_base_camera, config.pipeline.foreground);
     silhouette += filter.silhouette_pixels();
     benchmark::DoNotOptimize(filter.robot_pixels().from_raw);
   }

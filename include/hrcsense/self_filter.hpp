@@ -19,7 +19,7 @@ struct SelfFilterParams {
   /// `self_filter.margin_m`: a pixel inside the silhouette is the robot's when its depth is at
   /// or behind the padded surface minus this margin, up to the padded body's far side. The
   /// margin used is never less than the foreground's own noise test at that depth
-  /// (SelfFilterNoise).
+  /// (ForegroundParams: max(margin_m, min_margin_m, k_sigma · σ_stereo(z))).
   float margin_m = 0.03F;
   /// `self_filter.dilate_px`: the silhouette grows by this many pixels (square), so that depth
   /// edges, the spatial filter's smear and the calibration's error stay covered. In the
@@ -31,13 +31,7 @@ struct SelfFilterParams {
   int memory_frames = 3;
 };
 
-/// How the self-filter's margin follows the foreground test (ForegroundParams): at depth z the
-/// margin is max(margin_m, min_margin_m, k_sigma · σ_stereo(z)).
-struct SelfFilterNoise {
-  float k_sigma = 4.0F;
-  float min_margin_m = 0.02F;
-  float subpixel_rms_px = 0.08F;
-};
+struct ForegroundParams;  // segmentation.hpp: the foreground test the margin follows
 
 /// Which raw depths of each pixel are the robot's: [from_raw[i], to_raw[i]] (both inclusive);
 /// from_raw[i] = 0 where the robot is not in the pixel. Row-major, the rendered frame's size.
@@ -68,8 +62,9 @@ class SelfFilter {
   int poses() const { return pose_count_; }
 
   /// Renders the union of the remembered poses into the geometry of `frame` (its size,
-  /// intrinsics, depth unit and stereo baseline), the camera at `T_base_camera`.
-  void render(const Frame& frame, const Pose& T_base_camera, const SelfFilterNoise& noise);
+  /// intrinsics, depth unit and stereo baseline), the camera at `T_base_camera`; the margin
+  /// never undercuts `foreground`'s own noise test.
+  void render(const Frame& frame, const Pose& T_base_camera, const ForegroundParams& foreground);
   /// The robot's raw depths per pixel of the last render (valid until the next render).
   RobotPixels robot_pixels() const { return {from_raw_.data(), to_raw_.data()}; }
   /// The padded body's nearest depth per pixel in metres, dilated (+inf where no robot); for

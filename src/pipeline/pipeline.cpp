@@ -149,12 +149,9 @@ Pipeline::Pipeline(PipelineParams params)
 
 std::optional<RobotPixels> Pipeline::render_robot(const Frame& frame, FrameResult& result) {
   if (!params_.robot.arm) return std::nullopt;
-  // The foreground test's own noise model, on the filtered frame's focal length as it is.
-  const SelfFilterNoise noise{params_.foreground.k_sigma, params_.foreground.min_margin_m,
-                              params_.foreground.subpixel_rms_px};
   timed(result, "self_filter", [&] {
     self_filter_.add_pose(robot_);
-    self_filter_.render(frame, params_.T_base_camera, noise);
+    self_filter_.render(frame, params_.T_base_camera, params_.foreground);
   });
   return self_filter_.robot_pixels();
 }

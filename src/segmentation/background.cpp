@@ -318,24 +318,14 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
 
   // Raw units are integers, so the sums stay exact in double (65535² · 2^20 < 2^53).
   const uint16_t* raw = depth.pixels.data();
-  if (robot == nullptr) {
-    for (size_t i = 0; i < n; ++i) {
-      const double r = raw[i];
-      sum_[i] += r;
-      sum_sq_[i] += r * r;
-      valid_count_[i] += raw[i] != 0 ? 1U : 0U;
-      nearest_raw_[i] = nearer_sample(nearest_raw_[i], raw[i]);
-    }
-  } else {
-    // The robot's own pixels are no samples, as if invalid.
-    for (size_t i = 0; i < n; ++i) {
-      const uint16_t sample = robot->contains(i, raw[i]) ? uint16_t{0} : raw[i];
-      const double r = sample;
-      sum_[i] += r;
-      sum_sq_[i] += r * r;
-      valid_count_[i] += sample != 0 ? 1U : 0U;
-      nearest_raw_[i] = nearer_sample(nearest_raw_[i], sample);
-    }
+  // The robot's own pixels are no samples, as if invalid.
+  for (size_t i = 0; i < n; ++i) {
+    const uint16_t sample = robot != nullptr && robot->contains(i, raw[i]) ? uint16_t{0} : raw[i];
+    const double r = sample;
+    sum_[i] += r;
+    sum_sq_[i] += r * r;
+    valid_count_[i] += sample != 0 ? 1U : 0U;
+    nearest_raw_[i] = nearer_sample(nearest_raw_[i], sample);
   }
   ++count_;
   if (count_ < std::max(params.frames, 1)) return status;

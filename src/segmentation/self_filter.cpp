@@ -6,6 +6,7 @@
 #include "hrcsense/self_filter.hpp"
 
 #include "hrcsense/camera.hpp"
+#include "hrcsense/segmentation.hpp"
 
 #include <algorithm>
 #include <array>
@@ -103,9 +104,14 @@ struct ImageHull {
       const Eigen::Vector2f& p = points[static_cast<size_t>(i)];
       const Eigen::Vector2f& q = points[static_cast<size_t>((i + 1) % count)];
       if ((p.y() - v) * (q.y() - v) > 0.0F) continue;  // the edge lies above or below the row
-      const float u = p.y() == q.y() ? p.x() : p.x() + (v - p.y()) * (q.x() - p.x()) / (q.y() - p.y());
-      lo = std::min({lo, u, p.y() == q.y() ? q.x() : u});
-      hi = std::max({hi, u, p.y() == q.y() ? q.x() : u});
+      if (p.y() == q.y()) {  // an edge along the row: both its ends
+        lo = std::min({lo, p.x(), q.x()});
+        hi = std::max({hi, p.x(), q.x()});
+        continue;
+      }
+      const float u = p.x() + (v - p.y()) * (q.x() - p.x()) / (q.y() - p.y());
+      lo = std::min(lo, u);
+      hi = std::max(hi, u);
     }
     return lo <= hi;
   }
@@ -287,7 +293,7 @@ void SelfFilter::dilate(const Rect& rect) {
                 [](float x, float y) { return std::max(x, y); });
 }
 
-void SelfFilter::render(const Frame& frame, const Pose& T_base_camera, const SelfFilterNoise& noise) {
+void SelfFilter::render(const Frame& frame, const Pose& T_base_camera, const ForegroundParams& noise) {
   prepare(frame);
   clear(dirty_);
   dirty_ = Rect{};

@@ -66,7 +66,7 @@ SelfFilter filter_with(int dilate_px, float margin_m = 0.03F, int memory = 1) {
 TEST(SelfFilter, CentrePixelSpansTheBarFromItsFrontToItsBack) {
   SelfFilter filter = filter_with(0);
   filter.add_pose(bar_at(2.0F));
-  filter.render(camera_frame(), Pose::Identity(), SelfFilterNoise{});
+  filter.render(camera_frame(), Pose::Identity(), ForegroundParams{});
   // The optical axis meets the bar's front at 2.0 − 0.1 and its back at 2.0 + 0.1.
   EXPECT_NEAR(filter.surface_depth_m()[index(50, 50)], 1.9, 1e-5);
   const RobotPixels robot = filter.robot_pixels();
@@ -83,7 +83,7 @@ TEST(SelfFilter, CentrePixelSpansTheBarFromItsFrontToItsBack) {
 TEST(SelfFilter, OffAxisPixelsFollowTheCylindersCurve) {
   SelfFilter filter = filter_with(0);
   filter.add_pose(bar_at(2.0F));
-  filter.render(camera_frame(), Pose::Identity(), SelfFilterNoise{});
+  filter.render(camera_frame(), Pose::Identity(), ForegroundParams{});
   for (int v : {47, 52, 54}) {
     const auto [front, back] = ray_meets_bar(v, 2.0, 0.1);
     EXPECT_NEAR(filter.surface_depth_m()[index(50, v)], front, 1e-4) << "v = " << v;
@@ -103,7 +103,7 @@ TEST(SelfFilter, OffAxisPixelsFollowTheCylindersCurve) {
 TEST(SelfFilter, DilationGrowsTheSilhouetteWithTheNeighboursDepths) {
   SelfFilter filter = filter_with(2);
   filter.add_pose(bar_at(2.0F));
-  filter.render(camera_frame(), Pose::Identity(), SelfFilterNoise{});
+  filter.render(camera_frame(), Pose::Identity(), ForegroundParams{});
   // Rows 56 and 57 are within 2 px of row 55, the last one inside; each takes the nearest front
   // of the 5x5 square around it: rows 55..59 hold only row 55's, rows 54..58 also row 54's,
   // which is nearer (closer to the axis).
@@ -117,11 +117,12 @@ TEST(SelfFilter, DilationGrowsTheSilhouetteWithTheNeighboursDepths) {
 }
 
 TEST(SelfFilter, MarginIsNeverBelowTheForegroundsNoiseTest) {
-  // With a D435-like baseline the stereo σ at 2 m is z² · 0.08 / (f · B) = 4 · 0.08 / (100 ·
+  // ForegroundParams' defaults: k_sigma 4, min_margin_m 0.02, subpixel 0.08 px. With a D435-like
+  // baseline the stereo σ at 2 m is z² · 0.08 / (f · B) = 4 · 0.08 / (100 ·
   // 0.05) = 0.064 m; k_sigma 4 makes the margin 0.256 m, far above margin_m.
   SelfFilter filter = filter_with(0);
   filter.add_pose(bar_at(2.0F));
-  filter.render(camera_frame(50.0F), Pose::Identity(), SelfFilterNoise{4.0F, 0.02F, 0.08F});
+  filter.render(camera_frame(50.0F), Pose::Identity(), ForegroundParams{});
   const double front = 1.9;
   const double sigma = front * front * 0.08 / (kFocalPx * 0.05);
   EXPECT_NEAR(filter.robot_pixels().from_raw[index(50, 50)], std::ceil((front - 4.0 * sigma) * 1000.0), 1.0);
@@ -133,7 +134,7 @@ TEST(SelfFilter, RemembersTheUnionOfTheLastPoses) {
   SelfFilter filter = filter_with(0, 0.03F, 3);
   const float depths[] = {2.00F, 2.02F, 2.04F, 2.06F};
   for (float z : depths) filter.add_pose(bar_at(z));
-  filter.render(camera_frame(), Pose::Identity(), SelfFilterNoise{});
+  filter.render(camera_frame(), Pose::Identity(), ForegroundParams{});
   EXPECT_EQ(filter.poses(), 3);
   // Remembered: 2.02, 2.04, 2.06 (the oldest, 2.00, forgotten): front 1.92, back 2.16.
   EXPECT_NEAR(filter.surface_depth_m()[index(50, 50)], 1.92, 1e-5);
@@ -141,7 +142,7 @@ TEST(SelfFilter, RemembersTheUnionOfTheLastPoses) {
   // Where the arm was two frames ago (2.02 − 0.1 = 1.92) is still the robot's.
   EXPECT_TRUE(filter.robot_pixels().contains(index(50, 50), 1925));
   filter.clear_poses();
-  filter.render(camera_frame(), Pose::Identity(), SelfFilterNoise{});
+  filter.render(camera_frame(), Pose::Identity(), ForegroundParams{});
   EXPECT_EQ(filter.robot_pixels().from_raw[index(50, 50)], 0);
   EXPECT_EQ(filter.silhouette_pixels(), 0U);
 }
@@ -149,10 +150,10 @@ TEST(SelfFilter, RemembersTheUnionOfTheLastPoses) {
 TEST(SelfFilter, ARenderForgetsTheLastOnesPixels) {
   SelfFilter filter = filter_with(1);
   filter.add_pose(bar_at(2.0F, 0.3F));  // up in the image: rows around 50 + 0.3 / 2 · 100 = 65
-  filter.render(camera_frame(), Pose::Identity(), SelfFilterNoise{});
+  filter.render(camera_frame(), Pose::Identity(), ForegroundParams{});
   EXPECT_NE(filter.robot_pixels().from_raw[index(50, 65)], 0);
   filter.add_pose(bar_at(2.0F, -0.3F));  // memory 1: only this pose, rows around 35
-  filter.render(camera_frame(), Pose::Identity(), SelfFilterNoise{});
+  filter.render(camera_frame(), Pose::Identity(), ForegroundParams{});
   EXPECT_EQ(filter.robot_pixels().from_raw[index(50, 65)], 0);
   EXPECT_TRUE(std::isinf(filter.surface_depth_m()[index(50, 65)]));
   EXPECT_NE(filter.robot_pixels().from_raw[index(50, 35)], 0);
@@ -164,7 +165,7 @@ TEST(SelfFilter, CameraPoseMovesTheArmIntoTheCameraFrame) {
   filter.add_pose(bar_at(3.0F));
   Pose T_base_camera = Pose::Identity();
   T_base_camera.translation() = Eigen::Vector3d(0.0, 0.0, 1.0);  // the camera at z = 1 in the base
-  filter.render(camera_frame(), T_base_camera, SelfFilterNoise{});
+  filter.render(camera_frame(), T_base_camera, ForegroundParams{});
   EXPECT_NEAR(filter.surface_depth_m()[index(50, 50)], 1.9, 1e-5);
 }
 
@@ -173,7 +174,7 @@ TEST(SelfFilter, ForegroundKeepsAHandInFrontOfTheArmAndDropsTheArm) {
   SelfFilter filter = filter_with(1);
   filter.add_pose(bar_at(2.0F));
   Frame frame = camera_frame();
-  filter.render(frame, Pose::Identity(), SelfFilterNoise{});
+  filter.render(frame, Pose::Identity(), ForegroundParams{});
   // Background: a wall at 3 m. The bar's own rows 45..55 at the bar's depth, and a 10 x 10 px
   // hand 10 cm in front of the bar's front at columns 40..49, rows 46..55.
   BackgroundModel background;
