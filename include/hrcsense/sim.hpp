@@ -171,8 +171,8 @@ struct SimScratch {
   PointCloud points_camera;        ///< the same points, camera frame
   RobotModel arm_render;           ///< the moving arm's visual capsules this frame (SimArm)
   RobotModel arm_searched;         ///< its searched capsules this frame, for the truth contact
-  std::vector<float> label_z_m;    ///< label_at()'s z-buffer
-  int64_t label_index = -1;        ///< the frame label_at() last cast (object_ids hold it); -1: none
+  std::vector<float> label_z_m;    ///< hit_at()'s z-buffer
+  int64_t label_index = -1;        ///< the frame hit_at() last cast (object_ids, label_z_m hold it); -1: none
 };
 
 /// An arm the simulator moves along a trajectory (`robot.trajectory`): rendered at each frame's
@@ -211,11 +211,17 @@ struct Simulator {
   /// and with params.color the colour image, its intrinsics and the depth → colour extrinsics).
   /// Reuses out's buffers, so rendering into the same Frame does not allocate.
   void render(int64_t index, Frame& out) const;
-  /// The truth label render() gives source pixel `pixel` (v * width + u) of frame `index`,
+  /// What the ray of source pixel `pixel` (v * width + u) of frame `index` meets: its truth
+  /// label and the noise-free depth Z (m, 0 where nothing is hit), as render() gives them but
   /// without rendering the rest: the same ray cast, so the same label. Casts the whole frame
   /// once per index (scratch keeps it), so asking for several pixels of a frame is cheap.
-  /// kStaticLabel for a pixel outside the image.
-  uint16_t label_at(int64_t index, int pixel) const;
+  /// {kStaticLabel, 0} for a pixel outside the image.
+  struct Hit {
+    uint16_t label = kStaticLabel;
+    float z_m = 0.0F;
+  };
+  Hit hit_at(int64_t index, int pixel) const;
+  uint16_t label_at(int64_t index, int pixel) const { return hit_at(index, pixel).label; }
   /// A label's name: "static", "robot" (kRobotLabel), or the name of the non-static scene
   /// object with that label; "" for a label no object has.
   const std::string& label_name(uint16_t label) const;

@@ -268,17 +268,17 @@ void Simulator::render(int64_t index, Frame& out) const {
 
   sim_detail::cast_shapes(scratch.shapes_base, scratch.shape_ids, scratch.rays, T_base_camera_f, truth.depth_m.data(),
                           scratch.object_ids.data());
-  scratch.label_index = index;  // label_at() may read this frame's ids
+  scratch.label_index = -1;  // the cast above wrote object_ids but not hit_at()'s z-buffer
   sim_detail::write_sensor_depth(params, in.fx, index, truth.depth_m.data(), scratch, out.depth);
   fill_truth_labels(scratch, truth);
   fill_truth_contacts(*this, T_base_camera_f, truth);
   render_color(*this, T_base_camera_f, out);
 }
 
-uint16_t Simulator::label_at(int64_t index, int pixel) const {
+Simulator::Hit Simulator::hit_at(int64_t index, int pixel) const {
   const Intrinsics in = intrinsics();
   const size_t n = static_cast<size_t>(in.width) * in.height;
-  if (pixel < 0 || static_cast<size_t>(pixel) >= n) return kStaticLabel;
+  if (pixel < 0 || static_cast<size_t>(pixel) >= n) return Hit{};
   if (scratch.label_index != index) {
     sim_detail::ensure_rays(scratch.rays, in);
     place_shapes(*this, index, scratch);
@@ -291,7 +291,9 @@ uint16_t Simulator::label_at(int64_t index, int pixel) const {
                             scratch.label_z_m.data(), scratch.object_ids.data());
     scratch.label_index = index;
   }
-  return scratch.label_of_id[scratch.object_ids[static_cast<size_t>(pixel)]];
+  const size_t i = static_cast<size_t>(pixel);
+  const float z_m = scratch.label_z_m[i];
+  return Hit{scratch.label_of_id[scratch.object_ids[i]], std::isfinite(z_m) ? z_m : 0.0F};  // a miss is +inf
 }
 
 const std::string& Simulator::label_name(uint16_t label) const {

@@ -167,21 +167,33 @@ TEST(MovingArmScene, LabelAtAgreesWithTheRenderedLabels) {
   EXPECT_EQ(asking.label_name(2), "");
 }
 
-TEST(SourcePixelOf, MapsADecimatedPixelToTheFirstOfItsBlock) {
-  const Intrinsics source = *d435_depth_intrinsics(848, 480);
-  Intrinsics filtered = source;  // decimation by 2 as the SDK scales intrinsics
-  filtered.width = 424;
-  filtered.height = 240;
+Intrinsics decimated_by_two(const Intrinsics& source) {
+  Intrinsics filtered = source;  // as the SDK's decimation scales intrinsics
+  filtered.width = source.width / 2;
+  filtered.height = source.height / 2;
   filtered.fx = source.fx / 2;
   filtered.fy = source.fy / 2;
   filtered.ppx = source.ppx / 2;
   filtered.ppy = source.ppy / 2;
-  EXPECT_EQ(source_pixel_of(5 * 424 + 10, filtered, source), 10 * 848 + 20);
-  EXPECT_EQ(source_pixel_of(239 * 424 + 423, filtered, source), 478 * 848 + 846);
-  EXPECT_EQ(source_pixel_of(0, filtered, source), 0);
-  EXPECT_EQ(source_pixel_of(1234, source, source), 1234);
-  EXPECT_EQ(source_pixel_of(-1, filtered, source), -1);
-  EXPECT_EQ(source_pixel_of(424 * 240, filtered, source), -1);
+  return filtered;
+}
+
+TEST(SourceBlockOf, MapsADecimatedPixelToItsBlock) {
+  const Intrinsics source = *d435_depth_intrinsics(848, 480);
+  const Intrinsics filtered = decimated_by_two(source);
+  const auto expect_block = [&](int pixel, const Intrinsics& from, int u0, int u1, int v0, int v1) {
+    const SourceBlock b = source_block_of(pixel, from, source);
+    EXPECT_EQ(b.u_begin, u0) << pixel;
+    EXPECT_EQ(b.u_end, u1) << pixel;
+    EXPECT_EQ(b.v_begin, v0) << pixel;
+    EXPECT_EQ(b.v_end, v1) << pixel;
+  };
+  expect_block(5 * 424 + 10, filtered, 20, 22, 10, 12);
+  expect_block(239 * 424 + 423, filtered, 846, 848, 478, 480);  // the last one, clamped to the image
+  expect_block(0, filtered, 0, 2, 0, 2);
+  expect_block(1234, source, 1234 % 848, 1234 % 848 + 1, 1, 2);  // equal sizes: the pixel itself
+  EXPECT_TRUE(source_block_of(-1, filtered, source).empty());
+  EXPECT_TRUE(source_block_of(424 * 240, filtered, source).empty());
 }
 
 /// Keeps the last frame result it was given.
@@ -223,6 +235,51 @@ TEST(TruthLabelSink, NamesTheObjectUnderTheMeasuredContact) {
   result.contact.valid = false;  // no measured contact: no label
   sink.frame(result);
   EXPECT_EQ(out.label, "(null)");
+}
+
+// A decimated pixel on the edge between the arm and a person: its label is that of the block's
+// source pixel whose true depth is nearest the measured one, whichever pixel comes first.
+TEST(TruthLabelSink, OnAnEdgeNamesTheSurfaceAtTheMeasuredDepth) {
+  const Config config = moving_cell();
+  const Simulator sim = make_simulator(config);
+  const Intrinsics in = sim.intrinsics();
+  const Intrinsics filtered = decimated_by_two(in);
+  LastResultSink out;
+  TruthLabelSink sink(make_simulator(config), out);
+  RunHeader header;
+  header.source.intrinsics = in;
+  header.filters.intrinsics = filtered;
+  sink.header(header);
+  int edges = 0;
+  for (const int64_t index : {250, 283, 300}) {
+    Frame frame;
+    sim.render(index, frame);
+    const GroundTruth& truth = *frame.truth;
+    for (int v = 0; v + 1 < in.height && edges < 40; v += 2) {
+      for (int u = 0; u + 1 < in.width && edges < 40; u += 2) {
+        // The block's person and robot pixels, their true depths.
+        float person_z = 0, robot_z = 0;
+        for (const int i : {v * in.width + u, v * in.width + u + 1, (v + 1) * in.width + u, (v + 1) * in.width + u + 1}) {
+          if (truth.labels[static_cast<size_t>(i)] == 1) person_z = truth.depth_m[static_cast<size_t>(i)];
+          if (truth.labels[static_cast<size_t>(i)] == kRobotLabel) robot_z = truth.depth_m[static_cast<size_t>(i)];
+        }
+        if (person_z <= 0 || robot_z <= 0 || std::abs(person_z - robot_z) < 0.02F) continue;
+        ++edges;
+        FrameResult result;
+        result.frame = index;
+        result.truth = truth.contact;
+        result.contact.valid = true;
+        result.contact.pixel = (v / 2) * filtered.width + u / 2;
+        result.contact.closest_camera.z() = person_z + 0.003F;  // measured with a little noise
+        sink.frame(result);
+        EXPECT_EQ(out.label, "person") << index << " " << u << "," << v;
+        result.contact.closest_camera.z() = robot_z - 0.003F;
+        sink.frame(result);
+        EXPECT_EQ(out.label, "robot") << index << " " << u << "," << v;
+      }
+    }
+  }
+  EXPECT_GT(edges, 5) << "the frames should show the hand beside the arm";
 }
 
 }  // namespace
