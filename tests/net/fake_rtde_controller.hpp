@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 // Test support: an in-process UR controller speaking RTDE on 127.0.0.1 (ephemeral port), written
 // from ../shared/specs/ur-rtde.md independently of src/net/. It plays a joint trajectory at the
-// frequency the client asks for, with its timestamps on a FakeClock-driven schedule (the
-// controller's clock is the FakeClock plus an offset), and misbehaves on request. After each
-// data package it calls the test's `after_send` (which waits until the client has read it), so
-// a 30 s trajectory plays in well under a second and every arrival time is exact.
+// frequency the client asks for, with its timestamps on a schedule of the clock it is given
+// (the controller's clock is that clock plus an offset), and misbehaves on request. On a
+// FakeClock, after each data package it calls the test's `after_send` (which waits until the
+// client has read it), so a 30 s trajectory plays in well under a second and every arrival time
+// is exact; on the steady clock it streams in real time, for a client in another process.
 #pragma once
 
 #include "hrcsense/clock.hpp"
@@ -64,7 +65,7 @@ struct FakeRtdeScript {
 
 class FakeRtdeController {
  public:
-  FakeRtdeController(FakeRtdeScript script, FakeClock& clock) : script_(script), clock_(clock) {
+  FakeRtdeController(FakeRtdeScript script, RunClock& clock) : script_(script), clock_(clock) {
     listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
     sockaddr_in address{};
     address.sin_family = AF_INET;
@@ -112,7 +113,7 @@ class FakeRtdeController {
 
  private:
   FakeRtdeScript script_;
-  FakeClock& clock_;
+  RunClock& clock_;
   int listen_fd_ = -1;
   int port_ = 0;
   std::function<void(int64_t)> after_send_;
