@@ -76,6 +76,8 @@ class BagWriter {
 
   /// Bytes in the file so far (closed chunks), the open chunk's uncompressed bytes not included.
   uint64_t bytes_written() const { return position_; }
+  /// The open chunk's uncompressed bytes (what it adds to the file at most, before compression).
+  uint64_t pending_bytes() const { return chunk_.size(); }
   const std::string& path() const { return path_; }
 
  private:

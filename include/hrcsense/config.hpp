@@ -56,7 +56,7 @@ struct RobotStateConfig {
 
 /// `record.*`: recordings made by `hrcsense record` and `hrcsense run --record` (docs/CAMERAS.md).
 struct RecordConfig {
-  int64_t split_mb = 4000;          ///< `record.split_mb`: a new file past this many MiB (under FAT32's 4 GiB); 0: one file
+  int64_t split_mb = 0;             ///< `record.split_mb`: > 0: a new file (NAME-000.bag, ...) past this many MiB; 0: one file
   std::string on_error = "continue";  ///< `record.on_error`: continue (processing goes on unrecorded) or stop
   int queue_frames = 16;            ///< `record.queue_frames`: frames waiting for the disk before drops
 };

@@ -368,11 +368,13 @@ void BagWriter::add_color(int64_t timestamp_ns, const ColorImage& color, const I
 }
 
 void BagWriter::add_frame(const Frame& frame) {
-  add_depth(frame);
+  // Colour first: a reader that pairs each depth frame with the latest colour frame in file
+  // order (hrcsense's BagSource) then gets this frame's own.
   if (frame.color && frame.color->width > 0) {
     const Pose T_color_depth = frame.depth_to_color ? extrinsics_pose(*frame.depth_to_color) : Pose::Identity();
     add_color(frame.timestamp_ns, *frame.color, frame.color_intrinsics, T_color_depth);
   }
+  add_depth(frame);
 }
 
 void BagWriter::add_joint_state(int64_t timestamp_ns, const JointAngles& joints_rad) {

@@ -92,8 +92,10 @@ void Recorder::open_next_file(const Frame& first) {
 }
 
 void Recorder::write_item(const Item& item) {
+  // The open chunk counts uncompressed: a file may end up smaller than split_mb, never larger
+  // than split_mb plus one frame.
   if (writer_ && params_.split_mb > 0 &&
-      writer_->bytes_written() >= static_cast<uint64_t>(params_.split_mb) * 1024ULL * 1024ULL) {
+      writer_->bytes_written() + writer_->pending_bytes() >= static_cast<uint64_t>(params_.split_mb) * 1024ULL * 1024ULL) {
     writer_->close();  // complete and indexed before the next one starts
     writer_.reset();
   }
