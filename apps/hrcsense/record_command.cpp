@@ -14,6 +14,7 @@
 #include <cmath>
 #include <csignal>
 #include <filesystem>
+#include <optional>
 
 namespace hrcsense::app {
 namespace {
@@ -54,6 +55,8 @@ int record_command(const CommandArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
   std::unique_ptr<Source> source = make_source(config);
   const SourceInfo info = source->info();
+  // The robot's joints at each frame go to /hrcsense/joint_states beside it.
+  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config);
   Recorder recorder(recorder_params(config, args.out, info));
 
   g_record_stop.store(false);
@@ -73,7 +76,12 @@ int record_command(const CommandArgs& args) {
     if (frames == 0) first_ns = frame.timestamp_ns;
     // --duration-s counts source time: the frame at first + S is the first one left out.
     if (args.duration_s > 0.0 && frame.timestamp_ns - first_ns >= duration_ns) break;
-    recorder.push_wait(frame, kRecordWaitMs);  // no processing to protect: wait rather than drop
+    // As run_pipeline looks it up: at the live source's host time, else at the source timestamp.
+    RobotState state;
+    std::optional<JointAngles> joints_rad;
+    const int64_t state_time_ns = frame.host_time_ns != 0 ? frame.host_time_ns : frame.timestamp_ns;
+    if (robot_states->state_at(state_time_ns, state) && state.valid) joints_rad = state.q_rad;
+    recorder.push_wait(frame, kRecordWaitMs, joints_rad);  // no processing to protect: wait rather than drop
     ++frames;
   }
   for (int signal : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal, SIG_DFL);

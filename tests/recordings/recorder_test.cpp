@@ -488,6 +488,23 @@ TEST(RecordCli, RecordsTheRequestedFramesAndDuration) {
   };
   ASSERT_EQ(run({"--out", dir / "n.bag", "--frames", "7"}), 0);
   EXPECT_EQ(summarize_recording(dir / "n.bag").streams[0].frames, 7);
+  // The cell's fixed arm: every frame's joint state is robot.joints_rad of the configuration.
+  const JointAngles joints_rad = load_config(cell_config(), {}).robot_state.joints_rad;
+  BagReader reader(dir / "n.bag");
+  BagMessage m;
+  int joint_states = 0;
+  for (int guard = 0; guard < 1000 && reader.next(m); ++guard) {
+    if (reader.connections().at(m.conn).topic != "/hrcsense/joint_states") continue;
+    ++joint_states;
+    const size_t positions_at = 16 + 4 + 6 * 11 + 4;  // header, name[] of "joint_0".."joint_5", count
+    ASSERT_GE(m.size, positions_at + 48);
+    for (size_t j = 0; j < 6; ++j) {
+      double q = 0.0;
+      std::memcpy(&q, m.data + positions_at + 8 * j, 8);
+      EXPECT_EQ(q, joints_rad[j]) << "joint " << j;
+    }
+  }
+  EXPECT_EQ(joint_states, 7);
   // 30 frames/s: 0.5 s of source time holds frames 0..14.
   ASSERT_EQ(run({"--out", dir / "d.bag", "--duration-s", "0.5"}), 0);
   EXPECT_EQ(summarize_recording(dir / "d.bag").streams[0].frames, 15);
