@@ -41,9 +41,9 @@ int main(int argc, char** argv) {
   CLI::App* run = app.add_subcommand("run", "process a source and write JSON Lines (docs/OUTPUT.md)");
   add_common_flags(*run, args);
   run->add_option("--out", args.out, "JSON Lines output file (default: stdout)");
-  run->add_option("--record", args.record, "also record the source's frames to this RealSense .bag (docs/CAMERAS.md)");
+  run->add_option("--record", args.record, "also record the source's frames to this RealSense .bag (docs/RECORDINGS.md)");
 
-  CLI::App* record = app.add_subcommand("record", "record the configured source to a RealSense .bag (docs/CAMERAS.md)");
+  CLI::App* record = app.add_subcommand("record", "record the configured source to a RealSense .bag (docs/RECORDINGS.md)");
   add_common_flags(*record, args);
   record->add_option("--out", args.out, "the .bag file (with record.split_mb: FILE-000.bag, ...)")->required();
   // A day at most: longer recordings are split files of a service, not one command.

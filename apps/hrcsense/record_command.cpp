@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense CLI — `hrcsense record`: the configured source's frames, as delivered (before any
-// filter), to a RealSense .bag (docs/CAMERAS.md, "Recording").
+// filter), to a RealSense .bag (docs/RECORDINGS.md, "Recording").
 #include "commands.hpp"
 #include "common/app_errors.hpp"
 #include "common/assembly.hpp"

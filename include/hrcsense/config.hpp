@@ -54,7 +54,7 @@ struct RobotStateConfig {
   std::optional<RobotTrajectory> trajectory;
 };
 
-/// `record.*`: recordings made by `hrcsense record` and `hrcsense run --record` (docs/CAMERAS.md).
+/// `record.*`: recordings made by `hrcsense record` and `hrcsense run --record` (docs/RECORDINGS.md).
 struct RecordConfig {
   int64_t split_mb = 0;             ///< `record.split_mb`: > 0: a new file (NAME-000.bag, ...) past this many MiB; 0: one file
   std::string on_error = "continue";  ///< `record.on_error`: continue (processing goes on unrecorded) or stop

@@ -478,6 +478,44 @@ TEST(RecordCli, KilledWithSigkillTheFileIsReadableUpToItsLastCompleteChunk) {
   }
 }
 
+TEST(RecordCli, SigintClosesAndIndexesTheRecording) {
+  ScratchDir dir("recorder");
+  const std::string path = dir / "stopped.bag";
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, STDERR_FILENO);
+    std::vector<std::string> args = {HRCSENSE_CLI, "record", "--config", cell_config(), "--out", path,
+                                     "--set", "sim.width=424", "--set", "sim.height=240", "--set", "sim.frames=100000"};
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(HRCSENSE_CLI, argv.data());
+    ::_exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  std::error_code ec;
+  while (std::chrono::steady_clock::now() < deadline && (!fs::exists(path) || fs::file_size(path, ec) < (1U << 20))) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ::kill(pid, SIGINT);
+  int status = 0;
+  for (int i = 0; i < 3000 && ::waitpid(pid, &status, WNOHANG) == 0; ++i) {  // 30 s at most
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (i == 2999) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+    }
+  }
+  ASSERT_TRUE(WIFEXITED(status)) << "status " << status;
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  const RecordingSummary summary = summarize_recording(path);
+  EXPECT_TRUE(summary.indexed);
+  EXPECT_TRUE(summary.damage.empty()) << summary.damage;
+  EXPECT_GT(summary.streams[0].frames, 0);
+}
+
 TEST(RecordCli, RecordsTheRequestedFramesAndDuration) {
   ScratchDir dir("recorder");
   const auto run = [&](const std::vector<std::string>& extra) {
