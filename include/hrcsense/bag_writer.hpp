@@ -48,7 +48,8 @@ struct BagWriterParams {
 };
 
 /// Writes one bag; messages go into chunks as they come, the index on close() (or destruction).
-/// Every method throws BagWriteError naming the file when the file system refuses.
+/// Every method throws BagWriteError naming the file when the file system refuses, or when an
+/// image's buffer does not match its size.
 class BagWriter {
  public:
   explicit BagWriter(std::string path, BagWriterParams params = {});

@@ -349,6 +349,11 @@ void BagWriter::put_image(const std::string& stream, int64_t timestamp_ns, uint3
 
 void BagWriter::add_depth(const Frame& frame) {
   const DepthImage& d = frame.depth;
+  // The image is read through width × height: a mismatched buffer would be read past its end.
+  if (d.width <= 0 || d.height <= 0 || d.pixels.size() != static_cast<size_t>(d.width) * static_cast<size_t>(d.height)) {
+    throw BagWriteError(path_ + ": frame " + std::to_string(frame.index) + ": depth image of " + std::to_string(d.width) +
+                        "x" + std::to_string(d.height) + " px holds " + std::to_string(d.pixels.size()) + " pixels");
+  }
   if (!depth_started_) {
     start_stream(kDepthStream, "mono16", frame.intrinsics, Pose::Identity());  // depth: group 0's reference
     depth_started_ = true;
@@ -359,6 +364,11 @@ void BagWriter::add_depth(const Frame& frame) {
 
 void BagWriter::add_color(int64_t timestamp_ns, const ColorImage& color, const Intrinsics& intrinsics,
                           const Pose& T_color_depth) {
+  if (color.width <= 0 || color.height <= 0 ||
+      color.rgb.size() != static_cast<size_t>(color.width) * static_cast<size_t>(color.height) * 3) {
+    throw BagWriteError(path_ + ": colour image of " + std::to_string(color.width) + "x" + std::to_string(color.height) +
+                        " px holds " + std::to_string(color.rgb.size()) + " bytes, not 3 per pixel");
+  }
   if (!color_started_) {
     start_stream(kColorStream, "rgb8", intrinsics, T_color_depth);
     color_started_ = true;
