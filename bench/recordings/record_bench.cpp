@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// Record/848x480_depth_color_<compression>: the production bag writer (hrcsense/bag_writer.hpp)
+// Record/depth_color_<compression>/848x480: the production bag writer (hrcsense/bag_writer.hpp)
 // writing config/cell-ur5.yaml's simulated 848x480 depth + rgb8 colour, with the SDK's metadata
 // and chunking, into a temp file; frames/s as items_per_second (DESIGN.md's budget: LZ4 ≥ 300).
 // Thirty distinct frames are rendered once and written in turn (rendering is the slow part);
@@ -69,8 +69,8 @@ void record(benchmark::State& state, BagCompression compression) {
 void BM_Record_848x480_depth_color_lz4(benchmark::State& state) { record(state, BagCompression::lz4); }
 void BM_Record_848x480_depth_color_none(benchmark::State& state) { record(state, BagCompression::none); }
 
-BENCHMARK(BM_Record_848x480_depth_color_lz4)->Name("Record/848x480_depth_color_lz4")->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Record_848x480_depth_color_none)->Name("Record/848x480_depth_color_none")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Record_848x480_depth_color_lz4)->Name("Record/depth_color_lz4/848x480")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Record_848x480_depth_color_none)->Name("Record/depth_color_none/848x480")->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace hrcsense

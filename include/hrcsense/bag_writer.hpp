@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+struct LZ4F_cctx_s;
+
 namespace hrcsense {
 
 /// A failed write, open or close of a recording; the message names the file and the cause
@@ -94,6 +96,9 @@ class BagWriter {
   struct FileCloser {
     void operator()(std::FILE* file) const;
   };
+  struct Lz4Freer {
+    void operator()(LZ4F_cctx_s* context) const;
+  };
 
   void write(const uint8_t* data, size_t size);
   void write_bag_header(uint64_t index_pos, uint32_t conn_count, uint32_t chunk_count);
@@ -119,6 +124,9 @@ class BagWriter {
   ChunkInfo current_;
   std::vector<uint8_t> chunk_;   ///< the open chunk, uncompressed
   std::vector<uint8_t> packed_;  ///< its compressed form, reused
+  /// One compression context for every chunk: a fresh one per chunk would allocate and clear
+  /// its 1 MiB block buffer each time.
+  std::unique_ptr<LZ4F_cctx_s, Lz4Freer> lz4_;
   size_t message_start_ = 0;     ///< where the open message's data_len field is in chunk_
   /// Index entries of the open chunk per connection: (time, offset in the chunk).
   std::map<uint32_t, std::vector<std::pair<int64_t, uint32_t>>> in_chunk_;

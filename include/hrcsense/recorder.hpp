@@ -77,6 +77,7 @@ class Recorder {
   std::deque<Item> queue_;
   std::vector<Item> spare_;  ///< written items whose buffers push() reuses (no allocation per frame)
   bool closing_ = false;
+  bool writer_exited_ = false;  ///< the writer thread has left its loop: later items would stay queued
   RecorderStats stats_;
   std::unique_ptr<BagWriter> writer_;  ///< writer thread only
   int part_ = 0;

@@ -181,6 +181,7 @@ Pose extrinsics_pose(const Extrinsics& e) {
 }  // namespace
 
 void BagWriter::FileCloser::operator()(std::FILE* file) const { std::fclose(file); }
+void BagWriter::Lz4Freer::operator()(LZ4F_cctx_s* context) const { LZ4F_freeCompressionContext(context); }
 
 BagWriter::BagWriter(std::string path, BagWriterParams params) : path_(std::move(path)), params_(params) {
   file_.reset(std::fopen(path_.c_str(), "wb"));
@@ -413,9 +414,23 @@ void BagWriter::flush_chunk() {
     prefs.frameInfo.blockSizeID = LZ4F_max1MB;
     prefs.frameInfo.blockMode = LZ4F_blockIndependent;
     prefs.frameInfo.contentChecksumFlag = LZ4F_contentChecksumEnabled;
+    prefs.autoFlush = 1;  // every block goes out in compressUpdate: End only adds the checksum
+    if (!lz4_) {
+      LZ4F_cctx* context = nullptr;
+      const size_t made = LZ4F_createCompressionContext(&context, LZ4F_VERSION);
+      if (LZ4F_isError(made)) throw BagWriteError(path_ + ": lz4: " + LZ4F_getErrorName(made));
+      lz4_.reset(context);
+    }
     packed_.resize(LZ4F_compressFrameBound(chunk_.size(), &prefs));
-    const size_t n = LZ4F_compressFrame(packed_.data(), packed_.size(), chunk_.data(), chunk_.size(), &prefs);
-    if (LZ4F_isError(n)) throw BagWriteError(path_ + ": lz4 compression failed: " + LZ4F_getErrorName(n));
+    const auto check = [this](size_t made) {
+      if (LZ4F_isError(made)) throw BagWriteError(path_ + ": lz4 compression failed: " + LZ4F_getErrorName(made));
+      return made;
+    };
+    uint8_t* out = packed_.data();
+    const size_t room = packed_.size();
+    size_t n = check(LZ4F_compressBegin(lz4_.get(), out, room, &prefs));
+    n += check(LZ4F_compressUpdate(lz4_.get(), out + n, room - n, chunk_.data(), chunk_.size(), nullptr));
+    n += check(LZ4F_compressEnd(lz4_.get(), out + n, room - n, nullptr));
     data = packed_.data();
     size = n;
   }

@@ -52,6 +52,10 @@ bool Recorder::enqueue(const Frame& frame, const std::optional<JointAngles>& joi
   item.frame.truth.reset();  // ground truth is not recorded
   item.joints_rad = joints_rad;
   lock.lock();
+  if (writer_exited_) {  // close() finished meanwhile: nobody would write it
+    ++stats_.frames_dropped;
+    return false;
+  }
   queue_.push_back(std::move(item));
   wake_writer_.notify_one();
   return true;
@@ -108,7 +112,10 @@ void Recorder::writer_loop() {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
     wake_writer_.wait(lock, [this] { return closing_ || !queue_.empty(); });
-    if (queue_.empty() && closing_) break;
+    if (queue_.empty() && closing_) {
+      writer_exited_ = true;
+      break;
+    }
     Item item = std::move(queue_.front());
     queue_.pop_front();
     room_.notify_one();
