@@ -391,6 +391,26 @@ TEST(Recorder, WithOnErrorStopTheRecordingSourceEndsWithTheError) {
   EXPECT_EQ(stats.frames_recorded, 0);
 }
 
+TEST(Recorder, RecordKeysAreReadAndBounded) {
+  const Config defaults = load_config("", {});
+  EXPECT_EQ(defaults.record.split_mb, 0);  // docs/CONFIG.md: one file
+  EXPECT_EQ(defaults.record.on_error, "continue");
+  EXPECT_EQ(defaults.record.queue_frames, 16);
+  const Config set = load_config("", {"record.split_mb=512", "record.on_error=stop", "record.queue_frames=1"});
+  EXPECT_EQ(set.record.split_mb, 512);
+  EXPECT_EQ(set.record.on_error, "stop");
+  EXPECT_EQ(set.record.queue_frames, 1);
+  for (const std::string bad : {"record.split_mb=-1", "record.split_mb=1048577", "record.split_mb=0.5",
+                                "record.on_error=retry", "record.queue_frames=0", "record.queue_frames=1025"}) {
+    try {
+      load_config("", {bad});
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("key '" + bad.substr(0, bad.find('=')) + "'"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(Recorder, PushNeverWaitsForTheDiskAndCountsDrops) {
   ScratchDir dir("recorder");
   RecorderParams params = recorder_params(dir / "fast.bag");
