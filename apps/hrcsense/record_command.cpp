@@ -46,7 +46,7 @@ RecorderParams recorder_params(const Config& config, const std::string& path, co
 }
 
 void log_recording(const RecorderStats& stats) {
-  for (const std::string& file : stats.files) spdlog::info("recorded {}", file);
+  for (const std::string& file : stats.files) spdlog::info("recording file: {}", file);
   spdlog::info("recording: {} frames written, {} dropped", stats.frames_recorded, stats.frames_dropped);
   if (!stats.error.empty()) spdlog::error("recording: {}", stats.error);
 }
