@@ -2,6 +2,9 @@
 // hrcsense CLI — the subcommands. Each returns the process exit code and logs to stderr.
 #pragma once
 
+#include "hrcsense/config.hpp"
+#include "hrcsense/recorder.hpp"
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -16,9 +19,17 @@ struct CommandArgs {
   std::string out;                  ///< --out FILE; empty: stdout
   std::string input;                ///< positional path (info on a recording)
   std::string shared;               ///< verify-filters --shared DIR; empty: ../shared
+  std::string record;               ///< run --record FILE.bag; empty: no recording
+  double duration_s = -1.0;         ///< record --duration-s S; < 0: until --frames or the source's end
 };
 
 int run_command(const CommandArgs& args);
+/// record --out FILE.bag [--frames N | --duration-s S]: the source's frames, unfiltered, to a bag.
+int record_command(const CommandArgs& args);
+/// The recorder of `record` and `run --record` from record.* (creates the file's folder).
+RecorderParams recorder_params(const Config& config, const std::string& path, const SourceInfo& info);
+/// Logs the files written and the counters (and the error, naming the file) to stderr.
+void log_recording(const RecorderStats& stats);
 int info_command(const CommandArgs& args);
 int bench_command(const CommandArgs& args);
 /// verify-filters CASES_JSON [--shared DIR]: one stdout line per case, last "N/M cases bit-exact".

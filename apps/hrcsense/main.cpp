@@ -41,6 +41,15 @@ int main(int argc, char** argv) {
   CLI::App* run = app.add_subcommand("run", "process a source and write JSON Lines (docs/OUTPUT.md)");
   add_common_flags(*run, args);
   run->add_option("--out", args.out, "JSON Lines output file (default: stdout)");
+  run->add_option("--record", args.record, "also record the source's frames to this RealSense .bag (docs/RECORDINGS.md)");
+
+  CLI::App* record = app.add_subcommand("record", "record the configured source to a RealSense .bag (docs/RECORDINGS.md)");
+  add_common_flags(*record, args);
+  record->add_option("--out", args.out, "the .bag file (with record.split_mb: FILE-000.bag, ...)")->required();
+  // A day at most: longer recordings are split files of a service, not one command.
+  record->add_option("--duration-s", args.duration_s, "stop after S seconds of source time, 0.001 to 86400")
+      ->check(CLI::Range(0.001, 86400.0))
+      ->excludes(record->get_option("--frames"));
 
   CLI::App* info = app.add_subcommand("info", "describe a configured source or a recording");
   add_common_flags(*info, args);
@@ -56,9 +65,9 @@ int main(int argc, char** argv) {
 
   // CLI11 would only say "a subcommand is required" for a misspelt one; name it instead.
   const std::string first = argc > 1 ? argv[1] : "";
-  if (!first.empty() && first[0] != '-' && first != "run" && first != "info" && first != "bench" &&
+  if (!first.empty() && first[0] != '-' && first != "run" && first != "record" && first != "info" && first != "bench" &&
       first != "verify-filters") {
-    return hrcsense::app::report_error(std::string("unknown command '") + argv[1] + "'; expected run, info, bench or verify-filters",
+    return hrcsense::app::report_error(std::string("unknown command '") + argv[1] + "'; expected run, record, info, bench or verify-filters",
                                        hrcsense::app::kExitUsage);
   }
   try {
@@ -70,6 +79,7 @@ int main(int argc, char** argv) {
 
   try {
     if (run->parsed()) return hrcsense::app::run_command(args);
+    if (record->parsed()) return hrcsense::app::record_command(args);
     if (info->parsed()) return hrcsense::app::info_command(args);
     if (verify_filters->parsed()) return hrcsense::app::verify_filters_command(args);
     return hrcsense::app::bench_command(args);

@@ -65,6 +65,16 @@ int run_command(const CommandArgs& args) {
   std::unique_ptr<Source> source = make_source(config);
   std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config);
   const SourceInfo info = source->info();
+  // --record: the source's frames, as delivered, to a bag on a writer thread (never blocking).
+  std::optional<Recorder> recorder;
+  std::optional<RecordingSource> recording;
+  if (!args.record.empty()) {
+    RecorderParams params = recorder_params(config, args.record, info);
+    const RecordOnError on_error = params.on_error;
+    recorder.emplace(std::move(params));
+    recording.emplace(*source, *recorder, on_error);
+  }
+  Source& frames = recording ? static_cast<Source&>(*recording) : *source;
 
   Pipeline pipeline(config.pipeline);
   const bool background_loaded = load_background_file(config, info, pipeline);
@@ -96,10 +106,11 @@ int run_command(const CommandArgs& args) {
   options.max_frames = args.frames;
   options.stop_requested = &g_stop_requested;
   install_signal_handlers();
-  const RunSummary summary = run_pipeline(*source, *robot_states, pipeline, sinks, options, header);
+  const RunSummary summary = run_pipeline(frames, *robot_states, pipeline, sinks, options, header);
   restore_signal_handlers();
   if (g_stop_signal.load() != 0) spdlog::info("{} received: the run ended with a stop", signal_name(g_stop_signal.load()));
 
+  if (recorder) log_recording(recorder->close());
   if (!background_loaded) save_learnt_background(config, pipeline);
   const std::string out_name = args.out.empty() ? "stdout" : args.out;
   out.flush();

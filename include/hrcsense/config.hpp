@@ -54,6 +54,13 @@ struct RobotStateConfig {
   std::optional<RobotTrajectory> trajectory;
 };
 
+/// `record.*`: recordings made by `hrcsense record` and `hrcsense run --record` (docs/RECORDINGS.md).
+struct RecordConfig {
+  int64_t split_mb = 0;             ///< `record.split_mb`: > 0: a new file (NAME-000.bag, ...) past this many MiB; 0: one file
+  std::string on_error = "continue";  ///< `record.on_error`: continue (processing goes on unrecorded) or stop
+  int queue_frames = 16;            ///< `record.queue_frames`: frames waiting for the disk before drops
+};
+
 struct Config {
   std::string file;                ///< where it was read from ("" for defaults only)
   SourceConfig source;
@@ -71,6 +78,7 @@ struct Config {
   std::string robot_base_frame = "base"; ///< `robot.base_frame`: base or base_link (pipeline.robot.base_frame)
   RobotStateConfig robot_state;          ///< `robot.state.*` and `robot.joints_rad`
   int proximity_octree_height = 4;       ///< `proximity.octree.height` (1-10), for the octree backend
+  RecordConfig record;                   ///< `record.*`
   std::string canonical_yaml;      ///< the effective configuration, for the hash in the header
 };
 

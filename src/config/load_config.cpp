@@ -154,12 +154,21 @@ void read_robot_and_safety(KeyReader& r, Config& c) {
   }
 }
 
+void read_record(KeyReader& r, Config& c) {
+  // Up to 1 TiB per file; a bag's chunk positions are 64-bit, so only the file system limits it.
+  r.integer("record.split_mb", c.record.split_mb, 0, int64_t{1} << 20);
+  r.choice("record.on_error", c.record.on_error, {"continue", "stop"});
+  // Each queued 848x480 depth + colour frame holds about 2 MB: 1024 frames are 2 GB.
+  r.integer("record.queue_frames", c.record.queue_frames, 1, 1024);
+}
+
 // The table of every key: one typed read per key, in docs/CONFIG.md order.
 void read_all(KeyReader& r, Config& c) {
   read_source_and_sim(r, c);
   read_camera_and_filters(r, c);
   read_segmentation(r, c);
   read_robot_and_safety(r, c);
+  read_record(r, c);
 }
 
 // Every key the reader knows, found by reading an empty tree (all reads are unconditional).

@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense CLI — `hrcsense record`: the configured source's frames, as delivered (before any
+// filter), to a RealSense .bag (docs/RECORDINGS.md, "Recording").
+#include "commands.hpp"
+#include "common/app_errors.hpp"
+#include "common/assembly.hpp"
+
+#include "hrcsense/config.hpp"
+#include "hrcsense/recorder.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <filesystem>
+#include <optional>
+
+namespace hrcsense::app {
+namespace {
+
+std::atomic<bool> g_record_stop{false};
+
+extern "C" void on_record_stop(int signal) {
+  g_record_stop.store(true);
+  std::signal(signal, SIG_DFL);  // a second one kills
+}
+
+// How long push_wait gives the writer before a frame counts as dropped: a disk that stalls
+// this long is failing anyway.
+constexpr int kRecordWaitMs = 5000;
+
+}  // namespace
+
+RecorderParams recorder_params(const Config& config, const std::string& path, const SourceInfo& info) {
+  RecorderParams params;
+  params.path = path;
+  params.split_mb = config.record.split_mb;
+  params.on_error = config.record.on_error == "stop" ? RecordOnError::stop_run : RecordOnError::continue_run;
+  params.queue_frames = config.record.queue_frames;
+  params.bag.fps = static_cast<uint32_t>(std::lround(std::max(1.0, info.nominal_fps)));
+  params.bag.stereo_baseline_mm = info.stereo_baseline_mm;
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty()) std::filesystem::create_directories(parent);
+  return params;
+}
+
+void log_recording(const RecorderStats& stats) {
+  for (const std::string& file : stats.files) spdlog::info("recording file: {}", file);
+  spdlog::info("recording: {} frames written, {} dropped", stats.frames_recorded, stats.frames_dropped);
+  if (!stats.error.empty()) spdlog::error("recording: {}", stats.error);
+}
+
+int record_command(const CommandArgs& args) {
+  const Config config = load_config(args.config_path, args.sets);
+  std::unique_ptr<Source> source = make_source(config);
+  const SourceInfo info = source->info();
+  // The robot's joints at each frame go to /hrcsense/joint_states beside it.
+  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config);
+  Recorder recorder(recorder_params(config, args.out, info));
+
+  g_record_stop.store(false);
+  for (int signal : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal, on_record_stop);
+  Frame frame;
+  int64_t frames = 0;
+  int64_t first_ns = 0;
+  std::string source_error;
+  const auto duration_ns = static_cast<int64_t>(args.duration_s * 1e9);
+  while (!g_record_stop.load() && (args.frames < 0 || frames < args.frames) && !recorder.failed()) {
+    const Source::Status status = source->next(frame);
+    if (status == Source::Status::end) break;
+    if (status == Source::Status::error) {
+      source_error = source->error();
+      break;
+    }
+    if (frames == 0) first_ns = frame.timestamp_ns;
+    // --duration-s counts source time: the frame at first + S is the first one left out.
+    if (args.duration_s > 0.0 && frame.timestamp_ns - first_ns >= duration_ns) break;
+    // As run_pipeline looks it up: at the live source's host time, else at the source timestamp.
+    RobotState state;
+    std::optional<JointAngles> joints_rad;
+    const int64_t state_time_ns = frame.host_time_ns != 0 ? frame.host_time_ns : frame.timestamp_ns;
+    if (robot_states->state_at(state_time_ns, state) && state.valid) joints_rad = state.q_rad;
+    recorder.push_wait(frame, kRecordWaitMs, joints_rad);  // no processing to protect: wait rather than drop
+    ++frames;
+  }
+  for (int signal : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal, SIG_DFL);
+  const RecorderStats stats = recorder.close();
+  log_recording(stats);
+  if (!stats.error.empty()) return report_error("recording: " + stats.error, kExitRuntime);
+  if (!source_error.empty()) return report_error(source_error, kExitRuntime);
+  return 0;
+}
+
+}  // namespace hrcsense::app

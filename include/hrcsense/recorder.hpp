@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — recording frames to RealSense .bag files on a writer thread of their own: a
+// bounded queue between the caller and the file, so that a slow disk costs dropped recorded
+// frames (counted), never a late frame in processing.
+#pragma once
+
+#include "hrcsense/bag_writer.hpp"
+#include "hrcsense/source.hpp"
+#include "hrcsense/types.hpp"
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace hrcsense {
+
+/// `record.on_error`: after a write error, go on without recording (continue) or end the run (stop).
+enum class RecordOnError { continue_run, stop_run };
+
+struct RecorderParams {
+  std::string path;               ///< FILE.bag; with split_mb > 0 the files are FILE-000.bag, FILE-001.bag, ...
+  int64_t split_mb = 0;           ///< `record.split_mb`: start a new file past this many MiB; 0: one file
+  RecordOnError on_error = RecordOnError::stop_run;  ///< `record.on_error`
+  int queue_frames = 16;          ///< frames waiting for the writer before new ones are dropped
+  BagWriterParams bag;            ///< depth_units_option_m and stereo_baseline_mm come from the first frame
+};
+
+struct RecorderStats {
+  int64_t frames_recorded = 0;  ///< frames handed to the writer and written (into a chunk)
+  int64_t frames_dropped = 0;   ///< frames not recorded: queue full, or after a write error
+  std::vector<std::string> files;  ///< the files started, in order
+  std::string error;            ///< the first write error, naming the file; empty when none
+};
+
+/// The file of split number `part` (0-based) for `path`: "rec.bag" -> "rec-000.bag".
+std::string split_file_name(const std::string& path, int part);
+
+/// Records frames on a thread of its own. push() never waits for the disk.
+class Recorder {
+ public:
+  explicit Recorder(RecorderParams params);
+  ~Recorder();  ///< close()s; errors then only stay in stats()
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
+
+  /// Queues a copy of `frame` (and the robot's joints at it, when given) for the writer; false
+  /// when it was dropped (queue full, or recording ended by an error). Never blocks on the disk.
+  bool push(const Frame& frame, const std::optional<JointAngles>& joints_rad = std::nullopt);
+  /// As push(), but waits (at most `timeout_ms`) for room in the queue: for `hrcsense record`,
+  /// where the recorder is the only consumer and should lose nothing to a fast source.
+  bool push_wait(const Frame& frame, int timeout_ms, const std::optional<JointAngles>& joints_rad = std::nullopt);
+  /// True once a write error happened (stats().error says which file and why).
+  bool failed() const;
+  /// Writes what is queued, closes (and indexes) the last file, joins the thread. Idempotent.
+  RecorderStats close();
+  RecorderStats stats() const;
+
+ private:
+  struct Item {
+    Frame frame;
+    std::optional<JointAngles> joints_rad;
+  };
+  bool enqueue(const Frame& frame, const std::optional<JointAngles>& joints_rad, int timeout_ms);
+  void writer_loop();
+  void write_item(const Item& item);
+  void open_next_file(const Frame& first);
+
+  RecorderParams params_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_writer_, room_;
+  std::deque<Item> queue_;
+  std::vector<Item> spare_;  ///< written items whose buffers push() reuses (no allocation per frame)
+  bool closing_ = false;
+  bool writer_exited_ = false;  ///< the writer thread has left its loop: later items would stay queued
+  RecorderStats stats_;
+  std::unique_ptr<BagWriter> writer_;  ///< writer thread only
+  int part_ = 0;
+  std::thread thread_;
+};
+
+/// A Source that records every frame its inner source delivers (before any filter) and passes
+/// it on unchanged. With record.on_error stop, a write error ends the source with that error.
+class RecordingSource : public Source {
+ public:
+  RecordingSource(Source& inner, Recorder& recorder, RecordOnError on_error)
+      : inner_(inner), recorder_(recorder), on_error_(on_error) {}
+  SourceInfo info() const override { return inner_.info(); }
+  Status next(Frame& out) override;
+  std::string error() const override { return error_.empty() ? inner_.error() : error_; }
+
+ private:
+  Source& inner_;
+  Recorder& recorder_;
+  RecordOnError on_error_;
+  std::string error_;
+};
+
+}  // namespace hrcsense
