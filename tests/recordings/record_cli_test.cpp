@@ -37,34 +37,37 @@ std::unique_ptr<Source> cell_source(int frames, const std::vector<std::string>& 
   return make_source(load_config(cell_config(), sets));
 }
 
-// ---- `hrcsense record` killed with SIGKILL mid-recording.
-
-TEST(RecordCli, KilledWithSigkillTheFileIsReadableUpToItsLastCompleteChunk) {
-  ScratchDir dir("recorder");
-  const std::string path = dir / "killed.bag";
-  const std::vector<std::string> sets = {"sim.width=424", "sim.height=240", "sim.frames=100000"};
+// Starts `hrcsense record` of an endless 424x240 cell-ur5 into `path` as a child process
+// (stderr silenced) and returns once the file holds at least `bytes` or 60 s have passed.
+pid_t start_endless_recording(const std::string& path, uintmax_t bytes) {
   const pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
   if (pid == 0) {
     const int null = ::open("/dev/null", O_WRONLY);
     ::dup2(null, STDERR_FILENO);
-    std::vector<std::string> args = {HRCSENSE_CLI, "record", "--config", cell_config(), "--out", path};
-    for (const std::string& s : sets) {
-      args.push_back("--set");
-      args.push_back(s);
-    }
+    std::vector<std::string> args = {HRCSENSE_CLI, "record", "--config", cell_config(), "--out", path,
+                                     "--set", "sim.width=424", "--set", "sim.height=240", "--set", "sim.frames=100000"};
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
     ::execv(HRCSENSE_CLI, argv.data());
     ::_exit(127);
   }
-  // Kill it once it has written a few MB (bounded: 60 s).
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   std::error_code ec;
-  while (std::chrono::steady_clock::now() < deadline && (!fs::exists(path) || fs::file_size(path, ec) < (4U << 20))) {
+  while (pid > 0 && std::chrono::steady_clock::now() < deadline && (!fs::exists(path) || fs::file_size(path, ec) < bytes)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
+  return pid;
+}
+
+// ---- `hrcsense record` killed with SIGKILL mid-recording.
+
+TEST(RecordCli, KilledWithSigkillTheFileIsReadableUpToItsLastCompleteChunk) {
+  ScratchDir dir("recorder");
+  const std::string path = dir / "killed.bag";
+  // Kill it once it has written a few MB.
+  const pid_t pid = start_endless_recording(path, 4U << 20);
+  ASSERT_GE(pid, 0);
   ::kill(pid, SIGKILL);
   int status = 0;
   ::waitpid(pid, &status, 0);
@@ -102,24 +105,8 @@ TEST(RecordCli, KilledWithSigkillTheFileIsReadableUpToItsLastCompleteChunk) {
 TEST(RecordCli, SigintClosesAndIndexesTheRecording) {
   ScratchDir dir("recorder");
   const std::string path = dir / "stopped.bag";
-  const pid_t pid = ::fork();
+  const pid_t pid = start_endless_recording(path, 1U << 20);
   ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    const int null = ::open("/dev/null", O_WRONLY);
-    ::dup2(null, STDERR_FILENO);
-    std::vector<std::string> args = {HRCSENSE_CLI, "record", "--config", cell_config(), "--out", path,
-                                     "--set", "sim.width=424", "--set", "sim.height=240", "--set", "sim.frames=100000"};
-    std::vector<char*> argv;
-    for (std::string& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ::execv(HRCSENSE_CLI, argv.data());
-    ::_exit(127);
-  }
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  std::error_code ec;
-  while (std::chrono::steady_clock::now() < deadline && (!fs::exists(path) || fs::file_size(path, ec) < (1U << 20))) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
   ::kill(pid, SIGINT);
   int status = 0;
   for (int i = 0; i < 3000 && ::waitpid(pid, &status, WNOHANG) == 0; ++i) {  // 30 s at most
