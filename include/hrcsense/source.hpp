@@ -18,6 +18,11 @@ struct SourceInfo {
   float stereo_baseline_mm = 0.0F;  ///< 0 when unknown
   double nominal_fps = 30.0;    ///< for pacing when frames carry no usable timestamps
   int64_t frame_count = -1;     ///< -1 when unknown
+  /// A live camera's own name, serial number and firmware version (empty for other sources);
+  /// the JSON header reports them so a log names the device it came from.
+  std::string camera_name;
+  std::string camera_serial;
+  std::string camera_firmware;
 };
 
 /// A source of depth frames. One of the two virtual interfaces of hrcsense.
@@ -29,6 +34,10 @@ class Source {
   /// Reads the next frame into `out`, reusing its buffers. After `error`, error() says why.
   virtual Status next(Frame& out) = 0;
   virtual std::string error() const { return {}; }
+  /// Frames the camera produced that never reached next() (frame-number or timestamp gaps,
+  /// samples lost in transport): `frames_dropped_camera` in the summary, apart from the
+  /// pipeline's own `frames_dropped`. Read after the capture thread has finished.
+  virtual int64_t frames_dropped_camera() const { return 0; }
 };
 
 }  // namespace hrcsense

@@ -335,6 +335,7 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
   summary.frames_in = outcome.frames_in;
   summary.frames_processed = stats.processed;
   summary.frames_dropped = frames.dropped() + results.dropped();
+  summary.frames_dropped_camera = source.frames_dropped_camera();
   summary.timestamps = outcome.timestamps;
   summary.robot_state = robot_states.stats();
   summary.unknown_background_share = pipeline.unknown_background_share();

@@ -208,6 +208,11 @@ void JsonLinesSink::header(const RunHeader& header) {
   m.integer("frame_count", source.frame_count);
   m.number("nominal_fps", source.nominal_fps);
   m.number("stereo_baseline_mm", source.stereo_baseline_mm);
+  if (!source.camera_serial.empty() || !source.camera_name.empty()) {
+    m.text("name", source.camera_name);
+    m.text("serial", source.camera_serial);
+    m.text("firmware", source.camera_firmware);
+  }
   m.close();
 
   const Intrinsics& in = source.intrinsics;
@@ -314,6 +319,7 @@ void JsonLinesSink::summary(const RunSummary& summary) {
   m.integer("frames_in", summary.frames_in);
   m.integer("frames_processed", summary.frames_processed);
   m.integer("frames_dropped", summary.frames_dropped);
+  m.integer("frames_dropped_camera", summary.frames_dropped_camera);
   m.integer("frames_valid", summary.frames_valid);
   m.integer("verdict_run", summary.verdict_run);
   m.integer("verdict_slow", summary.verdict_slow);

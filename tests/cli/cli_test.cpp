@@ -167,6 +167,7 @@ TEST_F(Cli, RunWritesHeaderFramesAndSummaryWithTheBindingNames) {
   EXPECT_EQ(summary["frames_in"], 130);
   EXPECT_EQ(summary["frames_processed"], 130);
   EXPECT_EQ(summary["frames_dropped"], 0);  // unpaced: every frame is processed
+  EXPECT_EQ(summary["frames_dropped_camera"], 0);  // a simulator loses no frame on the way
 }
 
 // Frame i depends only on the configuration, the seed and i (docs/SIMULATOR.md), so two

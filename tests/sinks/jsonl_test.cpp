@@ -117,6 +117,22 @@ TEST(JsonLinesSink, HeaderCarriesVersionSourceAndIntrinsics) {
   EXPECT_EQ(i["coeffs"][0].get<float>(), 0.1F);
   EXPECT_EQ(i["coeffs"][1].get<float>(), -0.2F);
   EXPECT_EQ(i["coeffs"][4].get<float>(), 0.05F);
+  EXPECT_FALSE(h["source"].contains("serial"));  // not a camera: no device keys
+}
+
+TEST(JsonLinesSink, HeaderNamesTheLiveCamera) {
+  std::ostringstream out;
+  JsonLinesSink sink(out);
+  RunHeader header;
+  header.source.type = "realsense";
+  header.source.camera_name = "Intel RealSense D435";
+  header.source.camera_serial = "012345678901";
+  header.source.camera_firmware = "5.13.0.50";
+  sink.header(header);
+  const json h = json::parse(out.str());
+  EXPECT_EQ(h["source"]["name"], "Intel RealSense D435");
+  EXPECT_EQ(h["source"]["serial"], "012345678901");  // a string: serials keep their leading zero
+  EXPECT_EQ(h["source"]["firmware"], "5.13.0.50");
 }
 
 TEST(JsonLinesSink, FrameWithContactHasEveryField) {
@@ -188,6 +204,7 @@ TEST(JsonLinesSink, SummaryHasEveryRunSummaryField) {
   s.frames_in = 130;
   s.frames_processed = 129;
   s.frames_dropped = 1;
+  s.frames_dropped_camera = 4;
   s.frames_valid = 110;
   s.verdict_run = 100;
   s.verdict_slow = 9;
@@ -223,6 +240,7 @@ TEST(JsonLinesSink, SummaryHasEveryRunSummaryField) {
   EXPECT_EQ(j["frames_in"], 130);
   EXPECT_EQ(j["frames_processed"], 129);
   EXPECT_EQ(j["frames_dropped"], 1);
+  EXPECT_EQ(j["frames_dropped_camera"], 4);
   EXPECT_EQ(j["frames_valid"], 110);
   EXPECT_EQ(j["verdict_run"], 100);
   EXPECT_EQ(j["verdict_slow"], 9);
