@@ -8,6 +8,10 @@
 #include "hrcsense/rtde.hpp"
 #include "hrcsense/udp_json.hpp"
 
+#if HRCSENSE_HAVE_DDS
+#include "dds/ros2_camera_source.hpp"
+#endif
+
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -53,6 +57,37 @@ Simulator make_simulator(const Config& config) {
   return simulator;
 }
 
+namespace {
+
+// source.type ros2: realsense-ros topics over Cyclone DDS (docs/CAMERAS.md).
+std::unique_ptr<Source> make_ros2_source([[maybe_unused]] const Config& config,
+                                         [[maybe_unused]] const std::string& where) {
+#if HRCSENSE_HAVE_DDS
+  const Ros2SourceConfig& ros2 = config.source.ros2;
+  ros2::Ros2SourceParams params;
+  params.topics = ros2::realsense_topics(ros2.node_namespace);
+  if (!ros2.depth_topic.empty()) {
+    params.topics.depth_image = ros2.depth_topic;
+    params.topics.depth_info = ros2::camera_info_topic(ros2.depth_topic);
+  }
+  if (!ros2.color_topic.empty()) {
+    params.topics.color_image = ros2.color_topic;
+    params.topics.color_info = ros2::camera_info_topic(ros2.color_topic);
+  }
+  if (!ros2.extrinsics_topic.empty()) params.topics.extrinsics = ros2.extrinsics_topic;
+  params.color = ros2.color;
+  params.domain_id = static_cast<uint32_t>(ros2.domain_id);
+  params.startup_timeout_s = ros2.startup_timeout_s;
+  params.stereo_baseline_mm = config.source.stereo_baseline_mm;
+  return std::make_unique<ros2::Ros2CameraSource>(params);
+#else
+  throw ConfigError(where + ": source.type 'ros2': this hrcsense was built without Cyclone DDS; install "
+                    "cyclonedds-dev and cyclonedds-tools (scripts/setup does) and rebuild");
+#endif
+}
+
+}  // namespace
+
 std::unique_ptr<Source> make_source(const Config& config) {
   const std::string where = config.file.empty() ? std::string("configuration") : config.file;
   if (config.source.type == "sim") return std::make_unique<SimSource>(make_simulator(config));
@@ -64,6 +99,7 @@ std::unique_ptr<Source> make_source(const Config& config) {
     if (config.source.type == "folder") return std::make_unique<FolderSource>(params);
     return std::make_unique<BagSource>(params);
   }
+  if (config.source.type == "ros2") return make_ros2_source(config, where);
   // The configuration knows every type; the live adapters are optional targets.
   throw ConfigError(where + ": source.type '" + config.source.type + "': not built into this hrcsense");
 }

@@ -30,6 +30,8 @@ int record_command(const CommandArgs& args);
 RecorderParams recorder_params(const Config& config, const std::string& path, const SourceInfo& info);
 /// Logs the files written and the counters (and the error, naming the file) to stderr.
 void log_recording(const RecorderStats& stats);
+/// publish: the configured source as realsense-ros topics over Cyclone DDS (publish.*).
+int publish_command(const CommandArgs& args);
 int info_command(const CommandArgs& args);
 int bench_command(const CommandArgs& args);
 /// verify-filters CASES_JSON [--shared DIR]: one stdout line per case, last "N/M cases bit-exact".

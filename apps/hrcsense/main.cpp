@@ -51,6 +51,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.001, 86400.0))
       ->excludes(record->get_option("--frames"));
 
+  CLI::App* publish = app.add_subcommand(
+      "publish", "publish the configured source as a realsense-ros camera's ROS 2 topics (docs/CAMERAS.md)");
+  add_common_flags(*publish, args);
+
   CLI::App* info = app.add_subcommand("info", "describe a configured source or a recording");
   add_common_flags(*info, args);
   info->add_option("path", args.input, "a recording: a RealSense .bag file or a folder of depth PNGs");
@@ -65,9 +69,9 @@ int main(int argc, char** argv) {
 
   // CLI11 would only say "a subcommand is required" for a misspelt one; name it instead.
   const std::string first = argc > 1 ? argv[1] : "";
-  if (!first.empty() && first[0] != '-' && first != "run" && first != "record" && first != "info" && first != "bench" &&
+  if (!first.empty() && first[0] != '-' && first != "run" && first != "record" && first != "publish" && first != "info" && first != "bench" &&
       first != "verify-filters") {
-    return hrcsense::app::report_error(std::string("unknown command '") + argv[1] + "'; expected run, record, info, bench or verify-filters",
+    return hrcsense::app::report_error(std::string("unknown command '") + argv[1] + "'; expected run, record, publish, info, bench or verify-filters",
                                        hrcsense::app::kExitUsage);
   }
   try {
@@ -80,6 +84,7 @@ int main(int argc, char** argv) {
   try {
     if (run->parsed()) return hrcsense::app::run_command(args);
     if (record->parsed()) return hrcsense::app::record_command(args);
+    if (publish->parsed()) return hrcsense::app::publish_command(args);
     if (info->parsed()) return hrcsense::app::info_command(args);
     if (verify_filters->parsed()) return hrcsense::app::verify_filters_command(args);
     return hrcsense::app::bench_command(args);

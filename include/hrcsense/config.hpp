@@ -22,13 +22,36 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// `source.ros2.*`: realsense-ros 4.x camera topics read over Cyclone DDS (docs/CAMERAS.md).
+/// A topic left empty follows the namespace: `<namespace>/depth/image_rect_raw`,
+/// `<namespace>/color/image_raw`, `<namespace>/extrinsics/depth_to_color`; each image's
+/// CameraInfo is its sibling `camera_info`.
+struct Ros2SourceConfig {
+  std::string node_namespace = "/camera/camera";  ///< `source.ros2.namespace`: the camera node
+  std::string depth_topic;          ///< `source.ros2.depth_topic`
+  std::string color_topic;          ///< `source.ros2.color_topic`
+  std::string extrinsics_topic;     ///< `source.ros2.extrinsics_topic`
+  bool color = true;                ///< `source.ros2.color`: pair colour images with depth when they come
+  int domain_id = 0;                ///< `source.ros2.domain_id`: the DDS domain (ROS_DOMAIN_ID)
+  double startup_timeout_s = 10.0;  ///< `source.ros2.startup_timeout_s`: wait for the first depth CameraInfo
+};
+
+/// `publish.*`: `hrcsense publish`, a configured source as realsense-ros topics.
+struct PublishConfig {
+  std::string node_namespace = "/camera/camera";  ///< `publish.namespace`
+  int domain_id = 0;                ///< `publish.domain_id`
+  int wait_for_subscribers = 0;     ///< `publish.wait_for_subscribers`: start once this many depth readers matched
+  double wait_timeout_s = 30.0;     ///< `publish.wait_timeout_s`: how long to wait for them
+};
+
 struct SourceConfig {
-  std::string type = "sim";        ///< sim (default), folder, bag, realsense
+  std::string type = "sim";        ///< sim (default), folder, bag, realsense, ros2
   std::string path;                ///< file or folder for recorded sources
   bool pace = false;               ///< play at the recorded / nominal rate
   bool loop = false;               ///< start over at the end
   uint64_t seed = 1;               ///< simulator noise seed
   float stereo_baseline_mm = 0.0F; ///< for sources that do not carry one
+  Ros2SourceConfig ros2;           ///< `source.ros2.*`
 };
 
 /// Where the robot's joint state comes from (`robot.state.*`, docs/ROBOT.md).
@@ -79,6 +102,7 @@ struct Config {
   RobotStateConfig robot_state;          ///< `robot.state.*` and `robot.joints_rad`
   int proximity_octree_height = 4;       ///< `proximity.octree.height` (1-10), for the octree backend
   RecordConfig record;                   ///< `record.*`
+  PublishConfig publish;                 ///< `publish.*`
   std::string canonical_yaml;      ///< the effective configuration, for the hash in the header
 };
 

@@ -28,10 +28,14 @@ struct SourceInfo {
 /// A source of depth frames. One of the two virtual interfaces of hrcsense.
 class Source {
  public:
-  enum class Status { frame, end, error };
+  /// `idle`: a live source had no frame within its own short wait (a silent camera); the run
+  /// checks for a stop request and asks again, and its watchdog reports the silence.
+  enum class Status { frame, end, error, idle };
   virtual ~Source() = default;
   virtual SourceInfo info() const = 0;
   /// Reads the next frame into `out`, reusing its buffers. After `error`, error() says why.
+  /// A live source waits a bounded time (well below a second) and returns `idle` rather than
+  /// blocking for ever, so that a stop request ends the run.
   virtual Status next(Frame& out) = 0;
   virtual std::string error() const { return {}; }
   /// Frames the camera produced that never reached next() (frame-number or timestamp gaps,

@@ -50,7 +50,7 @@ Pose pose_from_rpy(const Eigen::Vector3f& translation_m, const Eigen::Vector3f& 
 }
 
 void read_source_and_sim(KeyReader& r, Config& c) {
-  r.choice("source.type", c.source.type, {"sim", "folder", "bag", "realsense"});
+  r.choice("source.type", c.source.type, {"sim", "folder", "bag", "realsense", "ros2"});
   r.text("source.path", c.source.path);
   r.flag("source.pace", c.source.pace);
   r.flag("source.loop", c.source.loop);
@@ -154,6 +154,38 @@ void read_robot_and_safety(KeyReader& r, Config& c) {
   }
 }
 
+// A ROS 2 name: absolute, '/'-separated tokens of letters, digits and '_' (ROS 2's rules,
+// which DDS topic names "rt/..." inherit); "" is allowed where `empty_ok` (derived later).
+void ros2_name(KeyReader& r, const std::string& key, std::string& value, bool empty_ok) {
+  r.text(key, value);
+  if (value.empty() && empty_ok) return;
+  bool ok = value.size() >= 2 && value.front() == '/' && value.back() != '/';
+  for (size_t i = 0; ok && i < value.size(); ++i) {
+    const char ch = value[i];
+    const bool token_char = std::isalnum(static_cast<unsigned char>(ch)) != 0 || ch == '_';
+    ok = token_char || (ch == '/' && i + 1 < value.size() && value[i + 1] != '/');
+  }
+  if (!ok) r.fail(key, "expected an absolute ROS 2 name like /camera/camera (letters, digits, '_' between '/'), got '" + value + "'");
+}
+
+void read_ros2(KeyReader& r, Config& c) {
+  Ros2SourceConfig& ros2 = c.source.ros2;
+  ros2_name(r, "source.ros2.namespace", ros2.node_namespace, false);
+  ros2_name(r, "source.ros2.depth_topic", ros2.depth_topic, true);
+  ros2_name(r, "source.ros2.color_topic", ros2.color_topic, true);
+  ros2_name(r, "source.ros2.extrinsics_topic", ros2.extrinsics_topic, true);
+  r.flag("source.ros2.color", ros2.color);
+  // DDS maps domain ids 0-232 to UDP ports (ROS 2 allows 0-101 on Linux, 0-232 in general).
+  r.integer("source.ros2.domain_id", ros2.domain_id, 0, 232);
+  r.number_in("source.ros2.startup_timeout_s", ros2.startup_timeout_s, 0.1, 3600.0, " s");
+
+  PublishConfig& publish = c.publish;
+  ros2_name(r, "publish.namespace", publish.node_namespace, false);
+  r.integer("publish.domain_id", publish.domain_id, 0, 232);
+  r.integer("publish.wait_for_subscribers", publish.wait_for_subscribers, 0, 100);
+  r.number_in("publish.wait_timeout_s", publish.wait_timeout_s, 0.1, 3600.0, " s");
+}
+
 void read_record(KeyReader& r, Config& c) {
   // Up to 1 TiB per file; a bag's chunk positions are 64-bit, so only the file system limits it.
   r.integer("record.split_mb", c.record.split_mb, 0, int64_t{1} << 20);
@@ -169,6 +201,7 @@ void read_all(KeyReader& r, Config& c) {
   read_segmentation(r, c);
   read_robot_and_safety(r, c);
   read_record(r, c);
+  read_ros2(r, c);
 }
 
 // Every key the reader knows, found by reading an empty tree (all reads are unconditional).

@@ -135,6 +135,10 @@ void capture_loop(Source& source, const RunOptions& options, RunClock& clock, do
       error = e.what();
     }
     if (status == Source::Status::end) break;  // the defaults say "source ended"
+    if (status == Source::Status::idle) {  // no frame yet: the output loop's watchdog stops the cell
+      --n;
+      continue;
+    }
     if (status == Source::Status::error) {
       outcome.end_code = ReasonCode::source_error;
       outcome.error = "source error: " + (error.empty() ? std::string("unknown") : error);

@@ -337,5 +337,70 @@ TEST(RunPipeline, StopRequestEndsTheRun) {
   EXPECT_EQ(sink.results.back().verdict.state, VerdictState::stop);
 }
 
+// A live source that has nothing yet says `idle`: the run asks again, counts only frames, and
+// still ends on a stop request while the camera is silent.
+class IdleBetweenFrames : public Source {
+ public:
+  IdleBetweenFrames(FakeSource& frames, int idles_per_frame) : frames_(frames), idles_per_frame_(idles_per_frame) {}
+  SourceInfo info() const override { return frames_.info(); }
+  Status next(Frame& out) override {
+    ++calls;
+    if (idles_++ < idles_per_frame_) return Status::idle;
+    idles_ = 0;
+    return frames_.next(out);
+  }
+  int calls = 0;
+
+ private:
+  FakeSource& frames_;
+  int idles_per_frame_;
+  int idles_ = 0;
+};
+
+TEST(RunPipeline, IdleSourceIsAskedAgainAndIdleCallsAreNoFrames) {
+  FakeSource frames(after_learning({{1.5F}, {1.5F}, {1.5F}}));
+  IdleBetweenFrames source(frames, 2);
+  CollectingSink sink;
+  RunOptions options;
+  options.max_frames = 5;
+  const RunSummary summary = test::run_fake(source, sink, fake_params(), options);
+  EXPECT_EQ(summary.frames_in, 5);  // the limit counts frames, not calls
+  EXPECT_EQ(source.calls, 15);      // 2 idle calls before each of the 5 frames
+  EXPECT_EQ(summary.end_code, ReasonCode::frame_limit_reached);
+  EXPECT_EQ(sink.frame_results().size(), 5U);
+}
+
+class AlwaysIdle : public Source {
+ public:
+  explicit AlwaysIdle(std::atomic<bool>& stop) : stop_(stop) {}
+  SourceInfo info() const override {
+    SourceInfo info;
+    info.intrinsics = test::fake_intrinsics();
+    return info;
+  }
+  Status next(Frame&) override {
+    if (++calls == 3) stop_.store(true);  // as SIGINT would, while the camera is silent
+    return Status::idle;
+  }
+  int calls = 0;
+
+ private:
+  std::atomic<bool>& stop_;
+};
+
+TEST(RunPipeline, StopRequestEndsARunWhoseSourceIsSilent) {
+  std::atomic<bool> stop{false};
+  AlwaysIdle source(stop);
+  CollectingSink sink;
+  RunOptions options;
+  options.stop_requested = &stop;
+  const RunSummary summary = test::run_fake(source, sink, fake_params(), options);
+  EXPECT_EQ(source.calls, 3);
+  EXPECT_EQ(summary.frames_in, 0);
+  EXPECT_EQ(summary.end_code, ReasonCode::stop_requested);
+  ASSERT_FALSE(sink.results.empty());
+  EXPECT_EQ(sink.results.back().verdict.state, VerdictState::stop);
+}
+
 }  // namespace
 }  // namespace hrcsense

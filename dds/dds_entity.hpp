@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense dds — small helpers over Cyclone DDS's C API: an owning entity handle, QoS as a
+// value, and return codes as exceptions naming what failed.
+#pragma once
+
+#include "dds/ros2_messages.hpp"
+
+#include <dds/dds.h>
+
+#include <string>
+#include <utility>
+
+namespace hrcsense::ros2 {
+
+/// Throws Ros2Error "`what`: <Cyclone's text>" when `ret` is a DDS error; returns it otherwise.
+inline dds_return_t check_dds(dds_return_t ret, const std::string& what) {
+  if (ret < 0) throw Ros2Error(what + ": " + dds_strretcode(ret));
+  return ret;
+}
+
+/// Owns one DDS entity (a participant owns its topics, readers, writers, waitsets).
+class DdsEntity {
+ public:
+  DdsEntity() = default;
+  explicit DdsEntity(dds_entity_t entity) : entity_(entity) {}
+  DdsEntity(const DdsEntity&) = delete;
+  DdsEntity& operator=(const DdsEntity&) = delete;
+  DdsEntity(DdsEntity&& other) noexcept : entity_(std::exchange(other.entity_, 0)) {}
+  DdsEntity& operator=(DdsEntity&& other) noexcept {
+    std::swap(entity_, other.entity_);
+    return *this;
+  }
+  ~DdsEntity() {
+    if (entity_ > 0) dds_delete(entity_);
+  }
+  dds_entity_t get() const { return entity_; }
+
+ private:
+  dds_entity_t entity_ = 0;
+};
+
+/// The QoS a ROS 2 endpoint is given here (../shared/specs/ros2-interop.md, "QoS").
+struct EndpointQos {
+  bool reliable = false;
+  bool transient_local = false;
+  int32_t depth = 1;  ///< keep-last depth
+};
+
+/// A dds_qos_t for `qos`, deleted with the returned holder.
+class QosHandle {
+ public:
+  explicit QosHandle(const EndpointQos& qos) : qos_(dds_create_qos()) {
+    dds_qset_reliability(qos_, qos.reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT, DDS_MSECS(100));
+    dds_qset_durability(qos_, qos.transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
+    dds_qset_history(qos_, DDS_HISTORY_KEEP_LAST, qos.depth);
+  }
+  QosHandle(const QosHandle&) = delete;
+  QosHandle& operator=(const QosHandle&) = delete;
+  ~QosHandle() { dds_delete_qos(qos_); }
+  const dds_qos_t* get() const { return qos_; }
+
+ private:
+  dds_qos_t* qos_;
+};
+
+}  // namespace hrcsense::ros2

@@ -1,0 +1,289 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense dds — the ROS 2 camera source (ros2_camera_source.hpp).
+#include "dds/ros2_camera_source.hpp"
+
+#include "dds/dds_entity.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdlib>
+
+namespace hrcsense::ros2 {
+namespace {
+
+int64_t wall_now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+int64_t monotonic_now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// Samples taken per call: the newest is used, older ones were overtaken (a slow pipeline).
+constexpr uint32_t kMaxTake = 4;
+// Colour images kept for pairing, and how long a depth image waits for its colour.
+constexpr size_t kColorsKept = 4;
+constexpr int64_t kColorWaitNs = 20'000'000;
+// Stamps within this of each other pair a colour image with a depth image, when the rate is
+// not known yet (half a period at 30 frames/s).
+constexpr int64_t kDefaultPairingNs = 16'000'000;
+
+// Loaned samples of one take, returned to the reader when this goes out of scope.
+template <typename T>
+class Taken {
+ public:
+  explicit Taken(dds_entity_t reader) : reader_(reader) {
+    count_ = dds_take(reader_, samples_.data(), infos_.data(), kMaxTake, kMaxTake);
+    if (count_ < 0) count_ = 0;  // a reader that failed reads as empty; the next call tries again
+  }
+  Taken(const Taken&) = delete;
+  Taken& operator=(const Taken&) = delete;
+  ~Taken() {
+    if (count_ > 0) dds_return_loan(reader_, samples_.data(), count_);
+  }
+  int32_t size() const { return count_; }
+  bool valid(int32_t i) const { return infos_[static_cast<size_t>(i)].valid_data; }
+  const T& operator[](int32_t i) const { return *static_cast<const T*>(samples_[static_cast<size_t>(i)]); }
+
+ private:
+  dds_entity_t reader_;
+  std::array<void*, kMaxTake> samples_{};
+  std::array<dds_sample_info_t, kMaxTake> infos_{};
+  int32_t count_ = 0;
+};
+
+}  // namespace
+
+// The participant owns everything else; readers and waitsets are plain handles into it.
+struct Ros2CameraSource::Dds {
+  DdsEntity participant;
+  dds_entity_t depth_reader = 0, depth_info_reader = 0, color_reader = 0, color_info_reader = 0;
+  dds_entity_t extrinsics_reader = 0;
+  dds_entity_t depth_waitset = 0, color_waitset = 0, info_waitset = 0;
+
+  dds_entity_t reader(const dds_topic_descriptor_t& type, const std::string& ros_topic, const EndpointQos& qos) {
+    const std::string name = dds_topic_name(ros_topic);
+    const dds_entity_t topic = check_dds(dds_create_topic(participant.get(), &type, name.c_str(), nullptr, nullptr),
+                                         "DDS topic " + name);
+    const QosHandle handle(qos);
+    return check_dds(dds_create_reader(participant.get(), topic, handle.get(), nullptr), "DDS reader on " + name);
+  }
+
+  dds_entity_t waitset_on(dds_entity_t reader) {
+    const dds_entity_t waitset = check_dds(dds_create_waitset(participant.get()), "DDS waitset");
+    const dds_entity_t condition = check_dds(dds_create_readcondition(reader, DDS_ANY_STATE), "DDS read condition");
+    check_dds(dds_waitset_attach(waitset, condition, condition), "DDS waitset attach");
+    return waitset;
+  }
+};
+
+Ros2CameraSource::Ros2CameraSource(Ros2SourceParams params) : params_(std::move(params)), dds_(std::make_unique<Dds>()) {
+  const CameraTopics& topics = params_.topics;
+  const std::string domain = "domain " + std::to_string(params_.domain_id);
+  // Cyclone reads its own configuration (CYCLONEDDS_URI) here; hrcsense never overrides it.
+  dds_->participant = DdsEntity(check_dds(dds_create_participant(params_.domain_id, nullptr, nullptr),
+                                          "DDS participant on " + domain));
+  const EndpointQos images{false, false, static_cast<int32_t>(kMaxTake)};
+  const EndpointQos infos{false, false, 1};
+  dds_->depth_reader = dds_->reader(sensor_msgs_msg_dds__Image__desc, topics.depth_image, images);
+  dds_->depth_info_reader = dds_->reader(sensor_msgs_msg_dds__CameraInfo__desc, topics.depth_info, infos);
+  if (params_.color) {
+    dds_->color_reader = dds_->reader(sensor_msgs_msg_dds__Image__desc, topics.color_image, images);
+    dds_->color_info_reader = dds_->reader(sensor_msgs_msg_dds__CameraInfo__desc, topics.color_info, infos);
+    dds_->extrinsics_reader =
+        dds_->reader(realsense2_camera_msgs_msg_dds__Extrinsics__desc, topics.extrinsics, EndpointQos{true, true, 1});
+    dds_->color_waitset = dds_->waitset_on(dds_->color_reader);
+  }
+  dds_->depth_waitset = dds_->waitset_on(dds_->depth_reader);
+  dds_->info_waitset = dds_->waitset_on(dds_->depth_info_reader);
+
+  // The first depth CameraInfo gives the intrinsics the run starts with; a second one, when it
+  // comes soon, gives the rate (realsense-ros publishes one per image).
+  const auto timeout = static_cast<dds_duration_t>(params_.startup_timeout_s * 1e9);
+  const dds_time_t deadline = dds_time() + timeout;
+  std::vector<int64_t> stamps;
+  while (stamps.size() < 2) {
+    const dds_time_t wait_until = stamps.empty() ? deadline : std::min<dds_time_t>(deadline, dds_time() + DDS_MSECS(500));
+    if (dds_waitset_wait_until(dds_->info_waitset, nullptr, 0, wait_until) <= 0) break;
+    Taken<sensor_msgs_msg_dds__CameraInfo_> taken(dds_->depth_info_reader);
+    for (int32_t i = 0; i < taken.size(); ++i) {
+      if (!taken.valid(i)) continue;
+      depth_intrinsics_ = intrinsics_from_camera_info(taken[i], topics.depth_info);  // Ros2Error: unusable
+      stamps.push_back(stamp_ns(taken[i].header.stamp));
+    }
+  }
+  if (stamps.empty()) {
+    throw Ros2Error("no CameraInfo on " + topics.depth_info + " (DDS " + dds_topic_name(topics.depth_info) + ", " +
+                    domain + ") within " + std::to_string(params_.startup_timeout_s) +
+                    " s (source.ros2.startup_timeout_s): is the camera node running, in this domain "
+                    "(ROS_DOMAIN_ID), reachable under CYCLONEDDS_URI's network settings?");
+  }
+  info_.type = "ros2";
+  info_.description = "ROS 2 " + topics.depth_image + " (" + domain + ")";
+  info_.intrinsics = depth_intrinsics_;
+  info_.stereo_baseline_mm = params_.stereo_baseline_mm;
+  info_.frame_count = -1;
+  const int64_t step_ns = stamps.size() >= 2 ? stamps.back() - stamps.front() : 0;
+  // A rate between 1 and 1000 frames/s is believed; else the D435's default 30.
+  info_.nominal_fps = step_ns >= 1'000'000 && step_ns <= 1'000'000'000 ? 1e9 / static_cast<double>(step_ns) : 30.0;
+}
+
+Ros2CameraSource::~Ros2CameraSource() = default;
+
+SourceInfo Ros2CameraSource::info() const { return info_; }
+
+int64_t Ros2CameraSource::frames_dropped_camera() const {
+  return frames_missed_.load() + rejected_.load() + overtaken_.load();
+}
+
+void Ros2CameraSource::reject(const std::string& topic, int64_t stamp_ns, const std::string& why) {
+  const int64_t count = ++rejected_;
+  // The first few, then one in a hundred: a camera configured wrongly would flood the log.
+  if (count <= 3 || count % 100 == 0) {
+    spdlog::warn("{}: message stamped {} ns rejected: {} ({} rejected so far)", topic, stamp_ns, why, count);
+  }
+}
+
+void Ros2CameraSource::take_infos() {
+  {
+    Taken<sensor_msgs_msg_dds__CameraInfo_> taken(dds_->depth_info_reader);
+    for (int32_t i = 0; i < taken.size(); ++i) {
+      if (!taken.valid(i)) continue;
+      try {
+        const Intrinsics intrinsics = intrinsics_from_camera_info(taken[i], params_.topics.depth_info);
+        // The image size is fixed for the run (the background, the filters); a new calibration
+        // of the same size is taken.
+        if (intrinsics.width == depth_intrinsics_.width && intrinsics.height == depth_intrinsics_.height) {
+          depth_intrinsics_ = intrinsics;
+        }
+      } catch (const Ros2Error& e) {
+        reject(params_.topics.depth_info, stamp_ns(taken[i].header.stamp), e.what());
+      }
+    }
+  }
+  if (!params_.color) return;
+  {
+    Taken<sensor_msgs_msg_dds__CameraInfo_> taken(dds_->color_info_reader);
+    for (int32_t i = 0; i < taken.size(); ++i) {
+      if (!taken.valid(i)) continue;
+      try {
+        color_intrinsics_ = intrinsics_from_camera_info(taken[i], params_.topics.color_info);
+      } catch (const Ros2Error& e) {
+        reject(params_.topics.color_info, stamp_ns(taken[i].header.stamp), e.what());
+      }
+    }
+  }
+  Taken<realsense2_camera_msgs_msg_dds__Extrinsics_> taken(dds_->extrinsics_reader);
+  for (int32_t i = 0; i < taken.size(); ++i) {
+    if (taken.valid(i)) depth_to_color_ = extrinsics_from_msg(taken[i]);
+  }
+}
+
+void Ros2CameraSource::take_colors() {
+  Taken<sensor_msgs_msg_dds__Image_> taken(dds_->color_reader);
+  for (int32_t i = 0; i < taken.size(); ++i) {
+    if (!taken.valid(i)) continue;
+    const sensor_msgs_msg_dds__Image_& image = taken[i];
+    const int64_t stamp = stamp_ns(image.header.stamp);
+    const std::string problem = color_image_problem(image);
+    if (!problem.empty()) {
+      reject(params_.topics.color_image, stamp, problem);
+      continue;
+    }
+    last_color_wall_ns_ = wall_now_ns();
+    TimedColor slot;
+    if (colors_.size() >= kColorsKept) {  // reuse the oldest buffer
+      slot = std::move(colors_.front());
+      colors_.pop_front();
+    }
+    slot.stamp_ns = stamp;
+    copy_color_image(image, slot.image);
+    colors_.push_back(std::move(slot));
+  }
+}
+
+bool Ros2CameraSource::attach_color(int64_t depth_stamp_ns, Frame& out) {
+  const int64_t tolerance_ns = gaps_.period_ns > 0 ? gaps_.period_ns / 2 : kDefaultPairingNs;
+  auto find = [&] {
+    return std::find_if(colors_.begin(), colors_.end(), [&](const TimedColor& color) {
+      return std::llabs(color.stamp_ns - depth_stamp_ns) <= tolerance_ns;
+    });
+  };
+  take_colors();
+  auto match = find();
+  // Colour that streams but has not come yet for this image: wait a little for it.
+  if (match == colors_.end() && last_color_wall_ns_ != 0 && wall_now_ns() - last_color_wall_ns_ < 1'000'000'000) {
+    if (dds_waitset_wait(dds_->color_waitset, nullptr, 0, kColorWaitNs) > 0) take_colors();
+    match = find();
+  }
+  if (match == colors_.end() || !color_intrinsics_ || color_intrinsics_->width != match->image.width ||
+      color_intrinsics_->height != match->image.height) {
+    return false;
+  }
+  out.color = match->image;
+  out.color_intrinsics = *color_intrinsics_;
+  out.depth_to_color = depth_to_color_;
+  return true;
+}
+
+Source::Status Ros2CameraSource::next(Frame& out) {
+  const dds_time_t deadline = dds_time() + params_.idle_after_ns;
+  for (;;) {
+    take_infos();
+    bool got = false;
+    int64_t stamp = 0;
+    {
+      Taken<sensor_msgs_msg_dds__Image_> taken(dds_->depth_reader);
+      int32_t newest = -1;
+      int32_t good = 0;
+      for (int32_t i = 0; i < taken.size(); ++i) {
+        if (!taken.valid(i)) continue;
+        const int64_t sample_stamp = stamp_ns(taken[i].header.stamp);
+        const int64_t outages_before = gaps_.outages;
+        const int64_t previous_stamp = gaps_.previous_ns;
+        gaps_.add(sample_stamp);
+        if (gaps_.outages != outages_before) {
+          spdlog::warn("{}: images again after {:.3f} s of silence", params_.topics.depth_image,
+                       static_cast<double>(sample_stamp - previous_stamp) * 1e-9);
+        }
+        const std::string problem = depth_image_problem(taken[i], depth_intrinsics_.width, depth_intrinsics_.height);
+        if (!problem.empty()) {
+          reject(params_.topics.depth_image, sample_stamp, problem);
+          continue;
+        }
+        newest = i;
+        ++good;
+      }
+      frames_missed_.store(gaps_.frames_missed);
+      outages_.store(gaps_.outages);
+      if (newest >= 0) {
+        overtaken_ += good - 1;
+        copy_depth_image(taken[newest], out.depth);
+        stamp = stamp_ns(taken[newest].header.stamp);
+        got = true;
+      }
+    }
+    if (got) {
+      out.index = delivered_++;
+      out.timestamp_ns = stamp;
+      out.host_time_ns = host_time_of_stamp(stamp, wall_now_ns(), monotonic_now_ns());
+      out.intrinsics = depth_intrinsics_;
+      out.stereo_baseline_mm = params_.stereo_baseline_mm;
+      out.truth.reset();
+      out.color.reset();
+      out.color_intrinsics = Intrinsics{};
+      out.depth_to_color.reset();
+      if (params_.color) attach_color(stamp, out);
+      return Status::frame;
+    }
+    if (dds_time() >= deadline) return Status::idle;
+    dds_waitset_wait_until(dds_->depth_waitset, nullptr, 0, deadline);
+  }
+}
+
+}  // namespace hrcsense::ros2
