@@ -88,7 +88,7 @@ std::unique_ptr<Source> make_ros2_source([[maybe_unused]] const Config& config,
 
 }  // namespace
 
-std::unique_ptr<Source> make_source(const Config& config) {
+std::unique_ptr<Source> make_source(const Config& config, bool with_color) {
   const std::string where = config.file.empty() ? std::string("configuration") : config.file;
   if (config.source.type == "sim") return std::make_unique<SimSource>(make_simulator(config));
   if (config.source.type == "folder" || config.source.type == "bag") {
@@ -96,6 +96,7 @@ std::unique_ptr<Source> make_source(const Config& config) {
       throw ConfigError(where + ": source.path: required for source.type " + config.source.type);
     }
     RecordingParams params{config.source.path, config.source.loop, config.source.stereo_baseline_mm};
+    params.with_color = with_color;
     if (config.source.type == "folder") return std::make_unique<FolderSource>(params);
     return std::make_unique<BagSource>(params);
   }

@@ -27,8 +27,9 @@ std::optional<SceneObject> robot_scene_object(const Config& config);
 Simulator make_simulator(const Config& config);
 
 /// The source the configuration names (source.type); throws ConfigError for a type this
-/// build does not have (naming it) or a recorded source without source.path.
-std::unique_ptr<Source> make_source(const Config& config);
+/// build does not have (naming it) or a recorded source without source.path. `with_color`:
+/// recorded sources decode their colour frames too (the pipeline does not need them).
+std::unique_ptr<Source> make_source(const Config& config, bool with_color = false);
 
 /// The robot state source (robot.state.source): fixed; sim (SimRobotState on the trajectory,
 /// with robot.state.sim_latency_s / sim_jitter_s, seeded by source.seed); rtde; udp_json.

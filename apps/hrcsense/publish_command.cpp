@@ -51,7 +51,7 @@ void sleep_until_or_stop(std::chrono::steady_clock::time_point due) {
 
 int publish_command(const CommandArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
-  std::unique_ptr<Source> source = make_source(config);
+  std::unique_ptr<Source> source = make_source(config, /*with_color=*/true);
   const SourceInfo info = source->info();
   ros2::Ros2PublisherParams params;
   params.node_namespace = config.publish.node_namespace;
