@@ -18,6 +18,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
@@ -38,9 +39,10 @@ Ros2SourceParams source_params(const std::string& node_namespace, double startup
   return params;
 }
 
-// Frames of a small simulated scene with colour (deterministic: the same config, the same frames).
+// Frames of the demo's walking person at 424x240 with colour (deterministic: the same
+// config, the same frames).
 std::vector<Frame> simulated_frames(int count) {
-  const Config config = load_config("", {"sim.width=424", "sim.height=240", "sim.color=true",
+  const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/walk.yaml", {"sim.width=424", "sim.height=240", "sim.color=true",
                                          "sim.frames=" + std::to_string(count)});
   std::unique_ptr<Source> sim = make_source(config);
   std::vector<Frame> frames;
@@ -100,6 +102,10 @@ TEST(Ros2Source, SimulatorFramesArriveAsPublished) {
   const std::vector<Frame> published = simulated_frames(12);
   ASSERT_EQ(published.size(), 12U);
   ASSERT_TRUE(published[0].color.has_value()) << "the simulated scene has colour";
+  ASSERT_GT(std::count_if(published[0].depth.pixels.begin(), published[0].depth.pixels.end(),
+                          [](uint16_t raw) { return raw != 0; }),
+            10000)
+      << "the scene is in view";
   std::map<int64_t, const Frame*> by_stamp;
   for (const Frame& frame : published) by_stamp[frame.timestamp_ns] = &frame;
 

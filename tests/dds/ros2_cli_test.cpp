@@ -1,0 +1,141 @@
+// SPDX-License-Identifier: Apache-2.0
+// `hrcsense run` with source.type ros2 fed by `hrcsense publish`, both child processes on
+// loopback: the cell stops (no_frame) while the camera is silent and carries on by itself
+// when a publisher is back. Every wait is bounded; a child still running at the end is killed.
+#include "dds_test_util.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace hrcsense {
+namespace {
+
+using nlohmann::json;
+using namespace std::chrono_literals;
+
+pid_t spawn(std::vector<std::string> args) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, STDERR_FILENO);
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(HRCSENSE_CLI, argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+// The exit status, or -1 after killing a child that did not end within `timeout`.
+int wait_exit(pid_t pid, std::chrono::seconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  int status = 0;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (::waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::this_thread::sleep_for(20ms);
+  }
+  ::kill(pid, SIGKILL);
+  ::waitpid(pid, &status, 0);
+  return -1;
+}
+
+std::vector<json> read_lines(const std::string& path) {
+  std::vector<json> lines;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\n') line.pop_back();
+    try {
+      lines.push_back(json::parse(line));
+    } catch (const json::exception&) {
+      break;  // a line being written
+    }
+  }
+  return lines;
+}
+
+bool has_watchdog_stop(const std::string& path) {
+  for (const json& line : read_lines(path)) {
+    if (line["type"] == "verdict" && line["reason_code"] == "no_frame") return true;
+  }
+  return false;
+}
+
+// A person walking through a simulated cell (the demo's scene).
+const std::string kWalk = std::string(HRCSENSE_SOURCE_DIR) + "/config/walk.yaml";
+
+std::vector<std::string> publisher_args(const std::string& domain, int frames) {
+  return {HRCSENSE_CLI, "publish", "--config", kWalk, "--set", "sim.width=424", "--set", "sim.height=240", "--set", "sim.frames=300",
+          "--set", "publish.namespace=/cli/camera", "--set", "publish.domain_id=" + domain,
+          "--set", "publish.wait_for_subscribers=1", "--frames", std::to_string(frames)};
+}
+
+TEST(Ros2Cli, SilentCameraStopsTheCellAndTheRunResumesWhenItIsBack) {
+  if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
+  const std::string domain = std::to_string(test::test_domain());
+  const std::string out = std::string(::testing::TempDir()) + "ros2_cli_run.jsonl";
+  std::remove(out.c_str());
+  const pid_t run = spawn({HRCSENSE_CLI, "run", "--config", kWalk, "--set", "source.type=ros2", "--set", "source.ros2.namespace=/cli/camera",
+                           "--set", "source.ros2.domain_id=" + domain, "--set", "source.ros2.startup_timeout_s=30",
+                           "--set", "background.frames=5", "--frames", "30", "--out", out});
+  ASSERT_GT(run, 0);
+  const pid_t first = spawn(publisher_args(domain, 15));
+  ASSERT_GT(first, 0);
+  EXPECT_EQ(wait_exit(first, 30s), 0);
+
+  // The camera is silent now: within a few watchdog periods (safety.max_frame_age_s 0.5 s) the
+  // run writes stops of its own.
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (!has_watchdog_stop(out) && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(50ms);
+  ASSERT_TRUE(has_watchdog_stop(out)) << "no no_frame stop while the camera was silent";
+
+  const pid_t second = spawn(publisher_args(domain, 200));
+  ASSERT_GT(second, 0);
+  const int run_exit = wait_exit(run, 60s);
+  ::kill(second, SIGTERM);
+  wait_exit(second, 10s);
+  ASSERT_EQ(run_exit, 0) << "the run did not reach its 30 frames after the publisher came back";
+
+  const std::vector<json> lines = read_lines(out);
+  ASSERT_GE(lines.size(), 3U);
+  EXPECT_EQ(lines.front()["source"]["type"], "ros2");
+  EXPECT_EQ(lines.front()["intrinsics"]["width"], 424);
+  const json& summary = lines.back();
+  ASSERT_EQ(summary["type"], "summary");
+  EXPECT_EQ(summary["frames_in"], 30);
+  EXPECT_TRUE(summary.contains("frames_dropped_camera"));
+  // Frames on both sides of the silence, and processed ones after it (the background was
+  // learnt from the first publisher's frames).
+  size_t first_stop = 0, frames_after = 0, valid_after = 0;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (first_stop == 0 && lines[i]["type"] == "verdict" && lines[i]["reason_code"] == "no_frame") first_stop = i;
+    if (first_stop != 0 && lines[i]["type"] == "frame") {
+      ++frames_after;
+      valid_after += lines[i]["valid"].get<bool>() ? 1 : 0;
+    }
+  }
+  ASSERT_GT(first_stop, 0U);
+  EXPECT_GT(frames_after, 0U);
+  EXPECT_GT(valid_after, 0U);
+  for (size_t i = first_stop; i < lines.size(); ++i) {
+    if (lines[i]["type"] == "verdict" && lines[i]["reason_code"] == "no_frame") {
+      EXPECT_EQ(lines[i]["verdict"], "stop");
+    }
+  }
+}
+
+}  // namespace
+}  // namespace hrcsense
