@@ -249,7 +249,8 @@ int64_t StampGapCounter::add(int64_t stamp_ns) {
     ++outages;
     return 0;
   }
-  if (period_ns == 0 || step_ns < period_ns) period_ns = step_ns;
+  if (step_ns >= min_period_ns && (period_ns == 0 || step_ns < period_ns)) period_ns = step_ns;
+  if (period_ns == 0) return 0;  // no believable period yet
   if (2 * step_ns <= 3 * period_ns) return 0;  // within 1.5 periods: jitter, nothing lost
   const int64_t missed = (step_ns + period_ns / 2) / period_ns - 1;
   frames_missed += missed;

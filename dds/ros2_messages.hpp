@@ -89,11 +89,12 @@ Extrinsics extrinsics_from_msg(const realsense2_camera_msgs_msg_dds__Extrinsics_
 realsense2_camera_msgs_msg_dds__Extrinsics_ extrinsics_to_msg(const Extrinsics& extrinsics);
 
 /// Frames a camera lost, from the gaps in its stamps: a step longer than 1.5 periods (the
-/// shortest step seen so far) missed round(step / period) − 1 frames. A step longer than
-/// `outage_ns` is a silence (the publisher was away), counted apart; a step back (a restarted
-/// publisher, a looped file) starts over.
+/// shortest step seen so far, at least `min_period_ns`) missed round(step / period) − 1
+/// frames. A step longer than `outage_ns` is a silence (the publisher was away), counted
+/// apart; a step back (a restarted publisher, a looped file) starts over.
 struct StampGapCounter {
   int64_t outage_ns = 1'000'000'000;
+  int64_t min_period_ns = 1'000'000;  ///< 1000 frames/s: a shorter step is no camera's period
   int64_t period_ns = 0;   ///< shortest positive step seen; 0 until there is one
   int64_t previous_ns = 0;
   bool has_previous = false;

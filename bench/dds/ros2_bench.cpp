@@ -57,9 +57,9 @@ void BM_Ros2Loopback(benchmark::State& state, bool paced) {
     std::thread publisher_thread([&] {
       ros2::Ros2CameraPublisher publisher(ros2::Ros2PublisherParams{"/bench/camera", domain});
       Frame frame = prototype;
-      // Warm-up frames (stamps below the base) until the source has started.
+      // Warm-up frames (stamps below 0, 10 ms apart) until the source has started.
       for (int i = 0; !source_ready.load() && i < 3000; ++i) {
-        frame.timestamp_ns = i;
+        frame.timestamp_ns = (i - 3000) * int64_t{10'000'000};
         publisher.publish(frame);
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
       }

@@ -283,6 +283,17 @@ TEST(Ros2StampGaps, CountsMissingFramesAndTellsOutagesApart) {
   EXPECT_EQ(gaps.frames_missed, 3);
 }
 
+TEST(Ros2StampGaps, StepsShorterThanAMillisecondAreNoPeriod) {
+  // Stamps 1 ns apart (a publisher counting frames, not time) must not turn the next real
+  // step into millions of lost frames.
+  StampGapCounter gaps;
+  for (int64_t t = 0; t < 5; ++t) EXPECT_EQ(gaps.add(t), 0);
+  EXPECT_EQ(gaps.add(500'000'000), 0);
+  EXPECT_EQ(gaps.add(533'333'333), 0);  // 33 ms: the shortest believable step so far, the period
+  EXPECT_EQ(gaps.add(600'000'000), 1);
+  EXPECT_EQ(gaps.frames_missed, 1);
+}
+
 TEST(Ros2HostTime, WallClockStampsMapToMonotonicOthersToArrival) {
   const int64_t wall = 1'800'000'000'000'000'000;
   const int64_t mono = 5'000'000'000;
