@@ -8,6 +8,10 @@
 #include "hrcsense/rtde.hpp"
 #include "hrcsense/udp_json.hpp"
 
+#ifdef HRCSENSE_HAVE_REALSENSE
+#include "realsense/realsense_source.hpp"
+#endif
+
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -53,7 +57,7 @@ Simulator make_simulator(const Config& config) {
   return simulator;
 }
 
-std::unique_ptr<Source> make_source(const Config& config) {
+std::unique_ptr<Source> make_source(const Config& config, const std::atomic<bool>* stop_requested) {
   const std::string where = config.file.empty() ? std::string("configuration") : config.file;
   if (config.source.type == "sim") return std::make_unique<SimSource>(make_simulator(config));
   if (config.source.type == "folder" || config.source.type == "bag") {
@@ -64,8 +68,24 @@ std::unique_ptr<Source> make_source(const Config& config) {
     if (config.source.type == "folder") return std::make_unique<FolderSource>(params);
     return std::make_unique<BagSource>(params);
   }
+  if (config.source.type == "realsense") {
+#ifdef HRCSENSE_HAVE_REALSENSE
+    return std::make_unique<RealSenseSource>(RealSenseParams{config.source, stop_requested});
+#else
+    (void)stop_requested;
+    throw ConfigError(realsense_missing_message(where + ": source.type 'realsense'"));
+#endif
+  }
   // The configuration knows every type; the live adapters are optional targets.
   throw ConfigError(where + ": source.type '" + config.source.type + "': not built into this hrcsense");
+}
+
+std::vector<DeviceDescriptor> list_cameras() {
+#ifdef HRCSENSE_HAVE_REALSENSE
+  return list_realsense_devices();
+#else
+  throw ConfigError(realsense_missing_message("hrcsense devices"));
+#endif
 }
 
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock) {

@@ -31,6 +31,9 @@ RecorderParams recorder_params(const Config& config, const std::string& path, co
 /// Logs the files written and the counters (and the error, naming the file) to stderr.
 void log_recording(const RecorderStats& stats);
 int info_command(const CommandArgs& args);
+/// devices: the RealSense cameras connected, with their depth profiles (docs/CAMERAS.md); in a
+/// build without the SDK, the error saying how to get it.
+int devices_command();
 int bench_command(const CommandArgs& args);
 /// verify-filters CASES_JSON [--shared DIR]: one stdout line per case, last "N/M cases bit-exact".
 int verify_filters_command(const CommandArgs& args);

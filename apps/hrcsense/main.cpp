@@ -55,6 +55,8 @@ int main(int argc, char** argv) {
   add_common_flags(*info, args);
   info->add_option("path", args.input, "a recording: a RealSense .bag file or a folder of depth PNGs");
 
+  CLI::App* devices = app.add_subcommand("devices", "list the RealSense cameras connected and their depth profiles");
+
   CLI::App* bench = app.add_subcommand("bench", "time the processing path on pre-rendered frames");
   add_common_flags(*bench, args);
 
@@ -65,9 +67,9 @@ int main(int argc, char** argv) {
 
   // CLI11 would only say "a subcommand is required" for a misspelt one; name it instead.
   const std::string first = argc > 1 ? argv[1] : "";
-  if (!first.empty() && first[0] != '-' && first != "run" && first != "record" && first != "info" && first != "bench" &&
+  if (!first.empty() && first[0] != '-' && first != "run" && first != "record" && first != "info" && first != "devices" && first != "bench" &&
       first != "verify-filters") {
-    return hrcsense::app::report_error(std::string("unknown command '") + argv[1] + "'; expected run, record, info, bench or verify-filters",
+    return hrcsense::app::report_error(std::string("unknown command '") + argv[1] + "'; expected run, record, info, devices, bench or verify-filters",
                                        hrcsense::app::kExitUsage);
   }
   try {
@@ -81,6 +83,7 @@ int main(int argc, char** argv) {
     if (run->parsed()) return hrcsense::app::run_command(args);
     if (record->parsed()) return hrcsense::app::record_command(args);
     if (info->parsed()) return hrcsense::app::info_command(args);
+    if (devices->parsed()) return hrcsense::app::devices_command();
     if (verify_filters->parsed()) return hrcsense::app::verify_filters_command(args);
     return hrcsense::app::bench_command(args);
   } catch (const std::exception& e) {
