@@ -11,6 +11,9 @@
 #if HRCSENSE_HAVE_DDS
 #include "dds/ros2_camera_source.hpp"
 #endif
+#ifdef HRCSENSE_HAVE_REALSENSE
+#include "realsense/realsense_source.hpp"
+#endif
 
 #include <spdlog/spdlog.h>
 
@@ -88,7 +91,7 @@ std::unique_ptr<Source> make_ros2_source([[maybe_unused]] const Config& config,
 
 }  // namespace
 
-std::unique_ptr<Source> make_source(const Config& config, bool with_color) {
+std::unique_ptr<Source> make_source(const Config& config, const SourceOptions& options) {
   const std::string where = config.file.empty() ? std::string("configuration") : config.file;
   if (config.source.type == "sim") return std::make_unique<SimSource>(make_simulator(config));
   if (config.source.type == "folder" || config.source.type == "bag") {
@@ -96,13 +99,28 @@ std::unique_ptr<Source> make_source(const Config& config, bool with_color) {
       throw ConfigError(where + ": source.path: required for source.type " + config.source.type);
     }
     RecordingParams params{config.source.path, config.source.loop, config.source.stereo_baseline_mm};
-    params.with_color = with_color;
+    params.with_color = options.with_color;
     if (config.source.type == "folder") return std::make_unique<FolderSource>(params);
     return std::make_unique<BagSource>(params);
   }
   if (config.source.type == "ros2") return make_ros2_source(config, where);
+  if (config.source.type == "realsense") {
+#ifdef HRCSENSE_HAVE_REALSENSE
+    return std::make_unique<RealSenseSource>(RealSenseParams{config.source, options.stop_requested});
+#else
+    throw ConfigError(realsense_missing_message(where + ": source.type 'realsense'"));
+#endif
+  }
   // The configuration knows every type; the live adapters are optional targets.
   throw ConfigError(where + ": source.type '" + config.source.type + "': not built into this hrcsense");
+}
+
+std::vector<DeviceDescriptor> list_cameras() {
+#ifdef HRCSENSE_HAVE_REALSENSE
+  return list_realsense_devices();
+#else
+  throw ConfigError(realsense_missing_message("hrcsense devices"));
+#endif
 }
 
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock) {

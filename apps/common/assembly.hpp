@@ -11,8 +11,12 @@
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/sim.hpp"
 
+#include "realsense/realsense_plan.hpp"
+
+#include <atomic>
 #include <memory>
 #include <optional>
+#include <vector>
 
 namespace hrcsense {
 
@@ -27,9 +31,17 @@ std::optional<SceneObject> robot_scene_object(const Config& config);
 Simulator make_simulator(const Config& config);
 
 /// The source the configuration names (source.type); throws ConfigError for a type this
-/// build does not have (naming it) or a recorded source without source.path. `with_color`:
-/// recorded sources decode their colour frames too (the pipeline does not need them).
-std::unique_ptr<Source> make_source(const Config& config, bool with_color = false);
+/// build does not have (naming it: realsense without the SDK says how to get it) or a recorded
+/// source without source.path.
+struct SourceOptions {
+  bool with_color = false;  ///< recorded sources decode their colour frames too (the pipeline does not need them)
+  const std::atomic<bool>* stop_requested = nullptr;  ///< ends a live camera's waits while it is unplugged (null: never)
+};
+std::unique_ptr<Source> make_source(const Config& config, const SourceOptions& options = {});
+
+/// The RealSense cameras connected (`hrcsense devices`); throws ConfigError in a build without
+/// the SDK, saying how to get it.
+std::vector<DeviceDescriptor> list_cameras();
 
 /// The robot state source (robot.state.source): fixed; sim (SimRobotState on the trajectory,
 /// with robot.state.sim_latency_s / sim_jitter_s, seeded by source.seed); rtde; udp_json.

@@ -33,6 +33,9 @@ void log_recording(const RecorderStats& stats);
 /// publish: the configured source as realsense-ros topics over Cyclone DDS (publish.*).
 int publish_command(const CommandArgs& args);
 int info_command(const CommandArgs& args);
+/// devices: the RealSense cameras connected, with their depth profiles (docs/CAMERAS.md); in a
+/// build without the SDK, the error saying how to get it.
+int devices_command();
 int bench_command(const CommandArgs& args);
 /// verify-filters CASES_JSON [--shared DIR]: one stdout line per case, last "N/M cases bit-exact".
 int verify_filters_command(const CommandArgs& args);

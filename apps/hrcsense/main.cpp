@@ -59,6 +59,8 @@ int main(int argc, char** argv) {
   add_common_flags(*info, args);
   info->add_option("path", args.input, "a recording: a RealSense .bag file or a folder of depth PNGs");
 
+  CLI::App* devices = app.add_subcommand("devices", "list the RealSense cameras connected and their depth profiles");
+
   CLI::App* bench = app.add_subcommand("bench", "time the processing path on pre-rendered frames");
   add_common_flags(*bench, args);
 
@@ -69,9 +71,10 @@ int main(int argc, char** argv) {
 
   // CLI11 would only say "a subcommand is required" for a misspelt one; name it instead.
   const std::string first = argc > 1 ? argv[1] : "";
-  if (!first.empty() && first[0] != '-' && first != "run" && first != "record" && first != "publish" && first != "info" && first != "bench" &&
-      first != "verify-filters") {
-    return hrcsense::app::report_error(std::string("unknown command '") + argv[1] + "'; expected run, record, publish, info, bench or verify-filters",
+  if (!first.empty() && first[0] != '-' && first != "run" && first != "record" && first != "publish" && first != "info" &&
+      first != "devices" && first != "bench" && first != "verify-filters") {
+    return hrcsense::app::report_error(std::string("unknown command '") + argv[1] +
+                                           "'; expected run, record, publish, info, devices, bench or verify-filters",
                                        hrcsense::app::kExitUsage);
   }
   try {
@@ -86,6 +89,7 @@ int main(int argc, char** argv) {
     if (record->parsed()) return hrcsense::app::record_command(args);
     if (publish->parsed()) return hrcsense::app::publish_command(args);
     if (info->parsed()) return hrcsense::app::info_command(args);
+    if (devices->parsed()) return hrcsense::app::devices_command();
     if (verify_filters->parsed()) return hrcsense::app::verify_filters_command(args);
     return hrcsense::app::bench_command(args);
   } catch (const std::exception& e) {

@@ -51,7 +51,10 @@ void sleep_until_or_stop(std::chrono::steady_clock::time_point due) {
 
 int publish_command(const CommandArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
-  std::unique_ptr<Source> source = make_source(config, /*with_color=*/true);
+  SourceOptions source_options;
+  source_options.with_color = true;
+  source_options.stop_requested = &g_publish_stop;
+  std::unique_ptr<Source> source = make_source(config, source_options);
   const SourceInfo info = source->info();
   ros2::Ros2PublisherParams params;
   params.node_namespace = config.publish.node_namespace;

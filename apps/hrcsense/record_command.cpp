@@ -53,7 +53,9 @@ void log_recording(const RecorderStats& stats) {
 
 int record_command(const CommandArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
-  std::unique_ptr<Source> source = make_source(config);
+  SourceOptions source_options;
+  source_options.stop_requested = &g_record_stop;
+  std::unique_ptr<Source> source = make_source(config, source_options);
   const SourceInfo info = source->info();
   // The robot's joints at each frame go to /hrcsense/joint_states beside it.
   std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config);

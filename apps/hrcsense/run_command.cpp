@@ -62,7 +62,9 @@ const char* signal_name(int signal) {
 
 int run_command(const CommandArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
-  std::unique_ptr<Source> source = make_source(config);
+  SourceOptions source_options;
+  source_options.stop_requested = &g_stop_requested;
+  std::unique_ptr<Source> source = make_source(config, source_options);
   std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config);
   const SourceInfo info = source->info();
   // --record: the source's frames, as delivered, to a bag on a writer thread (never blocking).

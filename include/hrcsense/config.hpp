@@ -44,13 +44,42 @@ struct PublishConfig {
   double wait_timeout_s = 30.0;     ///< `publish.wait_timeout_s`: how long to wait for them
 };
 
+/// One RealSense SDK option to set on the depth sensor (`source.options.<name>`): the SDK's
+/// option name in snake_case (visual_preset, laser_power, emitter_enabled, exposure,
+/// enable_auto_exposure) and the numeric value the SDK takes, already checked against the
+/// SDK's range (a visual preset is its rs2_rs400_visual_preset number).
+struct CameraOption {
+  std::string name;
+  float value = 0.0F;
+};
+
+/// `source.color`: the colour stream of a live camera (`source.type: realsense`).
+struct ColorStreamConfig {
+  bool enabled = false;  ///< `source.color.enabled`: stream colour too (off: depth alone)
+  int width = 848;       ///< `source.color.width`, pixels
+  int height = 480;      ///< `source.color.height`, pixels
+  int fps = 30;          ///< `source.color.fps`, frames/s (the D435's RGB sensor: 6, 15, 30, 60)
+};
+
 struct SourceConfig {
   std::string type = "sim";        ///< sim (default), folder, bag, realsense, ros2
-  std::string path;                ///< file or folder for recorded sources
+  std::string path;                ///< file or folder for recorded sources (realsense: a .bag to play through the SDK)
   bool pace = false;               ///< play at the recorded / nominal rate
   bool loop = false;               ///< start over at the end
   uint64_t seed = 1;               ///< simulator noise seed
   float stereo_baseline_mm = 0.0F; ///< for sources that do not carry one
+  // The live camera (`source.type: realsense`, docs/CAMERAS.md).
+  std::string serial;              ///< `source.serial`: the camera's serial number; empty: the first camera found
+  int width = 848;                 ///< `source.width`: depth width, pixels
+  int height = 480;                ///< `source.height`: depth height, pixels
+  int fps = 30;                    ///< `source.fps`: depth rate, one of the D435's 6, 15, 30, 60, 90 frames/s
+  ColorStreamConfig color;         ///< `source.color.*`
+  /// `source.options.*`, in the order the SDK must get them (visual_preset first: a preset
+  /// resets the other options; enable_auto_exposure before exposure).
+  std::vector<CameraOption> options;
+  /// `source.settle_frames`: frames skipped after the start (and each reconnect) while auto
+  /// exposure settles, before background learning sees any; 0 with auto exposure off.
+  int settle_frames = 30;
   Ros2SourceConfig ros2;           ///< `source.ros2.*`
 };
 

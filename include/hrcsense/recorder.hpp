@@ -93,6 +93,8 @@ class RecordingSource : public Source {
   SourceInfo info() const override { return inner_.info(); }
   Status next(Frame& out) override;
   std::string error() const override { return error_.empty() ? inner_.error() : error_; }
+  int64_t frames_dropped_camera() const override { return inner_.frames_dropped_camera(); }
+  ReasonCode silence_reason() const override { return inner_.silence_reason(); }
 
  private:
   Source& inner_;

@@ -42,6 +42,11 @@ class Source {
   /// samples lost in transport): `frames_dropped_camera` in the summary, apart from the
   /// pipeline's own `frames_dropped`. Read after the capture thread has finished.
   virtual int64_t frames_dropped_camera() const { return 0; }
+  /// Why no frame arrives, for the watchdog's stop when none came for safety.max_frame_age_s:
+  /// no_frame (the default) when the source does not know; a live camera that is unplugged says
+  /// camera_disconnected. Called from the output thread while next() runs on the capture
+  /// thread: an implementation reads only what is safe to read concurrently (an atomic).
+  virtual ReasonCode silence_reason() const { return ReasonCode::no_frame; }
 };
 
 }  // namespace hrcsense

@@ -226,6 +226,9 @@ enum class ReasonCode {
   source_error,          ///< stop: end of the run, the source failed
   processing_error,      ///< stop: end of the run, processing failed
   output_error,          ///< stop: end of the run, the output failed
+  /// stop: the watchdog saw no frame because the live camera is unplugged (Source::silence_reason),
+  /// until the same serial is back and streams again
+  camera_disconnected,
 };
 
 struct Verdict {

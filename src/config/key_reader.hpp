@@ -111,6 +111,10 @@ class KeyReader {
 /// docs/SIMULATOR.md) into `sim`.
 void read_sim_effects(KeyReader& r, SimParams& sim);
 
+/// Reads the live camera's keys (`source.serial`, `source.width`, `source.height`, `source.fps`,
+/// `source.color.*`, `source.options.*`, `source.settle_frames`) into `source`.
+void read_camera_source(KeyReader& r, SourceConfig& source);
+
 /// Reads `filters.preset`, `filters.order` and `filters.<block>.<option>` (docs/CONFIG.md) into
 /// `config.filters_preset` and `config.pipeline.filters`; a value outside the SDK's range is an
 /// error naming the key and the range.

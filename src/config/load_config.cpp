@@ -61,6 +61,7 @@ void read_source_and_sim(KeyReader& r, Config& c) {
     r.fail("source.stereo_baseline_mm", "expected 0 (unknown) or a baseline in [1, 1000] mm, got " +
                                             config_detail::float_text(c.source.stereo_baseline_mm));
   }
+  config_detail::read_camera_source(r, c.source);  // src/config/camera_config.cpp
   c.sim.seed = c.source.seed;
 
   r.integer("sim.width", c.sim.width, 1, 65535);

@@ -134,7 +134,14 @@ void capture_loop(Source& source, const RunOptions& options, RunClock& clock, do
     } catch (const std::exception& e) {
       error = e.what();
     }
-    if (status == Source::Status::end) break;  // the defaults say "source ended"
+    if (status == Source::Status::end) {
+      // A live source's wait (an unplugged camera) ends with `end` on a stop request: say so.
+      if (stop_requested(options)) {
+        outcome.end_code = ReasonCode::stop_requested;
+        outcome.final_reason = outcome.end_reason = "stop requested";
+      }
+      break;  // otherwise the defaults say "source ended"
+    }
     if (status == Source::Status::idle) {  // no frame yet: the output loop's watchdog stops the cell
       --n;
       continue;
@@ -253,13 +260,14 @@ bool take_until(Mailbox<FrameResult>& results, FrameResult& out, const RunClock&
 }
 
 // Writes every result; when none arrives within max_frame_age_s (on the run clock), writes a
-// watchdog stop, and another each max_frame_age_s after it. The wait for the next result
+// watchdog stop (with the source's reason for the silence: no_frame, or camera_disconnected),
+// and another each max_frame_age_s after it. The wait for the next result
 // starts when the last write ended, at the one clock reading after each write (tests rely on
 // it). Ends early when the sink fails (a closed pipe, a full disk): closes `results` so that
 // processing and capture end too, and says why in `error`. Returns the last result written
 // (for the final stop's frame index).
-FrameResult output_loop(Sink& sink, const RunClock& clock, double max_frame_age_s, Mailbox<FrameResult>& results,
-                        RunSummary& summary, std::string& error) {
+FrameResult output_loop(Sink& sink, const Source& source, const RunClock& clock, double max_frame_age_s,
+                        Mailbox<FrameResult>& results, RunSummary& summary, std::string& error) {
   const int64_t max_frame_age_ns = seconds_to_ns(max_frame_age_s);
   FrameResult result, last, watchdog;
   int64_t last_arrival_ns = clock.now_ns();
@@ -278,10 +286,12 @@ FrameResult output_loop(Sink& sink, const RunClock& clock, double max_frame_age_
         continue;
       }
       if (results.closed()) break;
-      char reason[96];
-      std::snprintf(reason, sizeof reason, "no frame for %.3f s (max_frame_age_s %.3f)",
+      const ReasonCode silence = source.silence_reason();
+      char reason[128];
+      std::snprintf(reason, sizeof reason, "%sno frame for %.3f s (max_frame_age_s %.3f)",
+                    silence == ReasonCode::camera_disconnected ? "camera disconnected: " : "",
                     ns_to_seconds(clock.now_ns() - last_arrival_ns), max_frame_age_s);
-      write_stop(sink, watchdog, last, ReasonCode::no_frame, reason);
+      write_stop(sink, watchdog, last, silence, reason);
       waiting_since_ns = clock.now_ns();
     }
   } catch (const std::exception& e) {
@@ -320,7 +330,7 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
       [&] { capture_loop(source, options, clock, max_frame_age_s, host_time_is_source_time, frames, outcome); });
   std::thread processing(
       [&] { processing_loop(pipeline, robot_states, options, clock, max_frame_age_s, frames, results, stats); });
-  const FrameResult last = output_loop(sink, clock, max_frame_age_s, results, summary, output_error);
+  const FrameResult last = output_loop(sink, source, clock, max_frame_age_s, results, summary, output_error);
   processing.join();
   capture.join();
 

@@ -96,6 +96,7 @@ const char* reason_code_name(ReasonCode code) {
     case ReasonCode::source_error: return "source_error";
     case ReasonCode::processing_error: return "processing_error";
     case ReasonCode::output_error: return "output_error";
+    case ReasonCode::camera_disconnected: return "camera_disconnected";
   }
   return "unknown";
 }

@@ -152,7 +152,7 @@ struct CollectingSink : Sink {
   std::vector<FrameResult> frame_results() const {
     std::vector<FrameResult> out;
     for (size_t i = 0; i + 1 < results.size(); ++i) {
-      if (results[i].verdict.code != ReasonCode::no_frame) out.push_back(results[i]);
+      if (results[i].source_frame) out.push_back(results[i]);
     }
     return out;
   }

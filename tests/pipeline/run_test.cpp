@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <string>
 #include <thread>
@@ -176,6 +177,79 @@ TEST(RunPipeline, WatchdogStopsWhenTheSourceStalls) {
   EXPECT_EQ(summary.verdict_stop, 3);  // learning; the watchdog's stop is no frame's verdict
   EXPECT_DOUBLE_EQ(summary.wall_s, 0.25);
   EXPECT_EQ(sink.results.back().verdict.reason, "source ended");
+}
+
+// A live camera that is unplugged says so (Source::silence_reason): the watchdog's stop then
+// carries camera_disconnected instead of no_frame, and the camera's return ends it. Same fake
+// clock choreography as above: the source is "unplugged" during the stall before frame 4.
+class UnpluggableSource : public FakeSource {
+ public:
+  using FakeSource::FakeSource;
+  ReasonCode silence_reason() const override { return silence.load(); }
+  std::atomic<ReasonCode> silence{ReasonCode::no_frame};
+};
+
+TEST(RunPipeline, WatchdogStopNamesTheDisconnectedCamera) {
+  test::WatchedClock clock;
+  UnpluggableSource source(after_learning({{1.5F}, {1.5F}, {1.5F}}));
+  CollectingSink sink;
+  source.before_step = [&](size_t step) {
+    if (step != 4) return true;
+    if (!has_results(sink, 4) || !clock.wait_output_reads_above(clock.output_reads())) return false;
+    source.silence = ReasonCode::camera_disconnected;  // unplugged
+    clock.fake.advance(250'000'000);
+    const bool stopped = sink.wait_until([](const std::vector<FrameResult>& results) {
+      return !results.empty() && results.back().verdict.code == ReasonCode::camera_disconnected;
+    });
+    source.silence = ReasonCode::no_frame;  // the same serial is back and streams
+    return stopped;
+  };
+  RunOptions options;
+  options.clock = &clock;
+  run(source, sink, fake_params(0.1), options);
+
+  ASSERT_EQ(sink.results.size(), 8U);  // 6 frames, the watchdog's stop, the final stop
+  const FrameResult& watchdog = sink.results[4];
+  EXPECT_EQ(watchdog.verdict.code, ReasonCode::camera_disconnected);
+  EXPECT_EQ(watchdog.verdict.state, VerdictState::stop);
+  EXPECT_EQ(watchdog.verdict.reason, "camera disconnected: no frame for 0.250 s (max_frame_age_s 0.100)");
+  EXPECT_FALSE(watchdog.source_frame);
+  const std::vector<FrameResult> frames = sink.frame_results();
+  ASSERT_EQ(frames.size(), 6U);
+  EXPECT_EQ(frames[4].verdict.state, VerdictState::run);  // back: frames are processed again
+  EXPECT_EQ(sink.results.back().verdict.code, ReasonCode::source_ended);
+}
+
+// A live source waiting for its camera ends the wait with `end` when the run is stopped
+// (SIGINT): the run ends as stopped, not as a source that ended.
+class WaitEndedByStop : public FakeSource {
+ public:
+  WaitEndedByStop(std::vector<Step> steps, std::atomic<bool>& stop) : FakeSource(std::move(steps)), stop_(stop) {}
+  Status next(Frame& out) override {
+    if (delivered_ == 4) {
+      stop_ = true;  // the signal arrives during the source's own wait
+      return Status::end;
+    }
+    ++delivered_;
+    return FakeSource::next(out);
+  }
+
+ private:
+  std::atomic<bool>& stop_;
+  int delivered_ = 0;
+};
+
+TEST(RunPipeline, SourceEndingOnAStopRequestEndsTheRunAsStopped) {
+  std::atomic<bool> stop{false};
+  WaitEndedByStop source(after_learning({{1.5F}, {1.5F}, {1.5F}}), stop);
+  CollectingSink sink;
+  RunOptions options;
+  options.stop_requested = &stop;
+  const RunSummary summary = run(source, sink, fake_params(), options);
+  EXPECT_EQ(summary.frames_in, 4);
+  EXPECT_EQ(summary.end_code, ReasonCode::stop_requested);
+  EXPECT_EQ(summary.end_reason, "stop requested");
+  EXPECT_EQ(sink.results.back().verdict.code, ReasonCode::stop_requested);
 }
 
 // The same on the steady clock, with a real stall of 0.4 s (max_frame_age_s 0.1 s): at least

@@ -152,14 +152,15 @@ TEST(Verdict, ReasonCodeNamesAreDistinctSnakeCase) {
       {ReasonCode::stale_frame, "stale_frame"}, {ReasonCode::no_frame, "no_frame"},
       {ReasonCode::source_ended, "source_ended"}, {ReasonCode::frame_limit_reached, "frame_limit_reached"},
       {ReasonCode::stop_requested, "stop_requested"}, {ReasonCode::source_error, "source_error"},
-      {ReasonCode::processing_error, "processing_error"}, {ReasonCode::output_error, "output_error"}};
+      {ReasonCode::processing_error, "processing_error"}, {ReasonCode::output_error, "output_error"},
+      {ReasonCode::camera_disconnected, "camera_disconnected"}};
   std::set<std::string> seen;
   for (const auto& [code, name] : expected) {
     EXPECT_EQ(reason_code_name(code), name);
     EXPECT_TRUE(seen.insert(name).second) << name;
   }
-  // The last enumerator is output_error: a new code without a name here fails this count.
-  EXPECT_EQ(static_cast<size_t>(ReasonCode::output_error) + 1, expected.size());
+  // The last enumerator is camera_disconnected: a new code without a name here fails this count.
+  EXPECT_EQ(static_cast<size_t>(ReasonCode::camera_disconnected) + 1, expected.size());
 }
 
 TEST(Verdict, Names) {
