@@ -69,8 +69,10 @@ class BagWriter {
   BagWriter& operator=(const BagWriter&) = delete;
 
   /// The frame's depth image (and its colour image when it has one, with depth_to_color as
-  /// the colour stream's tf). Stream info, camera_info and tf go out with a stream's first frame.
-  void add_frame(const Frame& frame);
+  /// the colour stream's tf), and with `robot_state` the robot's joints at it (add_joint_state:
+  /// positions and velocities), in that order: colour, joints, depth. Stream info, camera_info
+  /// and tf go out with a stream's first frame.
+  void add_frame(const Frame& frame, const RobotState* robot_state = nullptr);
   /// The depth image alone. Bag time: the frame's timestamp relative to the first frame's
   /// (plus 2 ns: the SDK's playback reads streams from there), header stamp: its timestamp.
   void add_depth(const Frame& frame);
@@ -80,8 +82,8 @@ class BagWriter {
                  const Pose& T_color_depth = Pose::Identity());
   /// The robot's joints at a frame as `/hrcsense/joint_states` (sensor_msgs/JointState stamped
   /// `timestamp_ns`: names from params.joint_names, positions in rad, velocities in rad/s when
-  /// given, no efforts). Write it before the frame's images: a reader in file order (BagSource)
-  /// then has a frame's joints when the frame arrives.
+  /// given, no efforts). Write it before the frame's depth image: a reader in file order
+  /// (BagSource) then has a frame's joints when the frame arrives.
   void add_joint_state(int64_t timestamp_ns, const JointAngles& position_rad,
                        const std::optional<JointAngles>& velocity_rad_s = std::nullopt);
 

@@ -217,10 +217,12 @@ void set_color_calibration(const BagState& s, Frame& out) {
 
 BagSource::BagSource(RecordingParams params) : params_(std::move(params)), state_(std::make_unique<BagState>(params_.path)) {
   if (params_.with_joint_states) state_->joint_states = std::make_shared<RecordedRobotState>(params_.path);
-  // Chunks holding only images nobody asked for (colour without with_color, infrared) are not
-  // even decompressed: the SDK writes one chunk per large frame, so this halves the work.
-  state_->reader.set_wanted([with_color = params_.with_color](const BagConnection& connection) {
+  // Chunks holding only images nobody asked for (colour without with_color, infrared), or
+  // joint states without with_joint_states, are not even decompressed: the SDK writes one chunk per large frame, so this halves the work.
+  state_->reader.set_wanted([with_color = params_.with_color, with_joints = params_.with_joint_states](
+                                const BagConnection& connection) {
     const bag::TopicRole role = bag::classify_topic(connection.topic);
+    if (role.role == bag::Role::joint_states) return with_joints;
     if (role.role != bag::Role::image) return true;
     return role.stream.rfind("Depth_", 0) == 0 || (with_color && role.stream.rfind("Color_", 0) == 0);
   });

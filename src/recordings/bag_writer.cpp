@@ -378,13 +378,16 @@ void BagWriter::add_color(int64_t timestamp_ns, const ColorImage& color, const I
             static_cast<size_t>(color.width) * 3, 0.0F);
 }
 
-void BagWriter::add_frame(const Frame& frame) {
-  // Colour first: a reader that pairs each depth frame with the latest colour frame in file
-  // order (hrcsense's BagSource) then gets this frame's own.
+void BagWriter::add_frame(const Frame& frame, const RobotState* robot_state) {
+  // Colour and joints first: a reader that pairs each depth frame with the latest colour frame
+  // and joint state in file order (hrcsense's BagSource) then gets this frame's own. The joints
+  // after the colour keep an SDK-sized colour image in a chunk of its own, which a reader that
+  // wants no colour skips undecompressed.
   if (frame.color && frame.color->width > 0) {
     const Pose T_color_depth = frame.depth_to_color ? extrinsics_pose(*frame.depth_to_color) : Pose::Identity();
     add_color(frame.timestamp_ns, *frame.color, frame.color_intrinsics, T_color_depth);
   }
+  if (robot_state != nullptr) add_joint_state(frame.timestamp_ns, robot_state->q_rad, robot_state->qd_rad_s);
   add_depth(frame);
 }
 

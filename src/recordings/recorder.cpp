@@ -104,11 +104,7 @@ void Recorder::write_item(const Item& item) {
     writer_.reset();
   }
   if (!writer_) open_next_file(item.frame);
-  // The joints before the images: a reader in file order has them when the frame arrives.
-  if (item.robot_state) {
-    writer_->add_joint_state(item.frame.timestamp_ns, item.robot_state->q_rad, item.robot_state->qd_rad_s);
-  }
-  writer_->add_frame(item.frame);
+  writer_->add_frame(item.frame, item.robot_state ? &*item.robot_state : nullptr);
 }
 
 void Recorder::writer_loop() {
