@@ -413,7 +413,7 @@ TEST(JsonLinesSink, NoRobotStatusKeyForSourcesWithoutOne) {
 
 // `run --record`: the recorder's counters as their own object, apart from the pipeline's
 // frames_dropped; null when the run recorded nothing.
-TEST(JsonLinesSink, SummaryRecordCountersAreNullWithoutARecording) {
+TEST(JsonLinesSink, SummaryHasTheRecordersCountersOrNull) {
   std::ostringstream out;
   JsonLinesSink sink(out);
   RunSummary summary;
