@@ -8,6 +8,7 @@
 #include "hrcsense/config.hpp"
 #include "hrcsense/io.hpp"
 #include "hrcsense/recordings.hpp"
+#include "hrcsense/robot_state_history.hpp"
 
 #include <sys/mman.h>
 #include <unistd.h>
@@ -18,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <vector>
 
 namespace hrcsense::fuzz {
@@ -30,13 +32,21 @@ namespace fs = std::filesystem;
   std::abort();
 }
 
-/// Plays `source` to its end or first error and checks the error contract.
-Outcome play(Source& source, const std::string& path) {
+/// Plays `source` to its end or first error and checks the error contract; with `states` (a
+/// bag's recorded joint states), looks each frame's state up as the pipeline would.
+Outcome play(Source& source, const std::string& path, RobotStateSource* states = nullptr) {
   Outcome out;
   (void)source.info();
   Frame frame;
   Source::Status status = Source::Status::frame;
-  while ((status = source.next(frame)) == Source::Status::frame) ++out.frames;
+  while ((status = source.next(frame)) == Source::Status::frame) {
+    ++out.frames;
+    RobotState state;
+    if (states != nullptr && states->state_at(frame.timestamp_ns, state) &&
+        !(state.valid && all_finite(state.q_rad) && all_finite(state.qd_rad_s))) {
+      contract_broken("a recorded joint state is invalid or not finite", path);
+    }
+  }
   if (status == Source::Status::error) {
     out.error = source.error();
     // Folder errors name the frame and the file that failed, which a list may place anywhere.
@@ -167,8 +177,10 @@ Outcome run_bag(const uint8_t* data, size_t size) {
   try {
     RecordingParams params{file.path};
     params.with_color = true;
+    params.with_joint_states = true;  // the JointState parser of /hrcsense/joint_states too
     BagSource source(params);
-    out = play(source, file.path);
+    const std::unique_ptr<RobotStateSource> states = source.recorded_robot_state();
+    out = play(source, file.path, states.get());
   } catch (const IoError& e) {
     out.error = e.what();
     if (out.error.find(file.path) == std::string::npos) contract_broken("error does not name the file", out.error);

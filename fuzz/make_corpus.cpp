@@ -39,6 +39,22 @@ void write_bag(const std::string& path, const test::BagWriterParams& params, boo
   writer.close();
 }
 
+/// Two frames, each after its robot joint state with UR's names and velocities, as hrcsense
+/// records them (/hrcsense/joint_states).
+void write_joint_state_bag(const std::string& path) {
+  test::BagWriterParams params;
+  params.sdk_metadata = false;
+  params.joint_names.assign(kUrJointNames.begin(), kUrJointNames.end());
+  test::BagWriter writer(path, params);
+  for (int64_t i = 0; i < 2; ++i) {
+    const Frame frame = tiny_frame(i);
+    const double t = 0.1 * static_cast<double>(i);
+    writer.add_joint_state(frame.timestamp_ns, JointAngles{t, -1.0, 1.5, -2.0, 0.5, -t}, JointAngles{1, 0, 0, 0, 0, -1});
+    writer.add_depth(frame);
+  }
+  writer.close();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -61,6 +77,7 @@ int main(int argc, char** argv) {
   old_sdk.depth_units_option_m = 0.0001F;
   old_sdk.file_version = 3;
   write_bag((root / "bag/lz4_units_option.bag").string(), old_sdk, false);
+  write_joint_state_bag((root / "bag/lz4_joint_states.bag").string());
   const char* names[fuzz::kFolderTargets] = {"depth_png", "dataset_json", "frames_txt", "color_png",
                                              "color_jpeg", "depth_txt", "rgb_txt", "hrcsense_json"};
   for (int t = 0; t < fuzz::kFolderTargets; ++t) {

@@ -101,6 +101,7 @@ std::unique_ptr<Source> make_source(const Config& config, const SourceOptions& o
     RecordingParams params{config.source.path, config.source.loop, config.source.stereo_baseline_mm};
     params.with_color = options.with_color;
     if (config.source.type == "folder") return std::make_unique<FolderSource>(params);
+    params.with_joint_states = config.robot_state.source == "recorded";  // make_robot_state_source takes them
     return std::make_unique<BagSource>(params);
   }
   if (config.source.type == "ros2") return make_ros2_source(config, where);
@@ -160,7 +161,26 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
     params.arm = config.pipeline.robot.arm;  // the forward kinematics actual_TCP_pose is checked against
     return std::make_unique<RtdeRobotState>(params, run_clock);
   }
+  if (source == "recorded") {
+    throw ConfigError(where + ": robot.state.source recorded: the joint states come from the recording (source.type bag)");
+  }
   throw ConfigError(where + ": robot.state.source '" + source + "': not built into this hrcsense");
+}
+
+std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, Source& source, RunClock* clock) {
+  if (config.robot_state.source != "recorded") return make_robot_state_source(config, clock);
+  const std::string where = config.file.empty() ? std::string("configuration") : config.file;
+  const auto* bag = dynamic_cast<const BagSource*>(&source);
+  if (bag == nullptr) {
+    throw ConfigError(where + ": robot.state.source recorded: needs source.type bag (a recording made by hrcsense), not " +
+                      config.source.type);
+  }
+  std::unique_ptr<RobotStateSource> states = bag->recorded_robot_state();
+  if (!states) {
+    throw IoError(config.source.path + ": no robot joint states (topic /hrcsense/joint_states), which robot.state.source "
+                  "recorded needs: record with hrcsense record or hrcsense run --record");
+  }
+  return states;
 }
 
 bool load_background_file(const Config& config, const SourceInfo& info, Pipeline& pipeline) {

@@ -32,7 +32,8 @@ Simulator make_simulator(const Config& config);
 
 /// The source the configuration names (source.type); throws ConfigError for a type this
 /// build does not have (naming it: realsense without the SDK says how to get it) or a recorded
-/// source without source.path.
+/// source without source.path. A bag reads its joint states too when robot.state.source is
+/// recorded.
 struct SourceOptions {
   bool with_color = false;  ///< recorded sources decode their colour frames too (the pipeline does not need them)
   const std::atomic<bool>* stop_requested = nullptr;  ///< ends a live camera's waits while it is unplugged (null: never)
@@ -45,10 +46,16 @@ std::vector<DeviceDescriptor> list_cameras();
 
 /// The robot state source (robot.state.source): fixed; sim (SimRobotState on the trajectory,
 /// with robot.state.sim_latency_s / sim_jitter_s, seeded by source.seed); rtde; udp_json.
-/// Throws ConfigError for one this build does not have, or for rtde without
-/// robot.state.host. A live source (rtde, udp_json) stamps arrivals with `clock` (null: the
+/// Throws ConfigError for one this build does not have, for rtde without robot.state.host, and
+/// for recorded (it needs the source: the overload below). A live source (rtde, udp_json) stamps arrivals with `clock` (null: the
 /// steady clock, run_pipeline's default); it must outlive the source.
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock = nullptr);
+
+/// As above, and `recorded`: the joint states of `source`, the BagSource make_source built for
+/// the configuration (it reads them as it plays). Throws ConfigError when `source` is no
+/// BagSource, IoError naming the file and the topic when the bag has no joint states.
+std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, Source& source,
+                                                          RunClock* clock = nullptr);
 
 /// Loads background.path into `pipeline` when the file exists (checked against the filtered
 /// resolution: after decimation); false when there is nothing to load. Throws IoError for a

@@ -6,6 +6,7 @@
 #include "hrcsense/recorder.hpp"
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,13 @@ RecorderParams recorder_params(const Config& config, const std::string& path, co
 void log_recording(const RecorderStats& stats);
 /// publish: the configured source as realsense-ros topics over Cyclone DDS (publish.*).
 int publish_command(const CommandArgs& args);
+/// How a recording of `source`'s frames finds each frame's robot state: as the run's processing
+/// looks it up in `run_states` (paced or not). A `sim` or `fixed` state is asked of a second
+/// source of the configuration, made into `own` (the same answers; a late simulated state
+/// keeps a history that the recorder's lookups, a frame ahead of processing's, would reset);
+/// live and recorded ones are shared (one connection; their lookups change nothing).
+RecordStateLookup record_state_lookup(const Config& config, Source& source, RobotStateSource& run_states, bool paced,
+                                      std::unique_ptr<RobotStateSource>& own);
 int info_command(const CommandArgs& args);
 /// devices: the RealSense cameras connected, with their depth profiles (docs/CAMERAS.md); in a
 /// build without the SDK, the error saying how to get it.

@@ -40,6 +40,10 @@ RecorderParams recorder_params(const Config& config, const std::string& path, co
   params.queue_frames = config.record.queue_frames;
   params.bag.fps = static_cast<uint32_t>(std::lround(std::max(1.0, info.nominal_fps)));
   params.bag.stereo_baseline_mm = info.stereo_baseline_mm;
+  // A UR arm's joints under UR's ROS names; other arms' descriptions name none: joint_0..5.
+  if (config.robot_model == "ur5" || config.robot_model == "ur5e" || config.robot_model == "ur10e") {
+    params.bag.joint_names.assign(kUrJointNames.begin(), kUrJointNames.end());
+  }
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);
   return params;
@@ -51,14 +55,28 @@ void log_recording(const RecorderStats& stats) {
   if (!stats.error.empty()) spdlog::error("recording: {}", stats.error);
 }
 
+RecordStateLookup record_state_lookup(const Config& config, Source& source, RobotStateSource& run_states, bool paced,
+                                      std::unique_ptr<RobotStateSource>& own) {
+  const RobotStateOrigin origin = run_states.origin();
+  if (origin == RobotStateOrigin::sim || origin == RobotStateOrigin::fixed) own = make_robot_state_source(config, source);
+  RecordStateLookup lookup;
+  lookup.states = own ? own.get() : &run_states;
+  lookup.host_time_is_source_time = host_time_is_source_time(origin, paced);
+  lookup.lookup_offset_ns = robot_state_lookup_offset_ns(origin, config.robot_state.camera_latency_s);
+  return lookup;
+}
+
 int record_command(const CommandArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
   SourceOptions source_options;
   source_options.stop_requested = &g_record_stop;
   std::unique_ptr<Source> source = make_source(config, source_options);
   const SourceInfo info = source->info();
-  // The robot's joints at each frame go to /hrcsense/joint_states beside it.
-  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config);
+  // The robot's joints at each frame go to /hrcsense/joint_states beside it, looked up as an
+  // unpaced `hrcsense run` of the configuration would.
+  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config, *source);
+  std::unique_ptr<RobotStateSource> recorder_states;
+  const RecordStateLookup lookup = record_state_lookup(config, *source, *robot_states, false, recorder_states);
   Recorder recorder(recorder_params(config, args.out, info));
 
   g_record_stop.store(false);
@@ -78,12 +96,8 @@ int record_command(const CommandArgs& args) {
     if (frames == 0) first_ns = frame.timestamp_ns;
     // --duration-s counts source time: the frame at first + S is the first one left out.
     if (args.duration_s > 0.0 && frame.timestamp_ns - first_ns >= duration_ns) break;
-    // As run_pipeline looks it up: at the live source's host time, else at the source timestamp.
-    RobotState state;
-    std::optional<JointAngles> joints_rad;
-    const int64_t state_time_ns = frame.host_time_ns != 0 ? frame.host_time_ns : frame.timestamp_ns;
-    if (robot_states->state_at(state_time_ns, state) && state.valid) joints_rad = state.q_rad;
-    recorder.push_wait(frame, kRecordWaitMs, joints_rad);  // no processing to protect: wait rather than drop
+    // No processing to protect: wait rather than drop.
+    recorder.push_wait(frame, kRecordWaitMs, robot_state_for_recording(frame, lookup));
     ++frames;
   }
   for (int signal : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal, SIG_DFL);

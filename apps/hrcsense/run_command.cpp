@@ -45,6 +45,27 @@ void install_signal_handlers() {
   std::signal(SIGPIPE, SIG_IGN);
 }
 
+// Adds the recorder's counters to the summary. The summary comes after the run's final stop, so
+// closing the recording here (writing what is still queued) never delays a verdict.
+class RecordCountersSink final : public Sink {
+ public:
+  RecordCountersSink(Sink& inner, Recorder& recorder) : inner_(inner), recorder_(recorder) {}
+  void header(const RunHeader& header) override { inner_.header(header); }
+  void frame(const FrameResult& result) override { inner_.frame(result); }
+  void summary(const RunSummary& summary) override {
+    RunSummary with_record = summary;
+    const RecorderStats stats = recorder_.close();
+    with_record.record = RecordCounters{stats.frames_recorded, stats.frames_dropped, stats.files, stats.error};
+    inner_.summary(with_record);
+  }
+  bool failed() const override { return inner_.failed(); }
+  std::string failure() const override { return inner_.failure(); }
+
+ private:
+  Sink& inner_;
+  Recorder& recorder_;
+};
+
 void restore_signal_handlers() {
   for (int signal : kStopSignals) std::signal(signal, SIG_DFL);
 }
@@ -65,16 +86,20 @@ int run_command(const CommandArgs& args) {
   SourceOptions source_options;
   source_options.stop_requested = &g_stop_requested;
   std::unique_ptr<Source> source = make_source(config, source_options);
-  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config);
+  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config, *source);
   const SourceInfo info = source->info();
-  // --record: the source's frames, as delivered, to a bag on a writer thread (never blocking).
+  // --record: the source's frames, as delivered, to a bag on a writer thread (never blocking),
+  // each with the robot state processing will measure it against.
+  std::unique_ptr<RobotStateSource> recorder_states;
   std::optional<Recorder> recorder;
   std::optional<RecordingSource> recording;
   if (!args.record.empty()) {
     RecorderParams params = recorder_params(config, args.record, info);
     const RecordOnError on_error = params.on_error;
     recorder.emplace(std::move(params));
-    recording.emplace(*source, *recorder, on_error);
+    const RecordStateLookup lookup =
+        record_state_lookup(config, *source, *robot_states, config.source.pace, recorder_states);
+    recording.emplace(*source, *recorder, on_error, lookup);
   }
   Source& frames = recording ? static_cast<Source&>(*recording) : *source;
 
@@ -96,7 +121,10 @@ int run_command(const CommandArgs& args) {
   // Simulated runs: truth.contact_label from the simulator's own labels (TruthLabelSink).
   std::optional<TruthLabelSink> labelled;
   if (config.source.type == "sim") labelled.emplace(make_simulator(config), jsonl);
-  TeeSink sinks{labelled ? static_cast<Sink*>(&*labelled) : &jsonl, &console};
+  TeeSink tee{labelled ? static_cast<Sink*>(&*labelled) : &jsonl, &console};
+  std::optional<RecordCountersSink> with_record;
+  if (recorder) with_record.emplace(tee, *recorder);
+  Sink& sinks = with_record ? static_cast<Sink&>(*with_record) : tee;
 
   RunHeader header = make_run_header(config, info);
   header.unknown_background_share = pipeline.unknown_background_share();  // a loaded background's

@@ -9,10 +9,12 @@
 
 #include "hrcsense/types.hpp"
 
+#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -29,6 +31,10 @@ class BagWriteError : public std::runtime_error {
 };
 
 enum class BagCompression { none, lz4 };
+
+/// A UR arm's joints as ROS names them (the UR ROS driver's joint_states), joint 1 first.
+inline constexpr std::array<const char*, kJointCount> kUrJointNames = {
+    "shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"};
 
 struct BagWriterParams {
   BagCompression compression = BagCompression::lz4;  ///< the D435's SDK default
@@ -47,6 +53,9 @@ struct BagWriterParams {
   uint32_t fps = 30;                ///< written in the streams' StreamInfo
   /// A chunk is closed once its uncompressed size exceeds this (the SDK: 768 KiB).
   size_t chunk_bytes = 768 * 1024;
+  /// The names add_joint_state gives the joints, joint 1 first (kUrJointNames for a UR arm);
+  /// empty: "joint_0" ... "joint_5".
+  std::vector<std::string> joint_names;
 };
 
 /// Writes one bag; messages go into chunks as they come, the index on close() (or destruction).
@@ -60,8 +69,10 @@ class BagWriter {
   BagWriter& operator=(const BagWriter&) = delete;
 
   /// The frame's depth image (and its colour image when it has one, with depth_to_color as
-  /// the colour stream's tf). Stream info, camera_info and tf go out with a stream's first frame.
-  void add_frame(const Frame& frame);
+  /// the colour stream's tf), and with `robot_state` the robot's joints at it (add_joint_state:
+  /// positions and velocities), in that order: colour, joints, depth. Stream info, camera_info
+  /// and tf go out with a stream's first frame.
+  void add_frame(const Frame& frame, const RobotState* robot_state = nullptr);
   /// The depth image alone. Bag time: the frame's timestamp relative to the first frame's
   /// (plus 2 ns: the SDK's playback reads streams from there), header stamp: its timestamp.
   void add_depth(const Frame& frame);
@@ -69,9 +80,12 @@ class BagWriter {
   /// depth→colour extrinsics) is the colour stream's tf.
   void add_color(int64_t timestamp_ns, const ColorImage& color, const Intrinsics& intrinsics,
                  const Pose& T_color_depth = Pose::Identity());
-  /// The robot's joints at a frame as `/hrcsense/joint_states` (sensor_msgs/JointState,
-  /// positions in rad; names "joint_0".. as hrcsense's JointAngles order).
-  void add_joint_state(int64_t timestamp_ns, const JointAngles& joints_rad);
+  /// The robot's joints at a frame as `/hrcsense/joint_states` (sensor_msgs/JointState stamped
+  /// `timestamp_ns`: names from params.joint_names, positions in rad, velocities in rad/s when
+  /// given, no efforts). Write it before the frame's depth image: a reader in file order
+  /// (BagSource) then has a frame's joints when the frame arrives.
+  void add_joint_state(int64_t timestamp_ns, const JointAngles& position_rad,
+                       const std::optional<JointAngles>& velocity_rad_s = std::nullopt);
 
   /// Flushes the last chunk, writes the index (unless params.write_index is false) and patches
   /// the bag header. Further calls do nothing.

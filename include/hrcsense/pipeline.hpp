@@ -113,10 +113,21 @@ struct RunOptions {
   double camera_latency_s = 0.0;
 };
 
+/// True when run_pipeline gives a frame without its own host time (Frame::host_time_ns 0) its
+/// source timestamp as host time: with a `sim` or `recorded` robot state (they live on the
+/// source's timeline, paced or not) and in an unpaced run with a `fixed` one; false: the frame's
+/// delivery time on the run's clock (docs/ROBOT.md, "Clocks").
+bool host_time_is_source_time(RobotStateOrigin origin, bool paced);
+
+/// How long before a frame's host time its robot state is looked up: camera_latency_s in ns,
+/// but 0 for a `recorded` state, which is the state processing used for the frame when it was
+/// recorded, the latency already applied.
+int64_t robot_state_lookup_offset_ns(RobotStateOrigin origin, double camera_latency_s);
+
 /// Runs capture, processing and output on three threads joined by mailboxes. Unpaced runs
 /// process every frame (the source waits for processing); paced runs drop and count.
 /// Each frame gets the robot state `robot_states` has at the frame's host time minus
-/// camera_latency_s. The host time is the source's own (a live camera's capture time) when it
+/// robot_state_lookup_offset_ns (camera_latency_s). The host time is the source's own (a live camera's capture time) when it
 /// sets Frame::host_time_ns; else the source timestamp with a `sim` state and for unpaced runs
 /// with a `fixed` one, and the delivery time on the run's clock otherwise (docs/ROBOT.md,
 /// "Clocks").

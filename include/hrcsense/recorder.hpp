@@ -5,6 +5,8 @@
 #pragma once
 
 #include "hrcsense/bag_writer.hpp"
+#include "hrcsense/clock.hpp"
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/source.hpp"
 #include "hrcsense/types.hpp"
 
@@ -49,12 +51,13 @@ class Recorder {
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
 
-  /// Queues a copy of `frame` (and the robot's joints at it, when given) for the writer; false
-  /// when it was dropped (queue full, or recording ended by an error). Never blocks on the disk.
-  bool push(const Frame& frame, const std::optional<JointAngles>& joints_rad = std::nullopt);
+  /// Queues a copy of `frame` (and the robot's state at it, when given: joints and velocities
+  /// go to /hrcsense/joint_states) for the writer; false when it was dropped (queue full, or
+  /// recording ended by an error). Never blocks on the disk.
+  bool push(const Frame& frame, const std::optional<RobotState>& robot_state = std::nullopt);
   /// As push(), but waits (at most `timeout_ms`) for room in the queue: for `hrcsense record`,
   /// where the recorder is the only consumer and should lose nothing to a fast source.
-  bool push_wait(const Frame& frame, int timeout_ms, const std::optional<JointAngles>& joints_rad = std::nullopt);
+  bool push_wait(const Frame& frame, int timeout_ms, const std::optional<RobotState>& robot_state = std::nullopt);
   /// True once a write error happened (stats().error says which file and why).
   bool failed() const;
   /// Writes what is queued, closes (and indexes) the last file, joins the thread. Idempotent.
@@ -64,9 +67,9 @@ class Recorder {
  private:
   struct Item {
     Frame frame;
-    std::optional<JointAngles> joints_rad;
+    std::optional<RobotState> robot_state;
   };
-  bool enqueue(const Frame& frame, const std::optional<JointAngles>& joints_rad, int timeout_ms);
+  bool enqueue(const Frame& frame, const std::optional<RobotState>& robot_state, int timeout_ms);
   void writer_loop();
   void write_item(const Item& item);
   void open_next_file(const Frame& first);
@@ -84,12 +87,29 @@ class Recorder {
   std::thread thread_;
 };
 
-/// A Source that records every frame its inner source delivers (before any filter) and passes
-/// it on unchanged. With record.on_error stop, a write error ends the source with that error.
+/// How the robot state of a frame is found for its recording: the way run_pipeline's
+/// processing will look it up (docs/RECORDINGS.md, "Joint states"), so that the recording holds
+/// the state the frame was measured against.
+struct RecordStateLookup {
+  RobotStateSource* states = nullptr;    ///< null: no joint states are recorded
+  /// host_time_is_source_time(origin, paced) of the run: a frame without its own host time is
+  /// looked up at its timestamp (true) or at its delivery time on `clock` (false).
+  bool host_time_is_source_time = true;
+  int64_t lookup_offset_ns = 0;          ///< robot_state_lookup_offset_ns(origin, camera_latency_s)
+  const RunClock* clock = nullptr;       ///< the run's clock; null: the steady clock
+};
+
+/// The state `lookup.states` gives for `frame` at the time processing will ask for it; nullopt
+/// when it has no valid one (the frame is then recorded without joints, and replays as a stop).
+std::optional<RobotState> robot_state_for_recording(const Frame& frame, const RecordStateLookup& lookup);
+
+/// A Source that records every frame its inner source delivers (before any filter), with the
+/// robot state of `lookup`, and passes it on unchanged. With record.on_error stop, a write
+/// error ends the source with that error.
 class RecordingSource : public Source {
  public:
-  RecordingSource(Source& inner, Recorder& recorder, RecordOnError on_error)
-      : inner_(inner), recorder_(recorder), on_error_(on_error) {}
+  RecordingSource(Source& inner, Recorder& recorder, RecordOnError on_error, RecordStateLookup lookup = {})
+      : inner_(inner), recorder_(recorder), on_error_(on_error), lookup_(lookup) {}
   SourceInfo info() const override { return inner_.info(); }
   Status next(Frame& out) override;
   std::string error() const override { return error_.empty() ? inner_.error() : error_; }
@@ -100,6 +120,7 @@ class RecordingSource : public Source {
   Source& inner_;
   Recorder& recorder_;
   RecordOnError on_error_;
+  RecordStateLookup lookup_;
   std::string error_;
 };
 

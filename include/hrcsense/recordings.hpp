@@ -3,6 +3,7 @@
 #pragma once
 
 #include "hrcsense/pipeline.hpp"
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/types.hpp"
 
 #include <cstdint>
@@ -51,6 +52,9 @@ struct RecordingParams {
   bool loop = false;                ///< start over at the end (indices and timestamps keep rising)
   float stereo_baseline_mm = 0.0F;  ///< used when the recording does not carry a baseline
   bool with_color = false;          ///< also decode colour frames into Frame::color (bag, folder)
+  /// bag: also read the robot's joint states (/hrcsense/joint_states) for recorded_robot_state();
+  /// a malformed one is then an error like a damaged frame.
+  bool with_joint_states = false;
 };
 
 /// A folder of depth PNGs. Two layouts:
@@ -124,6 +128,14 @@ class BagSource : public Source {
   /// returns `error` with a message naming the file and byte offset; every later call too.
   Status next(Frame& out) override;
   std::string error() const override;
+  /// With `with_joint_states`: the recorded joint states as a RobotStateSource (origin
+  /// `recorded`; docs/RECORDINGS.md, "Joint states"): for each frame the state stamped with its
+  /// timestamp, exactly, as this source has read it (the recording writes a frame's joint state
+  /// before its images); none for a frame is an invalid state. Joints are mapped by name
+  /// (UR's, optionally prefixed, or joint_0..joint_5). May outlive this source. Null without
+  /// `with_joint_states`, or when the bag has no /hrcsense/joint_states topic (indexed: anywhere;
+  /// not indexed: before its first depth frame).
+  std::unique_ptr<RobotStateSource> recorded_robot_state() const;
 
  private:
   RecordingParams params_;

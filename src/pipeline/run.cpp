@@ -186,7 +186,7 @@ void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const R
                      const RunClock& clock, double max_frame_age_s, Mailbox<Captured>& frames,
                      Mailbox<FrameResult>& results, ProcessingStats& stats) {
   const int64_t max_frame_age_ns = seconds_to_ns(max_frame_age_s);
-  const int64_t camera_latency_ns = std::llround(options.camera_latency_s * 1e9);
+  const int64_t camera_latency_ns = robot_state_lookup_offset_ns(robot_states.origin(), options.camera_latency_s);
   Captured in;
   FrameResult result;
   RobotState robot_state;
@@ -303,6 +303,18 @@ FrameResult output_loop(Sink& sink, const Source& source, const RunClock& clock,
 
 }  // namespace
 
+bool host_time_is_source_time(RobotStateOrigin origin, bool paced) {
+  // The simulated arm lives on the simulator's timeline and a recorded one on the recording's,
+  // and so do unpaced runs against a fixed arm; paced runs and live robot states live on the host's.
+  return origin == RobotStateOrigin::sim || origin == RobotStateOrigin::recorded ||
+         (!paced && origin == RobotStateOrigin::fixed);
+}
+
+int64_t robot_state_lookup_offset_ns(RobotStateOrigin origin, double camera_latency_s) {
+  if (origin == RobotStateOrigin::recorded) return 0;
+  return std::llround(camera_latency_s * 1e9);
+}
+
 RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline& pipeline, Sink& sink,
                         const RunOptions& options, const RunHeader& header) {
   SteadyClock steady;
@@ -321,13 +333,8 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
   std::string output_error;
 
   sink.header(header);
-  // The simulated arm lives on the simulator's timeline, and so do unpaced runs against a fixed
-  // arm; paced runs and live robot states live on the host's.
-  const RobotStateOrigin origin = robot_states.origin();
-  const bool host_time_is_source_time =
-      origin == RobotStateOrigin::sim || (!options.pace && origin == RobotStateOrigin::fixed);
-  std::thread capture(
-      [&] { capture_loop(source, options, clock, max_frame_age_s, host_time_is_source_time, frames, outcome); });
+  const bool source_time = host_time_is_source_time(robot_states.origin(), options.pace);
+  std::thread capture([&] { capture_loop(source, options, clock, max_frame_age_s, source_time, frames, outcome); });
   std::thread processing(
       [&] { processing_loop(pipeline, robot_states, options, clock, max_frame_age_s, frames, results, stats); });
   const FrameResult last = output_loop(sink, source, clock, max_frame_age_s, results, summary, output_error);

@@ -2,9 +2,11 @@
 // hrcsense — the SDK's topics and messages in a bag: classification and ROS1 deserialisation.
 #include "bag_messages.hpp"
 
+#include "hrcsense/bag_writer.hpp"
 #include "hrcsense/camera.hpp"
 #include "hrcsense/io.hpp"
 
+#include <array>
 #include <cmath>
 
 namespace hrcsense::bag {
@@ -20,6 +22,10 @@ constexpr uint32_t kMaxSidePx = 16384;
 
 TopicRole classify_topic(std::string_view topic) {
   TopicRole out;
+  if (topic == kJointStatesTopic) {
+    out.role = Role::joint_states;
+    return out;
+  }
   if (topic == "/file_version") {
     out.role = Role::file_version;
     return out;
@@ -123,6 +129,88 @@ std::string parse_transform(Cursor c, Pose& out) {
   out = Pose::Identity();
   out.linear() = q.normalized().toRotationMatrix();
   out.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+  return {};
+}
+
+namespace {
+
+/// True when `name` is `base`, or ends with it after a prefix whose last character is '_' or '/'.
+bool names_joint(std::string_view name, std::string_view base) {
+  if (name.size() < base.size() || name.substr(name.size() - base.size()) != base) return false;
+  if (name.size() == base.size()) return true;
+  const char before = name[name.size() - base.size() - 1];
+  return before == '_' || before == '/';
+}
+
+/// More joints than any arm with a gripper has; a damaged count cannot make the parser loop long.
+constexpr uint32_t kMaxJointStateJoints = 64;
+
+}  // namespace
+
+int joint_index(std::string_view name) {
+  for (int j = 0; j < kJointCount; ++j) {
+    if (names_joint(name, kUrJointNames[static_cast<size_t>(j)])) return j;
+    if (names_joint(name, "joint_" + std::to_string(j))) return j;
+  }
+  return -1;
+}
+
+std::string parse_joint_state(Cursor c, JointStateMessage& out) {
+  c.get<uint32_t>();  // header.seq
+  const auto sec = c.get<uint32_t>();
+  const auto nsec = c.get<uint32_t>();
+  c.string();  // header.frame_id
+  const auto count = c.get<uint32_t>();
+  if (!c.ok) return "joint_states message is cut off";
+  if (count > kMaxJointStateJoints) {
+    return "joint_states name[] has " + std::to_string(count) + " entries (at most " +
+           std::to_string(kMaxJointStateJoints) + ")";
+  }
+  std::array<int, kMaxJointStateJoints> joint_of{};  // message entry -> hrcsense joint, or -1
+  std::array<bool, kJointCount> named{};
+  for (uint32_t i = 0; i < count; ++i) {
+    const std::string_view name = c.string();
+    if (!c.ok) return "joint_states message is cut off in name[" + std::to_string(i) + "]";
+    const int j = joint_index(name);
+    joint_of[i] = j;
+    if (j < 0) continue;
+    if (named[static_cast<size_t>(j)]) {
+      return "joint_states name[" + std::to_string(i) + "] '" + std::string(name) + "' names joint " +
+             kUrJointNames[static_cast<size_t>(j)] + " again";
+    }
+    named[static_cast<size_t>(j)] = true;
+  }
+  for (int j = 0; j < kJointCount; ++j) {
+    if (!named[static_cast<size_t>(j)]) {
+      return std::string("joint_states has no joint ") + kUrJointNames[static_cast<size_t>(j)] + " (or joint_" +
+             std::to_string(j) + ")";
+    }
+  }
+  // position[] must match name[]; velocity[] and effort[] may also be empty (not measured).
+  const char* const arrays[] = {"position", "velocity", "effort"};
+  JointStateMessage message;
+  for (int a = 0; a < 3; ++a) {
+    const auto n = c.get<uint32_t>();
+    if (!c.ok) return std::string("joint_states message is cut off before ") + arrays[a] + "[]";
+    if (n != count && (a == 0 || n != 0)) {
+      return std::string("joint_states ") + arrays[a] + "[] has " + std::to_string(n) + " entries, name[] " +
+             std::to_string(count);
+    }
+    if (a == 1) message.has_velocity = n != 0;
+    for (uint32_t i = 0; i < n; ++i) {
+      const auto value = c.get<double>();
+      if (!c.ok) return std::string("joint_states message is cut off in ") + arrays[a] + "[]";
+      const int j = joint_of[i];
+      if (j < 0 || a == 2) continue;  // efforts are not used
+      if (!std::isfinite(value)) {
+        return std::string("joint_states ") + arrays[a] + "[" + std::to_string(i) + "] (" +
+               kUrJointNames[static_cast<size_t>(j)] + ") is not finite";
+      }
+      (a == 0 ? message.position_rad : message.velocity_rad_s)[static_cast<size_t>(j)] = value;
+    }
+  }
+  message.stamp_ns = static_cast<int64_t>(sec) * 1000000000LL + nsec;
+  out = message;
   return {};
 }
 

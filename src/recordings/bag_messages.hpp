@@ -13,7 +13,10 @@
 namespace hrcsense::bag {
 
 /// What a topic of the SDK's layout carries, as far as hrcsense cares.
-enum class Role { other, image, camera_info, tf, depth_units, stereo_baseline, file_version };
+enum class Role { other, image, camera_info, tf, depth_units, stereo_baseline, file_version, joint_states };
+
+/// hrcsense's own topic beside the SDK's: the robot's joints at each frame (sensor_msgs/JointState).
+inline constexpr std::string_view kJointStatesTopic = "/hrcsense/joint_states";
 
 /// A topic, classified: its role and, for stream topics, the stream ("Depth_0", "Color_0").
 struct TopicRole {
@@ -77,6 +80,25 @@ std::string parse_image(Cursor cursor, ImageView& out);
 std::string parse_camera_info(Cursor cursor, Intrinsics& out);
 /// Parses a geometry_msgs/Transform: P_stream = R·P_ref + t, i.e. T_stream_ref.
 std::string parse_transform(Cursor cursor, Pose& out);
+
+/// A sensor_msgs/JointState of /hrcsense/joint_states, its joints in hrcsense's order.
+struct JointStateMessage {
+  int64_t stamp_ns = 0;           ///< header stamp (0: the parser's caller uses the bag time)
+  JointAngles position_rad{};     ///< joint 1 (shoulder pan) first
+  JointAngles velocity_rad_s{};   ///< zeros when the message has no velocities
+  bool has_velocity = false;
+};
+
+/// The 0-based hrcsense joint of a JointState name, or -1 for a joint hrcsense does not know (a
+/// gripper's, say). Known: UR's ROS names (`shoulder_pan_joint` ... `wrist_3_joint`) and
+/// hrcsense's older `joint_0` ... `joint_5`, either after a prefix that ends in '_' or '/'
+/// (`ur_shoulder_pan_joint`, `arm/elbow_joint`). Never by position in the message.
+int joint_index(std::string_view name);
+
+/// Parses a JointState, mapping each joint by name (joint_index); unknown joints are ignored.
+/// "" or what is wrong: cut off, more than 64 joints, arrays of unequal length, one of the six
+/// joints missing or named twice, a non-finite position or velocity (naming the field).
+std::string parse_joint_state(Cursor cursor, JointStateMessage& out);
 
 }  // namespace hrcsense::bag
 

@@ -2,12 +2,14 @@
 // hrcsense — a RealSense .bag as a Source: the depth stream with its calibration and units.
 #include "bag_messages.hpp"
 #include "bag_reader.hpp"
+#include "recorded_robot_state.hpp"
 
 #include "hrcsense/io.hpp"
 #include "hrcsense/recordings.hpp"
 
 #include <cstring>
 #include <map>
+#include <memory>
 
 namespace hrcsense {
 
@@ -32,6 +34,8 @@ struct BagState {
   RecordingStream color_info{"color", "", {}, 0, 0, 0};
   ColorImage color;                          ///< the latest decoded colour frame
   bool have_color = false;
+  /// RecordingParams::with_joint_states: the /hrcsense/joint_states read so far; null without.
+  std::shared_ptr<RecordedRobotState> joint_states;
   // Playback.
   Frame pending;                             ///< the first frame, read while opening
   bool has_pending = false;
@@ -120,6 +124,17 @@ void decode_depth(BagState& s, const BagMessage& m, const bag::ImageView& image,
   out.truth.reset();
 }
 
+/// Hands a /hrcsense/joint_states message to s.joint_states, stamped on the playback's timeline
+/// as the frames are; "" or what is wrong with it, naming the frame it comes before.
+std::string read_joint_state(BagState& s, const BagMessage& m, const bag::Cursor& cursor) {
+  bag::JointStateMessage joints;
+  const std::string problem = bag::parse_joint_state(cursor, joints);
+  if (!problem.empty()) return "before frame " + std::to_string(s.played) + ": " + problem;
+  const int64_t stamp_ns = (joints.stamp_ns != 0 ? joints.stamp_ns : m.time_ns) + s.lap_offset_ns;
+  s.joint_states->add(stamp_ns, joints.position_rad, joints.velocity_rad_s);
+  return {};
+}
+
 /// Handles messages until one depth frame has been decoded into `out` (true) or the bag ends
 /// (false). Colour frames are decoded only when `with_color`. Throws IoError on damage.
 bool read_depth_frame(BagState& s, bool with_color, Frame& out) {
@@ -147,6 +162,9 @@ bool read_depth_frame(BagState& s, bool with_color, Frame& out) {
         break;
       case bag::Role::tf:
         problem = bag::parse_transform(cursor, s.tf[role.stream]);
+        break;
+      case bag::Role::joint_states:
+        if (s.joint_states) problem = read_joint_state(s, m, cursor);
         break;
       case bag::Role::image: {
         bag::ImageView image;
@@ -198,10 +216,13 @@ void set_color_calibration(const BagState& s, Frame& out) {
 }  // namespace
 
 BagSource::BagSource(RecordingParams params) : params_(std::move(params)), state_(std::make_unique<BagState>(params_.path)) {
-  // Chunks holding only images nobody asked for (colour without with_color, infrared) are not
-  // even decompressed: the SDK writes one chunk per large frame, so this halves the work.
-  state_->reader.set_wanted([with_color = params_.with_color](const BagConnection& connection) {
+  if (params_.with_joint_states) state_->joint_states = std::make_shared<RecordedRobotState>(params_.path);
+  // Chunks holding only images nobody asked for (colour without with_color, infrared), or
+  // joint states without with_joint_states, are not even decompressed: the SDK writes one chunk per large frame, so this halves the work.
+  state_->reader.set_wanted([with_color = params_.with_color, with_joints = params_.with_joint_states](
+                                const BagConnection& connection) {
     const bag::TopicRole role = bag::classify_topic(connection.topic);
+    if (role.role == bag::Role::joint_states) return with_joints;
     if (role.role != bag::Role::image) return true;
     return role.stream.rfind("Depth_", 0) == 0 || (with_color && role.stream.rfind("Color_", 0) == 0);
   });
@@ -266,7 +287,19 @@ Source::Status BagSource::next(Frame& out) {
     out.depth_to_color.reset();
   }
   out.index = s.played++;
+  if (s.joint_states) s.joint_states->frame_delivered(out.timestamp_ns);
   return Status::frame;
+}
+
+std::unique_ptr<RobotStateSource> BagSource::recorded_robot_state() const {
+  const BagState& s = *state_;
+  if (!s.joint_states) return nullptr;
+  // Indexed: every connection is known at open; scanned: those before the first depth frame,
+  // where a recording made by hrcsense has its first joint state.
+  for (const auto& [id, connection] : s.reader.connections()) {
+    if (connection.topic == bag::kJointStatesTopic) return share_recorded_robot_state(s.joint_states);
+  }
+  return nullptr;
 }
 
 /// Reads a whole bag for `summarize_recording`.

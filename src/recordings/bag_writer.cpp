@@ -378,27 +378,37 @@ void BagWriter::add_color(int64_t timestamp_ns, const ColorImage& color, const I
             static_cast<size_t>(color.width) * 3, 0.0F);
 }
 
-void BagWriter::add_frame(const Frame& frame) {
-  // Colour first: a reader that pairs each depth frame with the latest colour frame in file
-  // order (hrcsense's BagSource) then gets this frame's own.
+void BagWriter::add_frame(const Frame& frame, const RobotState* robot_state) {
+  // Colour and joints first: a reader that pairs each depth frame with the latest colour frame
+  // and joint state in file order (hrcsense's BagSource) then gets this frame's own. The joints
+  // after the colour keep an SDK-sized colour image in a chunk of its own, which a reader that
+  // wants no colour skips undecompressed.
   if (frame.color && frame.color->width > 0) {
     const Pose T_color_depth = frame.depth_to_color ? extrinsics_pose(*frame.depth_to_color) : Pose::Identity();
     add_color(frame.timestamp_ns, *frame.color, frame.color_intrinsics, T_color_depth);
   }
+  if (robot_state != nullptr) add_joint_state(frame.timestamp_ns, robot_state->q_rad, robot_state->qd_rad_s);
   add_depth(frame);
 }
 
-void BagWriter::add_joint_state(int64_t timestamp_ns, const JointAngles& joints_rad) {
+void BagWriter::add_joint_state(int64_t timestamp_ns, const JointAngles& position_rad,
+                                const std::optional<JointAngles>& velocity_rad_s) {
   std::vector<uint8_t> b;
   put32(b, 0);  // header: seq, stamp, frame_id
   put_time(b, timestamp_ns);
   put_string(b, "");
-  put32(b, static_cast<uint32_t>(joints_rad.size()));  // name[]
-  for (size_t i = 0; i < joints_rad.size(); ++i) put_string(b, "joint_" + std::to_string(i));
-  put32(b, static_cast<uint32_t>(joints_rad.size()));  // position[]
-  for (double q : joints_rad) put_f64(b, q);
-  put32(b, 0);  // velocity[], effort[]: not known
-  put32(b, 0);
+  const bool named = params_.joint_names.size() == position_rad.size();
+  put32(b, static_cast<uint32_t>(position_rad.size()));  // name[]
+  for (size_t i = 0; i < position_rad.size(); ++i) {
+    put_string(b, named ? params_.joint_names[i] : "joint_" + std::to_string(i));
+  }
+  put32(b, static_cast<uint32_t>(position_rad.size()));  // position[]
+  for (double q : position_rad) put_f64(b, q);
+  put32(b, velocity_rad_s ? static_cast<uint32_t>(velocity_rad_s->size()) : 0U);  // velocity[]
+  if (velocity_rad_s) {
+    for (double qd : *velocity_rad_s) put_f64(b, qd);
+  }
+  put32(b, 0);  // effort[]: not known
   put_message(topic(kJointStatesTopic, "sensor_msgs/JointState", kJointStateMd5), bag_time(timestamp_ns), b);
 }
 

@@ -22,15 +22,15 @@ Recorder::Recorder(RecorderParams params) : params_(std::move(params)) {
 
 Recorder::~Recorder() { close(); }
 
-bool Recorder::push(const Frame& frame, const std::optional<JointAngles>& joints_rad) {
-  return enqueue(frame, joints_rad, 0);
+bool Recorder::push(const Frame& frame, const std::optional<RobotState>& robot_state) {
+  return enqueue(frame, robot_state, 0);
 }
 
-bool Recorder::push_wait(const Frame& frame, int timeout_ms, const std::optional<JointAngles>& joints_rad) {
-  return enqueue(frame, joints_rad, timeout_ms);
+bool Recorder::push_wait(const Frame& frame, int timeout_ms, const std::optional<RobotState>& robot_state) {
+  return enqueue(frame, robot_state, timeout_ms);
 }
 
-bool Recorder::enqueue(const Frame& frame, const std::optional<JointAngles>& joints_rad, int timeout_ms) {
+bool Recorder::enqueue(const Frame& frame, const std::optional<RobotState>& robot_state, int timeout_ms) {
   std::unique_lock<std::mutex> lock(mutex_);
   const auto has_room = [this] {
     return closing_ || !stats_.error.empty() || queue_.size() < static_cast<size_t>(params_.queue_frames);
@@ -50,7 +50,7 @@ bool Recorder::enqueue(const Frame& frame, const std::optional<JointAngles>& joi
   // spare item reuses its buffers' capacity.
   item.frame = frame;
   item.frame.truth.reset();  // ground truth is not recorded
-  item.joints_rad = joints_rad;
+  item.robot_state = robot_state;
   lock.lock();
   if (writer_exited_) {  // close() finished meanwhile: nobody would write it
     ++stats_.frames_dropped;
@@ -104,8 +104,7 @@ void Recorder::write_item(const Item& item) {
     writer_.reset();
   }
   if (!writer_) open_next_file(item.frame);
-  writer_->add_frame(item.frame);
-  if (item.joints_rad) writer_->add_joint_state(item.frame.timestamp_ns, *item.joints_rad);
+  writer_->add_frame(item.frame, item.robot_state ? &*item.robot_state : nullptr);
 }
 
 void Recorder::writer_loop() {
@@ -151,6 +150,22 @@ void Recorder::writer_loop() {
   }
 }
 
+std::optional<RobotState> robot_state_for_recording(const Frame& frame, const RecordStateLookup& lookup) {
+  if (lookup.states == nullptr) return std::nullopt;
+  // As run_pipeline: a live camera's own host time; else the timestamp or the delivery time.
+  // The delivery time is read here, just before the run reads it (a paced run's wait between
+  // the two makes the recorded state of a live robot earlier by that wait).
+  int64_t host_time_ns = frame.host_time_ns;
+  if (host_time_ns == 0) {
+    static const SteadyClock steady;
+    const RunClock& clock = lookup.clock != nullptr ? *lookup.clock : steady;
+    host_time_ns = lookup.host_time_is_source_time ? frame.timestamp_ns : clock.now_ns();
+  }
+  RobotState state;
+  if (!lookup.states->state_at(host_time_ns - lookup.lookup_offset_ns, state) || !state.valid) return std::nullopt;
+  return state;
+}
+
 Source::Status RecordingSource::next(Frame& out) {
   if (!error_.empty()) return Status::error;
   const Status status = inner_.next(out);
@@ -159,7 +174,7 @@ Source::Status RecordingSource::next(Frame& out) {
     error_ = "recording: " + recorder_.stats().error;
     return Status::error;
   }
-  recorder_.push(out);
+  recorder_.push(out, robot_state_for_recording(out, lookup_));
   return status;
 }
 

@@ -312,6 +312,34 @@ void JsonLinesSink::frame(const FrameResult& result) {
   write_line();
 }
 
+namespace {
+
+/// `record`: the recorder's counters, null when the run recorded nothing.
+void put_record_counters(Members& m, const std::optional<RecordCounters>& record) {
+  if (!record) {
+    m.null("record");
+    return;
+  }
+  m.open("record");
+  m.integer("frames_recorded", record->frames_recorded);
+  m.integer("frames_dropped", record->frames_dropped);
+  put_key(m.line, "files");
+  m.line += '[';
+  for (size_t i = 0; i < record->files.size(); ++i) {
+    if (i > 0) m.line += ',';
+    put_string(m.line, record->files[i]);
+  }
+  m.line += ']';
+  if (record->error.empty()) {
+    m.null("error");
+  } else {
+    m.text("error", record->error);
+  }
+  m.close();
+}
+
+}  // namespace
+
 void JsonLinesSink::summary(const RunSummary& summary) {
   line_.assign("{");
   Members m{line_};
@@ -365,6 +393,7 @@ void JsonLinesSink::summary(const RunSummary& summary) {
     m.text("last_problem", robot.last_problem);
   }
   m.close();
+  put_record_counters(m, summary.record);
   line_ += "}\n";
   write_line();
 }

@@ -386,12 +386,13 @@ TEST(RobotStateConfig, JointsAreRequiredOnlyForTheFixedSource) {
   test::expect_config_error("", {"robot.model=ur5"}, {"'robot.joints_rad'", "robot.state.source fixed"});
   const Config live = load_config("", {"robot.model=ur5", "robot.state.source=recorded"});
   EXPECT_EQ(live.robot_state.source, "recorded");
-  // The assembly says what this build lacks, naming the key.
+  // Recorded joint states come from a bag source: the assembly says so, naming the key.
   try {
     (void)make_robot_state_source(live);
     FAIL() << "no error";
   } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()), "configuration: robot.state.source 'recorded': not built into this hrcsense");
+    EXPECT_EQ(std::string(e.what()),
+              "configuration: robot.state.source recorded: the joint states come from the recording (source.type bag)");
   }
 }
 

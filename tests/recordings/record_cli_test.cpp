@@ -7,6 +7,7 @@
 #include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/recordings.hpp"
+#include "../../src/recordings/bag_messages.hpp"
 #include "../../src/recordings/bag_reader.hpp"
 
 #include <gtest/gtest.h>
@@ -142,13 +143,9 @@ TEST(RecordCli, RecordsTheRequestedFramesAndDuration) {
   for (int guard = 0; guard < 1000 && reader.next(m); ++guard) {
     if (reader.connections().at(m.conn).topic != "/hrcsense/joint_states") continue;
     ++joint_states;
-    const size_t positions_at = 16 + 4 + 6 * 11 + 4;  // header, name[] of "joint_0".."joint_5", count
-    ASSERT_GE(m.size, positions_at + 48);
-    for (size_t j = 0; j < 6; ++j) {
-      double q = 0.0;
-      std::memcpy(&q, m.data + positions_at + 8 * j, 8);
-      EXPECT_EQ(q, joints_rad[j]) << "joint " << j;
-    }
+    bag::JointStateMessage joints;
+    ASSERT_EQ(bag::parse_joint_state(bag::Cursor{m.data, m.size}, joints), "");
+    EXPECT_EQ(joints.position_rad, joints_rad);
   }
   EXPECT_EQ(joint_states, 7);
   // 30 frames/s: 0.5 s of source time holds frames 0..14.

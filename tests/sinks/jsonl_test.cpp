@@ -411,5 +411,30 @@ TEST(JsonLinesSink, NoRobotStatusKeyForSourcesWithoutOne) {
   EXPECT_FALSE(lines[1].contains("robot_status"));
 }
 
+// `run --record`: the recorder's counters as their own object, apart from the pipeline's
+// frames_dropped; null when the run recorded nothing.
+TEST(JsonLinesSink, SummaryHasTheRecordersCountersOrNull) {
+  std::ostringstream out;
+  JsonLinesSink sink(out);
+  RunSummary summary;
+  summary.frames_dropped = 2;
+  sink.summary(summary);
+  summary.record = RecordCounters{297, 3, {"rec/a-000.bag", "rec/\"b\"-001.bag"}, ""};
+  sink.summary(summary);
+  summary.record->error = "rec/a-001.bag: write failed at byte 5: No space left on device";
+  sink.summary(summary);
+  const std::vector<json> lines = parse_lines(out.str());
+  ASSERT_EQ(lines.size(), 3U);
+  ASSERT_TRUE(lines[0].contains("record"));
+  EXPECT_TRUE(lines[0]["record"].is_null());
+  const json& record = lines[1]["record"];
+  EXPECT_EQ(record["frames_recorded"], 297);
+  EXPECT_EQ(record["frames_dropped"], 3);
+  EXPECT_EQ(record["files"], json::array({"rec/a-000.bag", "rec/\"b\"-001.bag"}));
+  EXPECT_TRUE(record["error"].is_null());
+  EXPECT_EQ(lines[1]["frames_dropped"], 2);
+  EXPECT_EQ(lines[2]["record"]["error"], "rec/a-001.bag: write failed at byte 5: No space left on device");
+}
+
 }  // namespace
 }  // namespace hrcsense
