@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 namespace hrcsense::ros2 {
 namespace {
@@ -64,11 +65,18 @@ builtin_interfaces_msg_dds__Time_ stamp_from_ns(int64_t ns) {
   return stamp;
 }
 
+namespace {
+
+bool fits_float(double value) { return std::isfinite(value) && std::fabs(value) <= std::numeric_limits<float>::max(); }
+
+}  // namespace
+
 Intrinsics intrinsics_from_camera_info(const sensor_msgs_msg_dds__CameraInfo_& info, const std::string& topic) {
   const std::string where = topic + ": CameraInfo ";
   const double* k = info.k;
+  // Intrinsics are float32 (as the SDK's): a double beyond float's range would become inf.
   for (double value : info.k) {
-    if (!std::isfinite(value)) throw Ros2Error(where + "k: not finite");
+    if (!fits_float(value)) throw Ros2Error(where + "k: not finite as float32");
   }
   // K = [fx 0 cx; 0 fy cy; 0 0 1] (row-major): anything else is not a pinhole this maps.
   if (!(k[0] > 0.0) || !(k[4] > 0.0) || k[3] != 0.0 || k[6] != 0.0 || k[7] != 0.0 || k[8] != 1.0) {
@@ -84,13 +92,16 @@ Intrinsics intrinsics_from_camera_info(const sensor_msgs_msg_dds__CameraInfo_& i
   intrinsics.fy = static_cast<float>(k[4]);
   intrinsics.ppx = static_cast<float>(k[2]);
   intrinsics.ppy = static_cast<float>(k[5]);
+  if (!(intrinsics.fx > 0.0F) || !(intrinsics.fy > 0.0F)) {  // a positive double below float's range is 0
+    throw Ros2Error(where + "k: fx, fy are 0 as float32");
+  }
   // k[1] (skew) is ignored: realsense-ros writes 0, and DESIGN's model has none.
 
   const std::string model = text_of(info.distortion_model);
   const double* d = info.d._buffer;
   const size_t n = info.d._length;
   for (size_t i = 0; i < n; ++i) {
-    if (!std::isfinite(d[i])) throw Ros2Error(where + "d[" + std::to_string(i) + "]: not finite");
+    if (!fits_float(d[i])) throw Ros2Error(where + "d[" + std::to_string(i) + "]: not finite as float32");
   }
   const std::string count_text = std::to_string(n) + " coefficients";
   if (model == "plumb_bob" || model == "rational_polynomial") {
@@ -154,6 +165,7 @@ std::string depth_image_problem(const sensor_msgs_msg_dds__Image_& image, int wi
   if (encoding != "16UC1" && encoding != "mono16") {
     return "encoding '" + encoding + "': expected 16UC1 (millimetres) or mono16";
   }
+  if (image.width == 0 || image.height == 0) return "size " + size_text(image.width, image.height) + ": empty";
   if (image.width != static_cast<uint32_t>(width) || image.height != static_cast<uint32_t>(height)) {
     return "size " + size_text(image.width, image.height) + ": expected " +
            size_text(static_cast<uint32_t>(width), static_cast<uint32_t>(height)) + " (its CameraInfo at the start)";

@@ -147,6 +147,26 @@ TEST(Ros2CameraInfo, NotAPinholeOrWrongCountIsAnError) {
   EXPECT_THROW(intrinsics_from_camera_info(h.get(), "t"), Ros2Error);
 }
 
+// CameraInfo holds doubles, Intrinsics float32 (as the SDK's): a focal length that is positive
+// as a double but 0 or inf as a float, or a coefficient beyond float's range, is refused
+// (found by fuzz_ros2).
+TEST(Ros2CameraInfo, ValuesOutsideFloatRangeAreAnError) {
+  for (double fx : {1e-300, 1e300}) {
+    InfoFixture f;
+    f.info.k[0] = fx;
+    EXPECT_THROW(intrinsics_from_camera_info(f.get(), "t"), Ros2Error) << fx;
+  }
+  InfoFixture g;
+  g.info.k[2] = -1e39;  // cx
+  EXPECT_THROW(intrinsics_from_camera_info(g.get(), "t"), Ros2Error);
+  InfoFixture h;
+  h.d = {1e39, 0.0, 0.0, 0.0, 0.0};
+  EXPECT_THROW(intrinsics_from_camera_info(h.get(), "t"), Ros2Error);
+  InfoFixture ok;
+  ok.info.k[0] = 1e-3;  // small but a float: accepted
+  EXPECT_FLOAT_EQ(intrinsics_from_camera_info(ok.get(), "t").fx, 1e-3F);
+}
+
 TEST(Ros2CameraInfo, FillWritesWhatRealsenseRosWrites) {
   Intrinsics in;
   in.width = 640;
@@ -234,6 +254,11 @@ TEST(Ros2DepthImage, WrongEncodingSizeStepOrLengthIsNamed) {
   DepthFixture i;
   i.bytes.pop_back();
   EXPECT_NE(depth_image_problem(i.get(), 3, 2).find("data 15 bytes"), std::string::npos);
+  DepthFixture empty;  // 0 columns with no data: refused even when 0 was expected (found by fuzz_ros2)
+  empty.image.width = 0;
+  empty.image.step = 0;
+  empty.bytes.clear();
+  EXPECT_NE(depth_image_problem(empty.get(), 0, 2).find("size 0x2: empty"), std::string::npos);
 }
 
 TEST(Ros2ColorImage, Bgr8IsSwappedToRgb) {
