@@ -27,19 +27,8 @@ struct CommandArgs {
 int run_command(const CommandArgs& args);
 /// record --out FILE.bag [--frames N | --duration-s S]: the source's frames, unfiltered, to a bag.
 int record_command(const CommandArgs& args);
-/// The recorder of `record` and `run --record` from record.* (creates the file's folder).
-RecorderParams recorder_params(const Config& config, const std::string& path, const SourceInfo& info);
-/// Logs the files written and the counters (and the error, naming the file) to stderr.
-void log_recording(const RecorderStats& stats);
 /// publish: the configured source as realsense-ros topics over Cyclone DDS (publish.*).
 int publish_command(const CommandArgs& args);
-/// How a recording of `source`'s frames finds each frame's robot state: as the run's processing
-/// looks it up in `run_states` (paced or not). A `sim` or `fixed` state is asked of a second
-/// source of the configuration, made into `own` (the same answers; a late simulated state
-/// keeps a history that the recorder's lookups, a frame ahead of processing's, would reset);
-/// live and recorded ones are shared (one connection; their lookups change nothing).
-RecordStateLookup record_state_lookup(const Config& config, Source& source, RobotStateSource& run_states, bool paced,
-                                      std::unique_ptr<RobotStateSource>& own);
 int info_command(const CommandArgs& args);
 /// devices: the RealSense cameras connected, with their depth profiles (docs/CAMERAS.md); in a
 /// build without the SDK, the error saying how to get it.

@@ -1,154 +1,19 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense CLI — `hrcsense run`: configured source → pipeline → JSON Lines (+ progress on stderr).
 #include "commands.hpp"
-#include "common/app_errors.hpp"
-#include "common/assembly.hpp"
-#include "common/console_sink.hpp"
-#include "common/tee_sink.hpp"
-#include "common/truth_label_sink.hpp"
+#include "common/run_session.hpp"
 
 #include "hrcsense/config.hpp"
-#include "hrcsense/sinks.hpp"
-
-#include <spdlog/spdlog.h>
-
-#include <algorithm>
-#include <atomic>
-#include <csignal>
-#include <filesystem>
-#include <fstream>
-#include <iostream>
-#include <optional>
 
 namespace hrcsense::app {
-namespace {
-
-// Set by SIGINT, SIGTERM (systemd's stop) or SIGHUP (the terminal closed); the pipeline polls
-// it and ends the run with a final stop line and a summary.
-std::atomic<bool> g_stop_requested{false};
-std::atomic<int> g_stop_signal{0};
-
-extern "C" void on_stop_signal(int signal) {
-  g_stop_requested.store(true);
-  g_stop_signal.store(signal);
-  std::signal(signal, SIG_DFL);  // a second one kills, in case the run is stuck
-}
-
-constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
-
-// SIGPIPE is ignored for the whole run: a reader that goes away makes the write fail (EPIPE),
-// and the failed sink ends the run, instead of the signal killing it mid-line.
-void install_signal_handlers() {
-  g_stop_requested.store(false);
-  g_stop_signal.store(0);
-  for (int signal : kStopSignals) std::signal(signal, on_stop_signal);
-  std::signal(SIGPIPE, SIG_IGN);
-}
-
-// Adds the recorder's counters to the summary. The summary comes after the run's final stop, so
-// closing the recording here (writing what is still queued) never delays a verdict.
-class RecordCountersSink final : public Sink {
- public:
-  RecordCountersSink(Sink& inner, Recorder& recorder) : inner_(inner), recorder_(recorder) {}
-  void header(const RunHeader& header) override { inner_.header(header); }
-  void frame(const FrameResult& result) override { inner_.frame(result); }
-  void summary(const RunSummary& summary) override {
-    RunSummary with_record = summary;
-    const RecorderStats stats = recorder_.close();
-    with_record.record = RecordCounters{stats.frames_recorded, stats.frames_dropped, stats.files, stats.error};
-    inner_.summary(with_record);
-  }
-  bool failed() const override { return inner_.failed(); }
-  std::string failure() const override { return inner_.failure(); }
-
- private:
-  Sink& inner_;
-  Recorder& recorder_;
-};
-
-void restore_signal_handlers() {
-  for (int signal : kStopSignals) std::signal(signal, SIG_DFL);
-}
-
-const char* signal_name(int signal) {
-  switch (signal) {
-    case SIGINT: return "SIGINT";
-    case SIGTERM: return "SIGTERM";
-    case SIGHUP: return "SIGHUP";
-    default: return "a signal";
-  }
-}
-
-}  // namespace
 
 int run_command(const CommandArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
-  SourceOptions source_options;
-  source_options.stop_requested = &g_stop_requested;
-  std::unique_ptr<Source> source = make_source(config, source_options);
-  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config, *source);
-  const SourceInfo info = source->info();
-  // --record: the source's frames, as delivered, to a bag on a writer thread (never blocking),
-  // each with the robot state processing will measure it against.
-  std::unique_ptr<RobotStateSource> recorder_states;
-  std::optional<Recorder> recorder;
-  std::optional<RecordingSource> recording;
-  if (!args.record.empty()) {
-    RecorderParams params = recorder_params(config, args.record, info);
-    const RecordOnError on_error = params.on_error;
-    recorder.emplace(std::move(params));
-    const RecordStateLookup lookup =
-        record_state_lookup(config, *source, *robot_states, config.source.pace, recorder_states);
-    recording.emplace(*source, *recorder, on_error, lookup);
-  }
-  Source& frames = recording ? static_cast<Source&>(*recording) : *source;
-
-  Pipeline pipeline(config.pipeline);
-  const bool background_loaded = load_background_file(config, info, pipeline);
-  if (background_loaded) spdlog::info("background loaded from {}", config.background_path);
-
-  std::ofstream file;
-  if (!args.out.empty()) {
-    const std::filesystem::path parent = std::filesystem::path(args.out).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent);
-    file.open(args.out, std::ios::out | std::ios::trunc);
-    if (!file) return report_error(args.out + ": cannot open for writing", kExitRuntime);
-  }
-  std::ostream& out = args.out.empty() ? std::cout : file;
-
-  JsonLinesSink jsonl(out, config.pipeline.backend);
-  ConsoleSink console;
-  // Simulated runs: truth.contact_label from the simulator's own labels (TruthLabelSink).
-  std::optional<TruthLabelSink> labelled;
-  if (config.source.type == "sim") labelled.emplace(make_simulator(config), jsonl);
-  TeeSink tee{labelled ? static_cast<Sink*>(&*labelled) : &jsonl, &console};
-  std::optional<RecordCountersSink> with_record;
-  if (recorder) with_record.emplace(tee, *recorder);
-  Sink& sinks = with_record ? static_cast<Sink&>(*with_record) : tee;
-
-  RunHeader header = make_run_header(config, info);
-  header.unknown_background_share = pipeline.unknown_background_share();  // a loaded background's
-  if (!header.filters.note.empty()) spdlog::warn("filters: {}", header.filters.note);
-
-  RunOptions options;
-  options.pace = config.source.pace;
-  options.camera_latency_s = config.robot_state.camera_latency_s;
-  options.max_frames = args.frames;
-  options.stop_requested = &g_stop_requested;
-  install_signal_handlers();
-  const RunSummary summary = run_pipeline(frames, *robot_states, pipeline, sinks, options, header);
-  restore_signal_handlers();
-  if (g_stop_signal.load() != 0) spdlog::info("{} received: the run ended with a stop", signal_name(g_stop_signal.load()));
-
-  if (recorder) log_recording(recorder->close());
-  if (!background_loaded) save_learnt_background(config, pipeline);
-  const std::string out_name = args.out.empty() ? "stdout" : args.out;
-  out.flush();
-  if (!out) return report_error(out_name + ": write failed; the run ended there", kExitRuntime);
-  // The output ends with a stop line and a summary either way (when it can still be written);
-  // the exit code tells scripts that the source, the processing or the output failed.
-  if (!summary.error.empty()) return report_error(summary.error, kExitRuntime);
-  return 0;
+  SessionOptions options;
+  options.frames = args.frames;
+  options.out = args.out;
+  options.record = args.record;
+  return run_session(config, options);
 }
 
 }  // namespace hrcsense::app

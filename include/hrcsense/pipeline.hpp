@@ -18,6 +18,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -111,6 +112,11 @@ struct RunOptions {
   /// `robot.state.camera_latency_s`: the robot state is looked up this much before the frame's
   /// host time (positive: the camera's image is older than its stamp says).
   double camera_latency_s = 0.0;
+  /// Called on the processing thread with each frame, the pipeline and its result once the
+  /// verdict is final (stale check included), before the result goes to the output: the
+  /// viewer's tap (hrcsense-view). It delays the output by what it costs, so it must copy and
+  /// return, never wait (a headless snapshot, which waits on purpose, runs unpaced).
+  std::function<void(const Frame&, const Pipeline&, const FrameResult&)> on_processed;
 };
 
 /// True when run_pipeline gives a frame without its own host time (Frame::host_time_ns 0) its

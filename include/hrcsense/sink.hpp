@@ -80,6 +80,9 @@ struct RunSummary {
   RobotStatusCounts robot_status; ///< the controller's status over the frames written
   double unknown_background_share = -1.0;  ///< Pipeline::unknown_background_share at the end; < 0: no background
   std::optional<RecordCounters> record;   ///< the recording's counters; none when the run records nothing
+  /// Frames the viewer (hrcsense-view) never drew, apart from frames_dropped: its mailbox kept
+  /// only the newest; none when no viewer watched the run.
+  std::optional<int64_t> viewer_frames_dropped;
 };
 
 /// A consumer of results. The other virtual interface of hrcsense.

@@ -198,6 +198,7 @@ void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const R
       result.timestamp_warning = in.timestamp_warning;
       const int64_t age_ns = clock.now_ns() - in.captured_ns;
       if (age_ns > max_frame_age_ns) result.verdict = stop_verdict(ReasonCode::stale_frame, "stale frame");
+      if (options.on_processed) options.on_processed(in.frame, pipeline, result);
       ++stats.processed;
       stats.latencies.add(result.latency_us);
       if (!(options.pace ? results.put(result) : results.put_wait(result))) break;  // the output ended

@@ -348,6 +348,11 @@ void JsonLinesSink::summary(const RunSummary& summary) {
   m.integer("frames_processed", summary.frames_processed);
   m.integer("frames_dropped", summary.frames_dropped);
   m.integer("frames_dropped_camera", summary.frames_dropped_camera);
+  if (summary.viewer_frames_dropped) {
+    m.integer("viewer_frames_dropped", *summary.viewer_frames_dropped);
+  } else {
+    m.null("viewer_frames_dropped");
+  }
   m.integer("frames_valid", summary.frames_valid);
   m.integer("verdict_run", summary.verdict_run);
   m.integer("verdict_slow", summary.verdict_slow);

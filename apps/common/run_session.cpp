@@ -1,0 +1,182 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense apps — one run of the configured cell (run_session.hpp).
+#include "common/run_session.hpp"
+
+#include "common/app_errors.hpp"
+#include "common/assembly.hpp"
+#include "common/console_sink.hpp"
+#include "common/record_setup.hpp"
+#include "common/tee_sink.hpp"
+#include "common/truth_label_sink.hpp"
+
+#include "hrcsense/recorder.hpp"
+#include "hrcsense/sinks.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <utility>
+
+namespace hrcsense::app {
+namespace {
+
+// Set by SIGINT, SIGTERM (systemd's stop) or SIGHUP (the terminal closed); the pipeline polls
+// it and ends the run with a final stop line and a summary.
+std::atomic<bool> g_stop_requested{false};
+std::atomic<int> g_stop_signal{0};
+
+extern "C" void on_stop_signal(int signal) {
+  g_stop_requested.store(true);
+  g_stop_signal.store(signal);
+  std::signal(signal, SIG_DFL);  // a second one kills, in case the run is stuck
+}
+
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+// SIGPIPE is ignored for the whole run: a reader that goes away makes the write fail (EPIPE),
+// and the failed sink ends the run, instead of the signal killing it mid-line.
+void install_signal_handlers() {
+  g_stop_requested.store(false);
+  g_stop_signal.store(0);
+  for (int signal : kStopSignals) std::signal(signal, on_stop_signal);
+  std::signal(SIGPIPE, SIG_IGN);
+}
+
+// Adds the recorder's counters to the summary. The summary comes after the run's final stop, so
+// closing the recording here (writing what is still queued) never delays a verdict.
+class RecordCountersSink final : public Sink {
+ public:
+  RecordCountersSink(Sink& inner, Recorder& recorder) : inner_(inner), recorder_(recorder) {}
+  void header(const RunHeader& header) override { inner_.header(header); }
+  void frame(const FrameResult& result) override { inner_.frame(result); }
+  void summary(const RunSummary& summary) override {
+    RunSummary with_record = summary;
+    const RecorderStats stats = recorder_.close();
+    with_record.record = RecordCounters{stats.frames_recorded, stats.frames_dropped, stats.files, stats.error};
+    inner_.summary(with_record);
+  }
+  bool failed() const override { return inner_.failed(); }
+  std::string failure() const override { return inner_.failure(); }
+
+ private:
+  Sink& inner_;
+  Recorder& recorder_;
+};
+
+// Adds the viewer's drops to the summary (the viewer's mailbox, read after the run).
+class ViewerCountersSink final : public Sink {
+ public:
+  ViewerCountersSink(Sink& inner, std::function<int64_t()> dropped) : inner_(inner), dropped_(std::move(dropped)) {}
+  void header(const RunHeader& header) override { inner_.header(header); }
+  void frame(const FrameResult& result) override { inner_.frame(result); }
+  void summary(const RunSummary& summary) override {
+    RunSummary with_viewer = summary;
+    with_viewer.viewer_frames_dropped = dropped_();
+    inner_.summary(with_viewer);
+  }
+  bool failed() const override { return inner_.failed(); }
+  std::string failure() const override { return inner_.failure(); }
+
+ private:
+  Sink& inner_;
+  std::function<int64_t()> dropped_;
+};
+
+void restore_signal_handlers() {
+  for (int signal : kStopSignals) std::signal(signal, SIG_DFL);
+}
+
+const char* signal_name(int signal) {
+  switch (signal) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    default: return "a signal";
+  }
+}
+
+}  // namespace
+
+void request_session_stop() { g_stop_requested.store(true); }
+
+int run_session(const Config& config, const SessionOptions& args) {
+  const bool paced = config.source.pace && !args.unpaced;
+  SourceOptions source_options;
+  source_options.stop_requested = &g_stop_requested;
+  std::unique_ptr<Source> source = make_source(config, source_options);
+  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config, *source);
+  const SourceInfo info = source->info();
+  // --record: the source's frames, as delivered, to a bag on a writer thread (never blocking),
+  // each with the robot state processing will measure it against.
+  std::unique_ptr<RobotStateSource> recorder_states;
+  std::optional<Recorder> recorder;
+  std::optional<RecordingSource> recording;
+  if (!args.record.empty()) {
+    RecorderParams params = recorder_params(config, args.record, info);
+    const RecordOnError on_error = params.on_error;
+    recorder.emplace(std::move(params));
+    const RecordStateLookup lookup =
+        record_state_lookup(config, *source, *robot_states, paced, recorder_states);
+    recording.emplace(*source, *recorder, on_error, lookup);
+  }
+  Source& frames = recording ? static_cast<Source&>(*recording) : *source;
+
+  Pipeline pipeline(config.pipeline);
+  const bool background_loaded = load_background_file(config, info, pipeline);
+  if (background_loaded) spdlog::info("background loaded from {}", config.background_path);
+
+  std::ofstream file;
+  if (!args.out.empty()) {
+    const std::filesystem::path parent = std::filesystem::path(args.out).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
+    file.open(args.out, std::ios::out | std::ios::trunc);
+    if (!file) return report_error(args.out + ": cannot open for writing", kExitRuntime);
+  }
+  std::ostream& out = args.out.empty() ? std::cout : file;
+
+  JsonLinesSink jsonl(out, config.pipeline.backend);
+  ConsoleSink console;
+  // Simulated runs: truth.contact_label from the simulator's own labels (TruthLabelSink).
+  std::optional<TruthLabelSink> labelled;
+  if (config.source.type == "sim") labelled.emplace(make_simulator(config), jsonl);
+  TeeSink tee{labelled ? static_cast<Sink*>(&*labelled) : &jsonl, &console};
+  std::optional<RecordCountersSink> with_record;
+  if (recorder) with_record.emplace(tee, *recorder);
+  Sink& recorded = with_record ? static_cast<Sink&>(*with_record) : tee;
+  std::optional<ViewerCountersSink> with_viewer;
+  if (args.viewer_frames_dropped) with_viewer.emplace(recorded, args.viewer_frames_dropped);
+  Sink& sinks = with_viewer ? static_cast<Sink&>(*with_viewer) : recorded;
+
+  RunHeader header = make_run_header(config, info);
+  header.unknown_background_share = pipeline.unknown_background_share();  // a loaded background's
+  if (!header.filters.note.empty()) spdlog::warn("filters: {}", header.filters.note);
+
+  RunOptions options;
+  options.pace = paced;
+  options.camera_latency_s = config.robot_state.camera_latency_s;
+  options.max_frames = args.frames;
+  options.stop_requested = &g_stop_requested;
+  options.on_processed = args.on_processed;
+  install_signal_handlers();
+  const RunSummary summary = run_pipeline(frames, *robot_states, pipeline, sinks, options, header);
+  restore_signal_handlers();
+  if (g_stop_signal.load() != 0) spdlog::info("{} received: the run ended with a stop", signal_name(g_stop_signal.load()));
+
+  if (recorder) log_recording(recorder->close());
+  if (!background_loaded) save_learnt_background(config, pipeline);
+  const std::string out_name = args.out.empty() ? "stdout" : args.out;
+  out.flush();
+  if (!out) return report_error(out_name + ": write failed; the run ended there", kExitRuntime);
+  // The output ends with a stop line and a summary either way (when it can still be written);
+  // the exit code tells scripts that the source, the processing or the output failed.
+  if (!summary.error.empty()) return report_error(summary.error, kExitRuntime);
+  return 0;
+}
+
+}  // namespace hrcsense::app

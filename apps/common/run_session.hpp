@@ -1,0 +1,38 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense apps — one run of the configured cell, as `hrcsense run` and `hrcsense-view` both
+// make it: source (and its recording), robot states, pipeline, background, JSON Lines and
+// console output, signal handling. The viewer joins through the hooks; nothing here knows it.
+#pragma once
+
+#include "hrcsense/config.hpp"
+#include "hrcsense/pipeline.hpp"
+#include "hrcsense/sink.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+namespace hrcsense::app {
+
+struct SessionOptions {
+  int64_t frames = -1;  ///< --frames N; -1: the source's length
+  std::string out;      ///< --out FILE; empty: stdout
+  std::string record;   ///< --record FILE.bag; empty: no recording
+  /// Play the source as fast as processing goes, whatever source.pace says (headless
+  /// snapshots). A live camera paces itself either way.
+  bool unpaced = false;
+  /// RunOptions::on_processed: a viewer's tap on the processing thread.
+  std::function<void(const Frame&, const Pipeline&, const FrameResult&)> on_processed;
+  /// Set: the summary reports `viewer_frames_dropped` from it (read once the run has ended).
+  std::function<int64_t()> viewer_frames_dropped;
+};
+
+/// Runs the configured cell to its end (source end, --frames, a signal or
+/// request_session_stop()) and returns the process exit code; errors are logged to stderr.
+int run_session(const Config& config, const SessionOptions& options);
+
+/// Ends a running session as SIGINT would (a final stop line, then the summary): the viewer's
+/// quit key and window close. Safe from any thread.
+void request_session_stop();
+
+}  // namespace hrcsense::app

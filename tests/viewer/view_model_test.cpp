@@ -1,0 +1,277 @@
+// SPDX-License-Identifier: Apache-2.0
+// The viewer's CPU side without a display: the colour map and its equalisation against hand
+// values, the robot's pixels against hand-solved ray-capsule geometry, the markers at their
+// pinhole projections, the shown state (NO DATA) on injected times, the layout rule, and the
+// view tap's mailbox (drops counted, snapshot frames waited for).
+#include "viewer/view_model.hpp"
+#include "viewer/view_tap.hpp"
+
+#include "hrcsense/config.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <thread>
+
+namespace hrcsense::view {
+namespace {
+
+Rgb pixel(const ColorImage& image, int u, int v) {
+  const size_t i = 3 * (static_cast<size_t>(v) * image.width + u);
+  return {image.rgb[i], image.rgb[i + 1], image.rgb[i + 2]};
+}
+
+// A 200×100 pinhole camera, focal 100 px, principal point (100, 50).
+Intrinsics test_camera() {
+  Intrinsics in;
+  in.width = 200;
+  in.height = 100;
+  in.fx = 100.0F;
+  in.fy = 100.0F;
+  in.ppx = 100.0F;
+  in.ppy = 50.0F;
+  return in;
+}
+
+TEST(Jet, HandValuesAtTheStopsAndBetween) {
+  EXPECT_EQ(jet(0.0F), (Rgb{0, 0, 255}));
+  EXPECT_EQ(jet(0.25F), (Rgb{0, 255, 255}));
+  EXPECT_EQ(jet(0.5F), (Rgb{255, 255, 0}));
+  EXPECT_EQ(jet(0.75F), (Rgb{255, 0, 0}));
+  EXPECT_EQ(jet(1.0F), (Rgb{50, 0, 0}));
+  EXPECT_EQ(jet(0.125F), (Rgb{0, 128, 255}));  // 127.5 rounds up
+  EXPECT_EQ(jet(0.375F), (Rgb{128, 255, 128}));
+  EXPECT_EQ(jet(0.875F), (Rgb{153, 0, 0}));    // (255 + 50) / 2 = 152.5
+  EXPECT_EQ(jet(-3.0F), jet(0.0F));
+  EXPECT_EQ(jet(7.0F), jet(1.0F));
+  EXPECT_EQ(jet(std::nanf("")), jet(0.0F));
+}
+
+TEST(Jet, NoMarkerColourIsAJetColour) {
+  for (int i = 0; i <= 100000; ++i) {
+    const Rgb c = jet(static_cast<float>(i) / 100000.0F);
+    EXPECT_NE(c, kContactMarker);
+    EXPECT_NE(c, kRobotMarker);
+    EXPECT_NE(c, kRobotOutline);
+    EXPECT_NE(c, kContactLine);
+  }
+}
+
+TEST(Equalise, ShareOfValidPixelsAtOrBelow) {
+  DepthImage depth;
+  depth.resize(4, 1);
+  depth.pixels = {0, 1000, 1000, 3000};
+  std::vector<uint32_t> histogram;
+  std::vector<float> t;
+  equalise_depth(depth, histogram, t);
+  ASSERT_EQ(t.size(), 4U);
+  EXPECT_FLOAT_EQ(t[0], -1.0F);
+  EXPECT_FLOAT_EQ(t[1], 2.0F / 3.0F);
+  EXPECT_FLOAT_EQ(t[2], 2.0F / 3.0F);
+  EXPECT_FLOAT_EQ(t[3], 1.0F);
+
+  ColorImage rgb;
+  colorize_depth(depth, histogram, t, rgb);
+  EXPECT_EQ(pixel(rgb, 0, 0), (Rgb{0, 0, 0}));     // invalid: black
+  EXPECT_EQ(pixel(rgb, 3, 0), (Rgb{50, 0, 0}));    // the farthest: the map's end
+  // 2/3 of the way: between (255, 255, 0) at 1/2 and (255, 0, 0) at 3/4, f = 2/3 → g = 85.
+  EXPECT_EQ(pixel(rgb, 1, 0), (Rgb{255, 85, 0}));
+}
+
+TEST(RobotMask, HandSolvedCapsuleSilhouette) {
+  // A horizontal capsule 2 m ahead: axis from x = -0.5 to 0.5, radius 0.1 m.
+  ViewCamera camera{test_camera(), Extrinsics{}};
+  const std::vector<Capsule> capsules{{Eigen::Vector3f(-0.5F, 0.0F, 2.0F), Eigen::Vector3f(0.5F, 0.0F, 2.0F), 0.1F, 1}};
+  std::vector<uint8_t> mask;
+  robot_mask(capsules, Pose::Identity(), camera, mask);
+  auto at = [&](int u, int v) { return mask[static_cast<size_t>(v) * 200 + u]; };
+  // Column u = 100: the ray (0, s, 1) passes 2|s| / sqrt(1 + s²) from the axis: inside for
+  // |s| ≤ 0.05006, i.e. |v - 50| ≤ 5 at 100 px focal length.
+  for (int v = 45; v <= 55; ++v) EXPECT_EQ(at(100, v), 1) << "v " << v;
+  EXPECT_EQ(at(100, 44), 0);
+  EXPECT_EQ(at(100, 56), 0);
+  // Row v = 50, the end cap at x = 0.5: the ray (t, 0, 1) is inside while
+  // (2t - 0.5) ≤ 0.1·sqrt(1 + t²): t = 0.30 inside (0.100 ≤ 0.1044), t = 0.31 outside.
+  EXPECT_EQ(at(130, 50), 1);
+  EXPECT_EQ(at(131, 50), 0);
+  EXPECT_EQ(at(70, 50), 1);
+  EXPECT_EQ(at(69, 50), 0);
+  EXPECT_EQ(at(10, 10), 0);
+}
+
+TEST(RobotMask, FollowsTheCameraPoseAndIgnoresWhatIsBehind) {
+  ViewCamera camera{test_camera(), Extrinsics{}};
+  // The base frame 1 m to the camera's right (T_camera_base translates x by +1): a capsule at
+  // base x = -1 lands on the optical axis.
+  Pose T_camera_base = Pose::Identity();
+  T_camera_base.translation() = Eigen::Vector3d(1.0, 0.0, 0.0);
+  const std::vector<Capsule> ahead{{Eigen::Vector3f(-1.0F, -0.2F, 2.0F), Eigen::Vector3f(-1.0F, 0.2F, 2.0F), 0.05F, 0}};
+  std::vector<uint8_t> mask;
+  robot_mask(ahead, T_camera_base, camera, mask);
+  EXPECT_EQ(mask[50 * 200 + 100], 1);
+  EXPECT_EQ(mask[50 * 200 + 110], 0);  // 10 px: 0.2 m off the axis at 2 m, the radius 0.05 m
+  const std::vector<Capsule> behind{{Eigen::Vector3f(0.0F, 0.0F, -2.0F), Eigen::Vector3f(0.1F, 0.0F, -2.0F), 0.2F, 0}};
+  robot_mask(behind, Pose::Identity(), camera, mask);
+  for (uint8_t m : mask) ASSERT_EQ(m, 0);
+}
+
+ViewFrame depth_only_frame() {
+  ViewFrame frame;
+  frame.frame = 7;
+  frame.depth_intrinsics = test_camera();
+  frame.depth.resize(200, 100);
+  std::fill(frame.depth.pixels.begin(), frame.depth.pixels.end(), uint16_t{2000});
+  for (int v = 0; v < 10; ++v) {
+    for (int u = 0; u < 10; ++u) frame.depth.pixels[static_cast<size_t>(v) * 200 + u] = 0;  // a hole, top left
+  }
+  frame.valid = true;
+  return frame;
+}
+
+TEST(Compose, MarkersLandOnThePinholeProjections) {
+  ViewFrame frame = depth_only_frame();
+  frame.contact.valid = true;
+  frame.contact.distance_m = 0.3F;
+  frame.contact.closest_camera = Eigen::Vector3f(0.4F, 0.2F, 2.0F);      // u = 100 + 20, v = 50 + 10
+  frame.contact.closest_robot_base = Eigen::Vector3f(-0.6F, 0.0F, 2.0F); // u = 70, v = 50 (T identity)
+  ComposeScratch scratch;
+  ColorImage out;
+  compose_2d(frame, 0.5F, 3, scratch, out);
+  ASSERT_EQ(out.width, 200);
+  ASSERT_EQ(out.height, 100);
+  EXPECT_EQ(pixel(out, 120, 60), kContactMarker);
+  EXPECT_EQ(pixel(out, 123, 60), kContactMarker);  // the disc's radius, either side
+  EXPECT_EQ(pixel(out, 117, 60), kContactMarker);
+  EXPECT_EQ(pixel(out, 120, 57), kContactMarker);
+  EXPECT_NE(pixel(out, 124, 60), kContactMarker);
+  EXPECT_NE(pixel(out, 120, 64), kContactMarker);
+  EXPECT_EQ(pixel(out, 70, 50), kRobotMarker);
+  EXPECT_EQ(pixel(out, 70, 47), kRobotMarker);
+  EXPECT_EQ(pixel(out, 95, 55), kContactLine);     // on the line between them, (95, 55) of (70, 50)-(120, 60)
+  // Depth only, uniform: every valid pixel the map's end; the hole black.
+  EXPECT_EQ(pixel(out, 5, 5), (Rgb{0, 0, 0}));
+  EXPECT_EQ(pixel(out, 180, 90), (Rgb{50, 0, 0}));
+}
+
+TEST(Compose, DepthOverColourAndTheRobotOutline) {
+  ViewFrame frame = depth_only_frame();
+  frame.color.emplace();
+  frame.color->width = 200;
+  frame.color->height = 100;
+  frame.color->rgb.assign(200 * 100 * 3, 0);
+  for (size_t i = 0; i < frame.color->rgb.size(); i += 3) {
+    frame.color->rgb[i] = 10;
+    frame.color->rgb[i + 1] = 20;
+    frame.color->rgb[i + 2] = 30;
+  }
+  frame.color_intrinsics = test_camera();
+  frame.depth_to_color = Extrinsics{};  // the same camera: aligned depth = depth
+  frame.capsules_base = {{Eigen::Vector3f(-0.5F, 0.0F, 2.0F), Eigen::Vector3f(0.5F, 0.0F, 2.0F), 0.1F, 1}};
+  ComposeScratch scratch;
+  ColorImage out;
+  compose_2d(frame, 0.5F, 3, scratch, out);
+  // Half colour (10, 20, 30), half jet(1) = (50, 0, 0): (30, 10, 15).
+  EXPECT_EQ(pixel(out, 180, 90), (Rgb{30, 10, 15}));
+  // The hole: half colour, half black.
+  EXPECT_EQ(pixel(out, 5, 5), (Rgb{5, 10, 15}));
+  // The capsule of RobotMask.HandSolvedCapsuleSilhouette: rows 45..55 at u = 100, its top and
+  // bottom rows the outline, the inside brightened halfway to white.
+  EXPECT_EQ(pixel(out, 100, 45), kRobotOutline);
+  EXPECT_EQ(pixel(out, 100, 55), kRobotOutline);
+  EXPECT_EQ(pixel(out, 130, 50), kRobotOutline);
+  EXPECT_EQ(pixel(out, 100, 50), (Rgb{142, 132, 135}));  // (30 + 255) / 2 ... rounded down
+  EXPECT_EQ(pixel(out, 100, 44), (Rgb{30, 10, 15}));
+}
+
+TEST(ShownState, NoDataWhenNothingOrTooOld) {
+  ViewFrame frame;
+  EXPECT_EQ(shown_state(frame, 0, 0.5), ShownState::no_data);  // nothing yet
+  frame.frame = 3;
+  frame.made_ns = 1'000'000'000;
+  frame.verdict.state = VerdictState::run;
+  EXPECT_EQ(shown_state(frame, 1'400'000'000, 0.5), ShownState::run);
+  EXPECT_EQ(shown_state(frame, 1'500'000'000, 0.5), ShownState::run);      // exactly the limit
+  EXPECT_EQ(shown_state(frame, 1'500'000'001, 0.5), ShownState::no_data);  // a frozen pipeline
+  frame.verdict.state = VerdictState::slow;
+  EXPECT_EQ(shown_state(frame, 1'100'000'000, 0.5), ShownState::slow);
+  frame.verdict.state = VerdictState::stop;
+  EXPECT_EQ(shown_state(frame, 1'100'000'000, 0.5), ShownState::stop);
+  EXPECT_EQ(shown_state(frame, 1'100'000'000, std::nan("")), ShownState::no_data);
+  EXPECT_NE(state_color(ShownState::no_data), kRunColor);
+  EXPECT_STREQ(state_word(ShownState::no_data), "NO DATA");
+  EXPECT_STREQ(state_word(ShownState::slow), "SLOW");
+}
+
+TEST(Layout, PaneAndFit) {
+  const Rect pane = pane_area(1280, 720, 12, 84);
+  EXPECT_EQ(pane.x, 12);
+  EXPECT_EQ(pane.y, 12);
+  EXPECT_EQ(pane.width, 1256);
+  EXPECT_EQ(pane.height, 612);
+  // 848×480 into 1256×612: height-bound, 612·848/480 = 1081.2 → 1081 wide, centred.
+  const Rect fit = fit_rect(848, 480, pane);
+  EXPECT_EQ(fit.width, 1081);
+  EXPECT_EQ(fit.height, 612);
+  EXPECT_EQ(fit.x, 12 + (1256 - 1081) / 2);
+  EXPECT_EQ(fit.y, 12);
+  // Width-bound: 400×100 into 1256×612 → 1256×314, centred vertically.
+  const Rect wide = fit_rect(400, 100, pane);
+  EXPECT_EQ(wide.width, 1256);
+  EXPECT_EQ(wide.height, 314);
+  EXPECT_EQ(wide.y, 12 + (612 - 314) / 2);
+}
+
+Pipeline walk_pipeline() {
+  const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/walk.yaml", {});
+  return Pipeline(config.pipeline);
+}
+
+TEST(ViewTap, NeverWaitsAndCountsWhatTheRendererMissed) {
+  const Pipeline pipeline = walk_pipeline();
+  ViewTap tap;
+  Frame frame;
+  frame.depth.resize(4, 2);
+  FrameResult result;
+  for (int64_t i = 0; i < 5; ++i) {
+    result.frame = i;
+    tap.offer(frame, pipeline, result);  // nobody takes: each replaces the last
+  }
+  EXPECT_EQ(tap.dropped(), 4);
+  ViewFrame newest;
+  ASSERT_TRUE(tap.take(newest, 1.0));
+  EXPECT_EQ(newest.frame, 4);
+  EXPECT_EQ(newest.depth.width, 4);
+  EXPECT_FALSE(tap.take(newest, 0.0));
+}
+
+TEST(ViewTap, WaitsAtASnapshotFrameUntilDrawn) {
+  const Pipeline pipeline = walk_pipeline();
+  ViewTap tap({3});
+  std::atomic<bool> passed{false};
+  std::thread processing([&] {
+    Frame frame;
+    FrameResult result;
+    for (int64_t i = 0; i < 5; ++i) {
+      result.frame = i;
+      tap.offer(frame, pipeline, result);
+      if (i == 3) passed.store(true);
+    }
+  });
+  // Frame 3 reaches the mailbox and the processing thread waits there.
+  ViewFrame taken;
+  for (int i = 0; i < 500 && !(tap.take(taken, 0.01) && taken.frame == 3); ++i) {
+  }
+  ASSERT_EQ(taken.frame, 3);
+  EXPECT_FALSE(passed.load());
+  EXPECT_EQ(tap.snapshots_pending(), 1U);
+  tap.rendered(3);
+  processing.join();
+  EXPECT_TRUE(passed.load());
+  EXPECT_EQ(tap.snapshots_pending(), 0U);
+}
+
+}  // namespace
+}  // namespace hrcsense::view

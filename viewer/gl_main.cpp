@@ -1,0 +1,287 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense-view — `hrcsense run` with a window: the same flags, sinks and links, and the
+// viewer as one more consumer of the results (docs/VIEWER.md). The run goes on a thread of its
+// own; GLFW and OpenGL stay on the main thread, which reads the newest frame from the view
+// tap's latest-value mailbox. Headless: --snapshot DIR --snapshot-at LIST writes PNGs from an
+// offscreen framebuffer and exits after the last.
+#include "viewer/gl_renderer.hpp"
+#include "viewer/view_model.hpp"
+#include "viewer/view_tap.hpp"
+
+#include "common/app_errors.hpp"
+#include "common/run_session.hpp"
+
+#include "hrcsense/config.hpp"
+#include "hrcsense/io.hpp"
+
+#include <CLI/CLI.hpp>
+#include <GLFW/glfw3.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+using namespace hrcsense;
+using namespace hrcsense::view;
+
+constexpr int kSnapshotWidth = 1280;   // issue E: snapshots are 1280×720
+constexpr int kSnapshotHeight = 720;
+constexpr float kDepthAlpha = 0.5F;    // depth over colour, half and half
+constexpr int kMarkerRadiusPx = 6;
+constexpr double kLingerAfterEndS = 2.0;  // the last verdict stays this long after the run ends
+constexpr int kExitNoDisplay = 3;
+
+struct ViewArgs {
+  std::string config_path;
+  std::vector<std::string> sets;
+  int64_t frames = -1;
+  std::string out;
+  std::string record;
+  std::string snapshot_dir;
+  std::string snapshot_at;
+  int slow_render_ms = 0;  ///< hidden: a deliberately slow renderer (tests of the mailbox)
+};
+
+std::atomic<bool> g_quit{false};
+std::atomic<bool> g_screenshot{false};
+
+void on_key(GLFWwindow* /*window*/, int key, int /*scancode*/, int action, int /*mods*/) {
+  if (action != GLFW_PRESS) return;
+  if (key == GLFW_KEY_Q || key == GLFW_KEY_ESCAPE) g_quit.store(true);
+  if (key == GLFW_KEY_S) g_screenshot.store(true);
+}
+
+std::set<int64_t> parse_frame_list(const std::string& text) {
+  std::set<int64_t> frames;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (item.empty()) continue;
+    size_t used = 0;
+    long long value = -1;
+    try {
+      value = std::stoll(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != item.size() || value < 0) {
+      throw ConfigError("--snapshot-at: '" + item + "' is not a source frame index (0, 1, ...)");
+    }
+    frames.insert(value);
+  }
+  if (frames.empty()) throw ConfigError("--snapshot-at: no frame index given (e.g. --snapshot-at 123,198)");
+  return frames;
+}
+
+int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+std::string glfw_error_text() {
+  const char* description = nullptr;
+  glfwGetError(&description);
+  return description != nullptr ? description : "unknown GLFW error";
+}
+
+int run_viewer(const ViewArgs& args) {
+  const Config config = load_config(args.config_path, args.sets);
+  const bool snapshots = !args.snapshot_dir.empty();
+  std::set<int64_t> snapshot_frames;
+  if (snapshots) {
+    snapshot_frames = parse_frame_list(args.snapshot_at);
+    std::filesystem::create_directories(args.snapshot_dir);
+  } else if (!args.snapshot_at.empty()) {
+    throw ConfigError("--snapshot-at needs --snapshot DIR");
+  }
+  const double max_frame_age_s = config.pipeline.safety.max_frame_age_s;
+
+  // No display: one line and a non-zero exit, never a crash (GLFW would only say "X11: ...").
+  const char* x_display = std::getenv("DISPLAY");
+  const char* wayland_display = std::getenv("WAYLAND_DISPLAY");
+  if ((x_display == nullptr || *x_display == '\0') && (wayland_display == nullptr || *wayland_display == '\0')) {
+    std::fprintf(stderr,
+                 "hrcsense-view: no display (DISPLAY is not set); run it under `xvfb-run -a` for snapshots, or use "
+                 "`hrcsense run`\n");
+    return kExitNoDisplay;
+  }
+  glfwSetErrorCallback(nullptr);
+  if (glfwInit() != GLFW_TRUE) {
+    std::fprintf(stderr, "hrcsense-view: no display (%s); run it under `xvfb-run -a`, or use `hrcsense run`\n",
+                 glfw_error_text().c_str());
+    return kExitNoDisplay;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_VISIBLE, snapshots ? GLFW_FALSE : GLFW_TRUE);
+  GLFWwindow* window = glfwCreateWindow(kSnapshotWidth, kSnapshotHeight, "hrcsense-view", nullptr, nullptr);
+  if (window == nullptr) {
+    const std::string why = glfw_error_text();
+    glfwTerminate();
+    std::fprintf(stderr, "hrcsense-view: no OpenGL 3.3 core context (%s)\n", why.c_str());
+    return kExitNoDisplay;
+  }
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(snapshots ? 0 : 1);
+  glfwSetKeyCallback(window, on_key);  // before ImGui's init, which chains it
+  Renderer renderer;
+  std::string gl_error;
+  if (!renderer.init(window, gl_error)) {
+    renderer.shutdown();
+    glfwDestroyWindow(window);
+    glfwTerminate();
+    std::fprintf(stderr, "hrcsense-view: %s\n", gl_error.c_str());
+    return kExitNoDisplay;
+  }
+
+  ViewTap tap(snapshot_frames);
+  app::SessionOptions options;
+  options.frames = args.frames;
+  options.out = args.out;
+  options.record = args.record;
+  options.unpaced = snapshots;  // snapshots wait for the renderer: a paced clock would drop
+  options.on_processed = [&tap](const Frame& frame, const Pipeline& pipeline, const FrameResult& result) {
+    tap.offer(frame, pipeline, result);
+  };
+  options.viewer_frames_dropped = [&tap] { return tap.dropped(); };
+  std::atomic<bool> session_done{false};
+  int session_code = 0;
+  std::thread session([&] {
+    try {
+      session_code = app::run_session(config, options);
+    } catch (const std::exception& e) {
+      session_code = app::report_error(e);
+    }
+    session_done.store(true);
+  });
+
+  ViewFrame frame;
+  ColorImage image;
+  ColorImage snapshot;
+  ComposeScratch scratch;
+  ViewStats stats;
+  std::vector<double> frame_times_ms;
+  int64_t drawn = 0;
+  const int64_t start_ns = steady_ns();
+  int64_t ended_ns = 0;
+  int exit_code = 0;
+  bool quit_requested = false;
+  while (true) {
+    glfwPollEvents();
+    if (!quit_requested && (g_quit.load() || glfwWindowShouldClose(window))) {
+      quit_requested = true;
+      app::request_session_stop();
+    }
+    const bool fresh = tap.take(frame, 1.0 / 60.0);
+    if (session_done.load() && ended_ns == 0) ended_ns = steady_ns();
+    if (snapshots && session_done.load() && !fresh) break;
+    if (!snapshots && ended_ns != 0 && (quit_requested || steady_ns() - ended_ns > kLingerAfterEndS * 1e9)) break;
+    const bool take_snapshot = snapshots && fresh && snapshot_frames.count(frame.frame) > 0;
+    if (snapshots && !take_snapshot) continue;  // headless: only the listed frames are drawn
+    const auto t0 = std::chrono::steady_clock::now();
+    if (fresh) {
+      if (args.slow_render_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(args.slow_render_ms));
+      compose_2d(frame, kDepthAlpha, kMarkerRadiusPx, scratch, image);
+    }
+    stats.viewer_dropped = tap.dropped();
+    stats.session_ended = ended_ns != 0;
+    const double elapsed_s = static_cast<double>(steady_ns() - start_ns) * 1e-9;
+    stats.display_fps = elapsed_s > 0.0 ? static_cast<double>(drawn) / elapsed_s : 0.0;
+    // The state when drawn: a result older than max_frame_age_s is NO DATA (a frozen pipeline).
+    const ShownState state = shown_state(frame, steady_ns(), max_frame_age_s);
+    if (take_snapshot || (!snapshots && g_screenshot.exchange(false))) {
+      if (!renderer.snapshot(frame, image, state, stats, kSnapshotWidth, kSnapshotHeight, snapshot)) {
+        spdlog::error("snapshot: the offscreen framebuffer could not be made");
+        exit_code = 1;
+      } else {
+        char name[64];
+        std::snprintf(name, sizeof(name), "frame_%06lld.png", static_cast<long long>(frame.frame));
+        const std::filesystem::path dir = snapshots ? std::filesystem::path(args.snapshot_dir) : std::filesystem::path(".");
+        const std::string path = (dir / name).string();
+        write_color_png(path, snapshot);
+        spdlog::info("snapshot: {} ({}, distance {})", path, state_word(state),
+                     frame.contact.valid ? std::to_string(frame.contact.distance_m) + " m" : std::string("none"));
+      }
+      if (take_snapshot) tap.rendered(frame.frame);
+    }
+    if (snapshots && tap.snapshots_pending() == 0) break;
+    if (!snapshots) {
+      int width = 0, height = 0;
+      glfwGetFramebufferSize(window, &width, &height);
+      renderer.draw(frame, image, state, stats, width, height);
+      glfwSwapBuffers(window);
+    }
+    if (fresh) {
+      ++drawn;
+      frame_times_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+  }
+  if (!session_done.load()) app::request_session_stop();
+  tap.close();  // a session waiting at a snapshot frame goes on
+  session.join();
+  const size_t missing = tap.snapshots_pending();
+  if (snapshots && missing > 0) {
+    spdlog::error("snapshot: {} of the --snapshot-at frames never came (the run ended before them)", missing);
+    exit_code = 1;
+  }
+  if (!frame_times_ms.empty()) {
+    std::sort(frame_times_ms.begin(), frame_times_ms.end());
+    // Nearest rank: the smallest time at or above which the share q of frames lies.
+    auto rank = [&](double q) {
+      const size_t n = frame_times_ms.size();
+      return frame_times_ms[std::min(n - 1, static_cast<size_t>(std::ceil(q * static_cast<double>(n))) - 1)];
+    };
+    spdlog::info("viewer: {} frames drawn, {} dropped; frame time p50 {:.2f} ms, p99 {:.2f} ms", drawn, tap.dropped(),
+                 rank(0.5), rank(0.99));
+  }
+  renderer.shutdown();
+  glfwDestroyWindow(window);
+  glfwTerminate();
+  return session_code != 0 ? session_code : exit_code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  spdlog::set_default_logger(spdlog::stderr_color_mt("hrcsense-view"));
+  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
+  CLI::App app{"hrcsense-view: hrcsense run with a window (docs/VIEWER.md); hrcsense is not a safety-rated device"};
+  ViewArgs args;
+  app.add_option("--config", args.config_path, "YAML configuration file (docs/CONFIG.md)");
+  app.add_option("--set", args.sets, "override a key, KEY=VALUE with VALUE in YAML (repeatable)")->allow_extra_args(false);
+  app.add_option("--frames", args.frames, "stop after N source frames, 1 to 10^10 (default: the source's length)")
+      ->check(CLI::Range(int64_t{1}, int64_t{10'000'000'000}));
+  app.add_option("--out", args.out, "JSON Lines output file (default: stdout)");
+  app.add_option("--record", args.record, "also record the source's frames to this RealSense .bag");
+  app.add_option("--snapshot", args.snapshot_dir, "headless: write DIR/frame_%06d.png (1280x720) at --snapshot-at");
+  app.add_option("--snapshot-at", args.snapshot_at, "comma-separated source frame indices for --snapshot");
+  app.add_option("--slow-render-ms", args.slow_render_ms, "testing: sleep this long per frame drawn")
+      ->group("")
+      ->check(CLI::Range(0, 10'000));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    return hrcsense::app::report_error(e.what(), hrcsense::app::kExitUsage);
+  }
+  try {
+    return run_viewer(args);
+  } catch (const std::exception& e) {
+    return hrcsense::app::report_error(e);
+  }
+}

@@ -1,0 +1,328 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense viewer — the 2D pane's pixels on the CPU (view_model.hpp).
+#include "viewer/view_model.hpp"
+
+#include "hrcsense/camera.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hrcsense::view {
+namespace {
+
+constexpr float kRayLength_m = 100.0F;  // the pixel ray as a segment: far beyond any cell
+
+Eigen::Vector3f to_view(const Extrinsics& depth_to_view, const Eigen::Vector3f& p) {
+  return transform_point(depth_to_view, p);
+}
+
+// Squared distance between segments p1–q1 and p2–q2 (the closest points of two segments,
+// clamping the line parameters to [0, 1] in turn).
+float segment_segment_distance_sq(const Eigen::Vector3f& p1, const Eigen::Vector3f& q1, const Eigen::Vector3f& p2,
+                                  const Eigen::Vector3f& q2) {
+  const Eigen::Vector3f d1 = q1 - p1;
+  const Eigen::Vector3f d2 = q2 - p2;
+  const Eigen::Vector3f r = p1 - p2;
+  const float a = d1.squaredNorm();
+  const float e = d2.squaredNorm();
+  const float f = d2.dot(r);
+  float s = 0.0F;
+  float t = 0.0F;
+  constexpr float kEps = 1e-12F;
+  if (a <= kEps && e <= kEps) return r.squaredNorm();
+  if (a <= kEps) {
+    t = std::clamp(f / e, 0.0F, 1.0F);
+  } else {
+    const float c = d1.dot(r);
+    if (e <= kEps) {
+      s = std::clamp(-c / a, 0.0F, 1.0F);
+    } else {
+      const float b = d1.dot(d2);
+      const float denom = a * e - b * b;
+      s = denom > kEps ? std::clamp((b * f - c * e) / denom, 0.0F, 1.0F) : 0.0F;
+      t = (b * s + f) / e;
+      if (t < 0.0F) {
+        t = 0.0F;
+        s = std::clamp(-c / a, 0.0F, 1.0F);
+      } else if (t > 1.0F) {
+        t = 1.0F;
+        s = std::clamp((b - c) / a, 0.0F, 1.0F);
+      }
+    }
+  }
+  return ((p1 + d1 * s) - (p2 + d2 * t)).squaredNorm();
+}
+
+void put_pixel(ColorImage& image, int u, int v, const Rgb& color) {
+  if (u < 0 || v < 0 || u >= image.width || v >= image.height) return;
+  uint8_t* px = &image.rgb[3 * (static_cast<size_t>(v) * image.width + u)];
+  px[0] = color[0];
+  px[1] = color[1];
+  px[2] = color[2];
+}
+
+void blend_pixel(ColorImage& image, int u, int v, const Rgb& toward, int weight_256) {
+  if (u < 0 || v < 0 || u >= image.width || v >= image.height) return;
+  uint8_t* px = &image.rgb[3 * (static_cast<size_t>(v) * image.width + u)];
+  for (int c = 0; c < 3; ++c) px[c] = static_cast<uint8_t>((px[c] * (256 - weight_256) + toward[c] * weight_256) / 256);
+}
+
+void draw_disc(ColorImage& image, const Eigen::Vector2f& centre, int radius_px, const Rgb& color) {
+  const int cu = static_cast<int>(std::lround(centre.x()));
+  const int cv = static_cast<int>(std::lround(centre.y()));
+  for (int dv = -radius_px; dv <= radius_px; ++dv) {
+    for (int du = -radius_px; du <= radius_px; ++du) {
+      if (du * du + dv * dv <= radius_px * radius_px) put_pixel(image, cu + du, cv + dv, color);
+    }
+  }
+}
+
+// A line of 3 px width (DDA over the longer axis), clipped by put_pixel.
+void draw_line(ColorImage& image, const Eigen::Vector2f& from, const Eigen::Vector2f& to, const Rgb& color) {
+  const Eigen::Vector2f delta = to - from;
+  const float length = std::max(std::abs(delta.x()), std::abs(delta.y()));
+  if (!std::isfinite(length)) return;
+  const int steps = std::min(static_cast<int>(std::ceil(length)), 1 << 14);
+  for (int i = 0; i <= steps; ++i) {
+    const Eigen::Vector2f p = steps == 0 ? from : from + delta * (static_cast<float>(i) / steps);
+    const int u = static_cast<int>(std::lround(p.x()));
+    const int v = static_cast<int>(std::lround(p.y()));
+    for (int dv = -1; dv <= 1; ++dv) {
+      for (int du = -1; du <= 1; ++du) put_pixel(image, u + du, v + dv, color);
+    }
+  }
+}
+
+}  // namespace
+
+ViewCamera view_camera(const ViewFrame& frame) {
+  ViewCamera camera;
+  if (frame.color && frame.depth_to_color && frame.color_intrinsics.width == frame.color->width &&
+      frame.color_intrinsics.height == frame.color->height && frame.color->width > 0) {
+    camera.intrinsics = frame.color_intrinsics;
+    camera.depth_to_view = *frame.depth_to_color;
+  } else {
+    camera.intrinsics = frame.depth_intrinsics;
+    camera.depth_to_view = Extrinsics{};
+  }
+  return camera;
+}
+
+std::optional<Eigen::Vector2f> project_to_view(const ViewCamera& camera, const Eigen::Vector3f& point_depth_camera) {
+  return project(camera.intrinsics, to_view(camera.depth_to_view, point_depth_camera));
+}
+
+Rgb jet(float t) {
+  static constexpr std::array<std::array<float, 3>, 5> kStops{
+      {{0.0F, 0.0F, 255.0F}, {0.0F, 255.0F, 255.0F}, {255.0F, 255.0F, 0.0F}, {255.0F, 0.0F, 0.0F}, {50.0F, 0.0F, 0.0F}}};
+  if (!(t > 0.0F)) t = 0.0F;  // NaN too
+  if (t > 1.0F) t = 1.0F;
+  const float x = t * 4.0F;
+  const int i = std::min(static_cast<int>(x), 3);
+  const float f = x - static_cast<float>(i);
+  Rgb out{};
+  for (int c = 0; c < 3; ++c) {
+    const float value = kStops[i][c] + (kStops[i + 1][c] - kStops[i][c]) * f;
+    out[c] = static_cast<uint8_t>(std::lround(value));
+  }
+  return out;
+}
+
+void equalise_depth(const DepthImage& depth, std::vector<uint32_t>& histogram, std::vector<float>& out) {
+  histogram.assign(65536, 0);
+  for (uint16_t d : depth.pixels) ++histogram[d];
+  histogram[0] = 0;
+  for (size_t i = 1; i < histogram.size(); ++i) histogram[i] += histogram[i - 1];
+  const float valid = static_cast<float>(histogram.back());
+  out.resize(depth.pixels.size());
+  for (size_t i = 0; i < depth.pixels.size(); ++i) {
+    const uint16_t d = depth.pixels[i];
+    out[i] = d == 0 ? -1.0F : static_cast<float>(histogram[d]) / valid;
+  }
+}
+
+void colorize_depth(const DepthImage& depth, std::vector<uint32_t>& histogram, std::vector<float>& t, ColorImage& out) {
+  equalise_depth(depth, histogram, t);
+  out.width = depth.width;
+  out.height = depth.height;
+  out.rgb.resize(t.size() * 3);
+  for (size_t i = 0; i < t.size(); ++i) {
+    const Rgb c = t[i] < 0.0F ? Rgb{0, 0, 0} : jet(t[i]);
+    out.rgb[3 * i] = c[0];
+    out.rgb[3 * i + 1] = c[1];
+    out.rgb[3 * i + 2] = c[2];
+  }
+}
+
+void robot_mask(const std::vector<Capsule>& capsules_base, const Pose& T_camera_base, const ViewCamera& camera,
+                std::vector<uint8_t>& mask) {
+  const Intrinsics& in = camera.intrinsics;
+  mask.assign(static_cast<size_t>(in.width) * in.height, 0);
+  if (in.width <= 0 || in.height <= 0) return;
+  const Eigen::Isometry3f T = T_camera_base.cast<float>();
+  for (const Capsule& capsule : capsules_base) {
+    if (!(capsule.radius_m >= 0.0F)) continue;
+    const Eigen::Vector3f a = to_view(camera.depth_to_view, T * capsule.a);
+    const Eigen::Vector3f b = to_view(camera.depth_to_view, T * capsule.b);
+    if (!a.allFinite() || !b.allFinite()) continue;
+    const float r = capsule.radius_m;
+    const float radius_sq = r * r;
+    // The projected bounding box (pixels), or the whole image when the capsule comes near the
+    // camera's plane (its projection is unbounded there).
+    int u0 = 0, v0 = 0, u1 = in.width - 1, v1 = in.height - 1;
+    const float z_min = std::min(a.z(), b.z()) - r;
+    if (z_min <= 0.0F && std::max(a.z(), b.z()) + r <= 0.0F) continue;  // wholly behind
+    if (z_min > 0.05F) {
+      const std::optional<Eigen::Vector2f> pa = project(in, a);
+      const std::optional<Eigen::Vector2f> pb = project(in, b);
+      if (!pa || !pb) continue;
+      const float r_px = std::max(in.fx, in.fy) * r / z_min + 3.0F;
+      u0 = std::max(u0, static_cast<int>(std::floor(std::min(pa->x(), pb->x()) - r_px)));
+      u1 = std::min(u1, static_cast<int>(std::ceil(std::max(pa->x(), pb->x()) + r_px)));
+      v0 = std::max(v0, static_cast<int>(std::floor(std::min(pa->y(), pb->y()) - r_px)));
+      v1 = std::min(v1, static_cast<int>(std::ceil(std::max(pa->y(), pb->y()) + r_px)));
+    }
+    for (int v = v0; v <= v1; ++v) {
+      for (int u = u0; u <= u1; ++u) {
+        uint8_t& m = mask[static_cast<size_t>(v) * in.width + u];
+        if (m) continue;
+        const std::optional<Eigen::Vector3f> ray =
+            deproject(in, Eigen::Vector2f(static_cast<float>(u), static_cast<float>(v)), 1.0F);
+        if (!ray) continue;
+        const Eigen::Vector3f far = ray->normalized() * kRayLength_m;
+        if (segment_segment_distance_sq(Eigen::Vector3f::Zero(), far, a, b) <= radius_sq) m = 1;
+      }
+    }
+  }
+}
+
+void compose_2d(const ViewFrame& frame, float depth_alpha, int marker_radius_px, ComposeScratch& scratch,
+                ColorImage& out) {
+  const ViewCamera camera = view_camera(frame);
+  const Intrinsics& in = camera.intrinsics;
+  const bool with_color = in.width == frame.color_intrinsics.width && frame.color && frame.depth_to_color &&
+                          in.width == frame.color->width;
+  // Depth in the view camera's grid, coloured.
+  const DepthImage* depth = &frame.depth;
+  if (with_color) {
+    scratch.align.apply(frame.depth, frame.depth_intrinsics, in, camera.depth_to_view, scratch.aligned_depth);
+    depth = &scratch.aligned_depth;
+  }
+  out.width = in.width;
+  out.height = in.height;
+  out.rgb.assign(static_cast<size_t>(in.width) * in.height * 3, 0);
+  if (depth->width != in.width || depth->height != in.height) return;  // a frame without depth of its size: black
+  colorize_depth(*depth, scratch.histogram, scratch.t, scratch.depth_rgb);
+  const float alpha = std::clamp(depth_alpha, 0.0F, 1.0F);
+  if (with_color) {
+    const std::vector<uint8_t>& color = frame.color->rgb;
+    for (size_t i = 0; i < out.rgb.size(); ++i) {
+      out.rgb[i] = static_cast<uint8_t>(std::lround((1.0F - alpha) * color[i] + alpha * scratch.depth_rgb.rgb[i]));
+    }
+  } else {
+    out.rgb = scratch.depth_rgb.rgb;
+  }
+  // Foreground points, tinted towards the contact marker's colour over their footprint. The
+  // mask keeps a pixel covered by two points from being tinted twice.
+  const float focal_ratio = frame.depth_intrinsics.fx > 0.0F ? in.fx / frame.depth_intrinsics.fx : 1.0F;
+  const int side = std::clamp(static_cast<int>(std::lround(frame.foreground_footprint * focal_ratio)), 1, 16);
+  scratch.tinted.assign(static_cast<size_t>(in.width) * in.height, 0);
+  for (size_t i = 0; i + 2 < frame.foreground_camera.size(); i += 3) {
+    const Eigen::Vector3f p(frame.foreground_camera[i], frame.foreground_camera[i + 1], frame.foreground_camera[i + 2]);
+    const std::optional<Eigen::Vector2f> px = project_to_view(camera, p);
+    if (!px || !px->allFinite()) continue;
+    const int u0 = static_cast<int>(std::lround(px->x() - 0.5F * static_cast<float>(side - 1)));
+    const int v0 = static_cast<int>(std::lround(px->y() - 0.5F * static_cast<float>(side - 1)));
+    for (int v = std::max(v0, 0); v < std::min(v0 + side, in.height); ++v) {
+      for (int u = std::max(u0, 0); u < std::min(u0 + side, in.width); ++u) {
+        uint8_t& done = scratch.tinted[static_cast<size_t>(v) * in.width + u];
+        if (done) continue;
+        done = 1;
+        blend_pixel(out, u, v, kContactMarker, 96);
+      }
+    }
+  }
+  // The robot: brightened, its outline exact.
+  robot_mask(frame.capsules_base, frame.T_camera_base, camera, scratch.robot);
+  const std::vector<uint8_t>& robot = scratch.robot;
+  for (int v = 0; v < in.height; ++v) {
+    for (int u = 0; u < in.width; ++u) {
+      const size_t i = static_cast<size_t>(v) * in.width + u;
+      if (!robot[i]) continue;
+      const bool edge = u == 0 || v == 0 || u == in.width - 1 || v == in.height - 1 || !robot[i - 1] ||
+                        !robot[i + 1] || !robot[i - in.width] || !robot[i + in.width];
+      if (edge) {
+        put_pixel(out, u, v, kRobotOutline);
+      } else {
+        blend_pixel(out, u, v, Rgb{255, 255, 255}, 128);
+      }
+    }
+  }
+  // The closest pair and the line between them.
+  if (!frame.contact.valid) return;
+  const std::optional<Eigen::Vector2f> contact_px = project_to_view(camera, frame.contact.closest_camera);
+  const Eigen::Vector3f robot_camera = frame.T_camera_base.cast<float>() * frame.contact.closest_robot_base;
+  const std::optional<Eigen::Vector2f> robot_px = project_to_view(camera, robot_camera);
+  if (contact_px && robot_px) draw_line(out, *contact_px, *robot_px, kContactLine);
+  if (robot_px) draw_disc(out, *robot_px, marker_radius_px, kRobotMarker);
+  if (contact_px) draw_disc(out, *contact_px, marker_radius_px, kContactMarker);
+}
+
+ShownState shown_state(const ViewFrame& frame, int64_t now_ns, double max_frame_age_s) {
+  if (frame.frame < 0) return ShownState::no_data;
+  const double age_s = static_cast<double>(now_ns - frame.made_ns) * 1e-9;
+  if (!(age_s <= max_frame_age_s)) return ShownState::no_data;  // NaN age too
+  switch (frame.verdict.state) {
+    case VerdictState::run: return ShownState::run;
+    case VerdictState::slow: return ShownState::slow;
+    case VerdictState::stop: return ShownState::stop;
+  }
+  return ShownState::stop;
+}
+
+Rgb state_color(ShownState state) {
+  switch (state) {
+    case ShownState::run: return kRunColor;
+    case ShownState::slow: return kSlowColor;
+    case ShownState::stop: return kStopColor;
+    case ShownState::no_data: return kNoDataColor;
+  }
+  return kNoDataColor;
+}
+
+const char* state_word(ShownState state) {
+  switch (state) {
+    case ShownState::run: return "RUN";
+    case ShownState::slow: return "SLOW";
+    case ShownState::stop: return "STOP";
+    case ShownState::no_data: return "NO DATA";
+  }
+  return "NO DATA";
+}
+
+Rect fit_rect(int image_width, int image_height, const Rect& area) {
+  if (image_width <= 0 || image_height <= 0 || area.width <= 0 || area.height <= 0) return {area.x, area.y, 0, 0};
+  Rect r;
+  // Integer arithmetic: the same rule in the renderer and in the tests.
+  if (static_cast<int64_t>(area.width) * image_height <= static_cast<int64_t>(area.height) * image_width) {
+    r.width = area.width;
+    r.height = static_cast<int>(static_cast<int64_t>(area.width) * image_height / image_width);
+  } else {
+    r.height = area.height;
+    r.width = static_cast<int>(static_cast<int64_t>(area.height) * image_width / image_height);
+  }
+  r.x = area.x + (area.width - r.width) / 2;
+  r.y = area.y + (area.height - r.height) / 2;
+  return r;
+}
+
+Rect pane_area(int window_width, int window_height, int border_px, int status_px) {
+  Rect r;
+  r.x = border_px;
+  r.y = border_px;
+  r.width = std::max(0, window_width - 2 * border_px);
+  r.height = std::max(0, window_height - 2 * border_px - status_px);
+  return r;
+}
+
+}  // namespace hrcsense::view
