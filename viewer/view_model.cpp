@@ -3,6 +3,7 @@
 #include "viewer/view_model.hpp"
 
 #include "hrcsense/camera.hpp"
+#include "hrcsense/proximity.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -16,41 +17,13 @@ Eigen::Vector3f to_view(const Extrinsics& depth_to_view, const Eigen::Vector3f& 
   return transform_point(depth_to_view, p);
 }
 
-// Squared distance between segments p1–q1 and p2–q2 (the closest points of two segments,
-// clamping the line parameters to [0, 1] in turn).
+// Squared distance between segments p1–q1 and p2–q2.
 float segment_segment_distance_sq(const Eigen::Vector3f& p1, const Eigen::Vector3f& q1, const Eigen::Vector3f& p2,
                                   const Eigen::Vector3f& q2) {
-  const Eigen::Vector3f d1 = q1 - p1;
-  const Eigen::Vector3f d2 = q2 - p2;
-  const Eigen::Vector3f r = p1 - p2;
-  const float a = d1.squaredNorm();
-  const float e = d2.squaredNorm();
-  const float f = d2.dot(r);
   float s = 0.0F;
   float t = 0.0F;
-  constexpr float kEps = 1e-12F;
-  if (a <= kEps && e <= kEps) return r.squaredNorm();
-  if (a <= kEps) {
-    t = std::clamp(f / e, 0.0F, 1.0F);
-  } else {
-    const float c = d1.dot(r);
-    if (e <= kEps) {
-      s = std::clamp(-c / a, 0.0F, 1.0F);
-    } else {
-      const float b = d1.dot(d2);
-      const float denom = a * e - b * b;
-      s = denom > kEps ? std::clamp((b * f - c * e) / denom, 0.0F, 1.0F) : 0.0F;
-      t = (b * s + f) / e;
-      if (t < 0.0F) {
-        t = 0.0F;
-        s = std::clamp(-c / a, 0.0F, 1.0F);
-      } else if (t > 1.0F) {
-        t = 1.0F;
-        s = std::clamp((b - c) / a, 0.0F, 1.0F);
-      }
-    }
-  }
-  return ((p1 + d1 * s) - (p2 + d2 * t)).squaredNorm();
+  closest_segment_params(p1, q1, p2, q2, s, t);
+  return ((p1 + s * (q1 - p1)) - (p2 + t * (q2 - p2))).squaredNorm();
 }
 
 void put_pixel(ColorImage& image, int u, int v, const Rgb& color) {

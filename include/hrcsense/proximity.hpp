@@ -15,6 +15,12 @@ namespace hrcsense {
 float point_capsule_distance(const Eigen::Vector3f& p, const Capsule& capsule,
                              Eigen::Vector3f* closest_on_capsule = nullptr);
 
+/// Closest points of segments p1q1 and p2q2 (either may be a point): their parameters s and t
+/// in [0, 1], the points p1 + s·(q1 − p1) and p2 + t·(q2 − p2). The simulator's analytic truth
+/// and the viewer's robot silhouette use it.
+void closest_segment_params(const Eigen::Vector3f& p1, const Eigen::Vector3f& q1, const Eigen::Vector3f& p2,
+                            const Eigen::Vector3f& q2, float& s, float& t);
+
 /// Exact closest contact by brute force over every point and capsule, single-threaded, with
 /// no state kept between calls. `points_base` in the base frame; `points_camera` (same order)
 /// fills Contact::closest_camera and may be empty. Ties: the smallest float distance, then the

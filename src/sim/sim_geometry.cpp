@@ -3,51 +3,14 @@
 
 #include "sim_geometry.hpp"
 
+#include "hrcsense/proximity.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <utility>
 
 namespace hrcsense::sim_detail {
 namespace {
-
-/// Closest points of segments p1q1 and p2q2 (either may be a point): parameters s, t in [0, 1].
-/// The classic clamp-and-recompute construction (Ericson, Real-Time Collision Detection §5.1.9).
-void closest_segment_params(const Eigen::Vector3f& p1, const Eigen::Vector3f& q1, const Eigen::Vector3f& p2,
-                            const Eigen::Vector3f& q2, float& s, float& t) {
-  const Eigen::Vector3f d1 = q1 - p1;
-  const Eigen::Vector3f d2 = q2 - p2;
-  const Eigen::Vector3f r = p1 - p2;
-  const float a = d1.squaredNorm();
-  const float e = d2.squaredNorm();
-  const float f = d2.dot(r);
-  if (a <= 0.0F && e <= 0.0F) {
-    s = t = 0.0F;
-    return;
-  }
-  if (a <= 0.0F) {
-    s = 0.0F;
-    t = std::clamp(f / e, 0.0F, 1.0F);
-    return;
-  }
-  const float c = d1.dot(r);
-  if (e <= 0.0F) {
-    t = 0.0F;
-    s = std::clamp(-c / a, 0.0F, 1.0F);
-    return;
-  }
-  const float b = d1.dot(d2);
-  const float denom = a * e - b * b;
-  // Parallel segments (denom 0): any s works; 0 is then corrected by the clamps below.
-  s = denom > 0.0F ? std::clamp((b * f - c * e) / denom, 0.0F, 1.0F) : 0.0F;
-  t = (b * s + f) / e;
-  if (t < 0.0F) {
-    t = 0.0F;
-    s = std::clamp(-c / a, 0.0F, 1.0F);
-  } else if (t > 1.0F) {
-    t = 1.0F;
-    s = std::clamp((b - c) / a, 0.0F, 1.0F);
-  }
-}
 
 /// Two rounded cores (segment or point plus radius): closest surface points.
 ClosestPair closest_rounded(const Eigen::Vector3f& shape_a, const Eigen::Vector3f& shape_b, float shape_r,
