@@ -114,16 +114,40 @@ void equalise_depth(const DepthImage& depth, std::vector<uint32_t>& histogram, s
   }
 }
 
-void colorize_depth(const DepthImage& depth, std::vector<uint32_t>& histogram, std::vector<float>& t, ColorImage& out) {
-  equalise_depth(depth, histogram, t);
+void colorize_depth(const DepthImage& depth, std::vector<uint32_t>& histogram, std::vector<uint32_t>& lut,
+                    ColorImage& out) {
+  // The colour depends on the raw value alone: one jet() per raw value present (a table over
+  // [min, max]), then a lookup per pixel, rather than the map's arithmetic per pixel.
+  histogram.assign(65536, 0);
+  uint16_t lo = 65535;
+  uint16_t hi = 0;
+  for (uint16_t d : depth.pixels) {
+    ++histogram[d];
+    if (d != 0) {
+      lo = std::min(lo, d);
+      hi = std::max(hi, d);
+    }
+  }
+  histogram[0] = 0;
   out.width = depth.width;
   out.height = depth.height;
-  out.rgb.resize(t.size() * 3);
-  for (size_t i = 0; i < t.size(); ++i) {
-    const Rgb c = t[i] < 0.0F ? Rgb{0, 0, 0} : jet(t[i]);
-    out.rgb[3 * i] = c[0];
-    out.rgb[3 * i + 1] = c[1];
-    out.rgb[3 * i + 2] = c[2];
+  out.rgb.assign(depth.pixels.size() * 3, 0);
+  if (hi == 0) return;  // no valid pixel: all black
+  for (size_t i = lo; i <= hi; ++i) histogram[i] += histogram[i - 1];
+  const float valid = static_cast<float>(histogram[hi]);
+  lut.resize(static_cast<size_t>(hi - lo) + 1);
+  for (size_t d = lo; d <= hi; ++d) {
+    const Rgb c = jet(static_cast<float>(histogram[d]) / valid);
+    lut[d - lo] = uint32_t{c[0]} | (uint32_t{c[1]} << 8) | (uint32_t{c[2]} << 16);
+  }
+  uint8_t* rgb = out.rgb.data();
+  for (size_t i = 0; i < depth.pixels.size(); ++i) {
+    const uint16_t d = depth.pixels[i];
+    if (d == 0) continue;
+    const uint32_t packed = lut[d - lo];
+    rgb[3 * i] = static_cast<uint8_t>(packed);
+    rgb[3 * i + 1] = static_cast<uint8_t>(packed >> 8);
+    rgb[3 * i + 2] = static_cast<uint8_t>(packed >> 16);
   }
 }
 
@@ -185,12 +209,15 @@ void compose_2d(const ViewFrame& frame, float depth_alpha, int marker_radius_px,
   out.height = in.height;
   out.rgb.assign(static_cast<size_t>(in.width) * in.height * 3, 0);
   if (depth->width != in.width || depth->height != in.height) return;  // a frame without depth of its size: black
-  colorize_depth(*depth, scratch.histogram, scratch.t, scratch.depth_rgb);
-  const float alpha = std::clamp(depth_alpha, 0.0F, 1.0F);
+  colorize_depth(*depth, scratch.histogram, scratch.lut, scratch.depth_rgb);
+  // Blend in integers, weights out of 256, rounded to nearest: (1 - a)·colour + a·depth.
+  const int weight = static_cast<int>(std::lround(std::clamp(depth_alpha, 0.0F, 1.0F) * 256.0F));
   if (with_color) {
-    const std::vector<uint8_t>& color = frame.color->rgb;
+    const uint8_t* color = frame.color->rgb.data();
+    const uint8_t* depth_rgb = scratch.depth_rgb.rgb.data();
+    uint8_t* dst = out.rgb.data();
     for (size_t i = 0; i < out.rgb.size(); ++i) {
-      out.rgb[i] = static_cast<uint8_t>(std::lround((1.0F - alpha) * color[i] + alpha * scratch.depth_rgb.rgb[i]));
+      dst[i] = static_cast<uint8_t>(((256 - weight) * color[i] + weight * depth_rgb[i] + 128) >> 8);
     }
   } else {
     out.rgb = scratch.depth_rgb.rgb;

@@ -79,8 +79,10 @@ Rgb jet(float t);
 void equalise_depth(const DepthImage& depth, std::vector<uint32_t>& histogram_scratch, std::vector<float>& out);
 
 /// Depth coloured with jet() after equalise_depth(), invalid black; rgb8 of the depth's size.
-void colorize_depth(const DepthImage& depth, std::vector<uint32_t>& histogram_scratch, std::vector<float>& t_scratch,
-                    ColorImage& out);
+/// `lut_scratch` holds one packed colour per raw value between the image's nearest and
+/// farthest valid depth.
+void colorize_depth(const DepthImage& depth, std::vector<uint32_t>& histogram_scratch,
+                    std::vector<uint32_t>& lut_scratch, ColorImage& out);
 
 /// The robot's pixels in the view image: 1 where the ray through the pixel's centre passes
 /// within a capsule's radius of its segment (capsules in the base frame, taken to the view
@@ -94,7 +96,7 @@ struct ComposeScratch {
   AlignDepthToColor align;
   DepthImage aligned_depth;
   std::vector<uint32_t> histogram;
-  std::vector<float> t;
+  std::vector<uint32_t> lut;
   ColorImage depth_rgb;
   std::vector<uint8_t> robot;
   std::vector<uint8_t> tinted;
@@ -103,7 +105,8 @@ struct ComposeScratch {
 /// Everything the 2D pane draws into the image itself (what the GL part adds: the border, the
 /// verdict word and the distance label). With `depth_alpha` a in [0, 1]:
 /// - each pixel: (1 − a)·colour + a·jet(equalised aligned depth), invalid depth black in the
-///   depth layer; without colour the depth layer alone;
+///   depth layer (integer weights out of 256, rounded to nearest); without colour the depth
+///   layer alone;
 /// - foreground points (projected into the view) tinted 3/8 of the way to kContactMarker, each
 ///   over a square of its footprint (foreground_footprint × the view's over the depth's focal
 ///   length, at least one pixel);

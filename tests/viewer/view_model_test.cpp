@@ -74,7 +74,8 @@ TEST(Equalise, ShareOfValidPixelsAtOrBelow) {
   EXPECT_FLOAT_EQ(t[3], 1.0F);
 
   ColorImage rgb;
-  colorize_depth(depth, histogram, t, rgb);
+  std::vector<uint32_t> lut;
+  colorize_depth(depth, histogram, lut, rgb);
   EXPECT_EQ(pixel(rgb, 0, 0), (Rgb{0, 0, 0}));     // invalid: black
   EXPECT_EQ(pixel(rgb, 3, 0), (Rgb{50, 0, 0}));    // the farthest: the map's end
   // 2/3 of the way: between (255, 255, 0) at 1/2 and (255, 0, 0) at 3/4, f = 2/3 → g = 85.
