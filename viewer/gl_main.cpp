@@ -192,10 +192,9 @@ int run_viewer(const ViewArgs& args) {
   bool quit_requested = false;
   while (true) {
     glfwPollEvents();
-    if (!quit_requested && (g_quit.load() || glfwWindowShouldClose(window))) {
-      quit_requested = true;
-      app::request_session_stop();
-    }
+    if (g_quit.load() || glfwWindowShouldClose(window)) quit_requested = true;
+    // Asked again every turn: a request made before the run installed its handlers is reset.
+    if (quit_requested && !session_done.load()) app::request_session_stop();
     const bool fresh = tap.take(frame, 1.0 / 60.0);
     if (session_done.load() && ended_ns == 0) ended_ns = steady_ns();
     if (snapshots && session_done.load() && !fresh) break;
@@ -210,6 +209,7 @@ int run_viewer(const ViewArgs& args) {
       compose_times_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - c0).count());
     }
     stats.viewer_dropped = tap.dropped();
+    tap.timeline(stats.timeline);
     stats.session_ended = ended_ns != 0;
     const double elapsed_s = static_cast<double>(steady_ns() - start_ns) * 1e-9;
     stats.display_fps = elapsed_s > 0.0 ? static_cast<double>(drawn) / elapsed_s : 0.0;
@@ -230,7 +230,6 @@ int run_viewer(const ViewArgs& args) {
       }
       if (take_snapshot) tap.rendered(frame.frame);
     }
-    if (snapshots && tap.snapshots_pending() == 0) break;
     if (!snapshots) {
       int width = 0, height = 0;
       glfwGetFramebufferSize(window, &width, &height);
@@ -241,6 +240,7 @@ int run_viewer(const ViewArgs& args) {
       ++drawn;
       frame_times_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
+    if (snapshots && tap.snapshots_pending() == 0) break;
   }
   if (!session_done.load()) app::request_session_stop();
   tap.close();  // a session waiting at a snapshot frame goes on

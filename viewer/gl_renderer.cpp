@@ -16,6 +16,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 namespace hrcsense::view {
 namespace {
@@ -218,32 +219,65 @@ void Renderer::draw_overlay(const ViewFrame& frame, const ColorImage& image, Sho
       draw->AddText(font_small_, 28.0F, at, IM_COL32(255, 255, 255, 255), text.c_str());
     }
   }
-  // The status strip: the word in the state's colour, the distance large, then details.
+  // The status strip: the word in the state's colour and the distance, large; the reason and
+  // the figures under them; the timeline on the right.
   const float strip_y = static_cast<float>(height - kBorderPx - kStatusPx);
   const float x = kBorderPx + 16.0F;
   const char* word = state_word(state);
   const Rgb word_color = state == ShownState::no_data ? kStopColor : state_color(state);
-  draw->AddText(font_large_, 56.0F, ImVec2(x, strip_y + 12.0F), im_color(word_color), word);
+  draw->AddText(font_large_, 56.0F, ImVec2(x, strip_y + 6.0F), im_color(word_color), word);
   const float word_width = font_large_->CalcTextSizeA(56.0F, 1e9F, 0.0F, "NO DATA").x;
   const std::string distance = state == ShownState::no_data ? "-" : distance_text(frame);
-  draw->AddText(font_large_, 56.0F, ImVec2(x + word_width + 40.0F, strip_y + 12.0F), IM_COL32(255, 255, 255, 255),
+  draw->AddText(font_large_, 56.0F, ImVec2(x + word_width + 40.0F, strip_y + 6.0F), IM_COL32(255, 255, 255, 255),
                 distance.c_str());
-  char line1[256];
-  char line2[256];
+  const RateStats rates = rate_stats(stats.timeline);
   const std::string reason = state == ShownState::no_data
                                  ? std::string("no result newer than safety.max_frame_age_s")
                                  : std::string(reason_code_name(frame.verdict.code)) + ": " + frame.verdict.reason;
-  std::snprintf(line1, sizeof(line1), "%s", reason.c_str());
-  std::snprintf(line2, sizeof(line2), "frame %lld  fg %zu pts  invalid %zu px  latency %.2f ms  view %.1f fps  dropped %lld%s",
+  char line2[160];
+  char line3[200];
+  std::snprintf(line2, sizeof(line2), "frame %lld  fg %zu pts  invalid %zu px  latency %.2f / %.2f ms%s",
                 static_cast<long long>(frame.frame), frame.foreground_points, frame.invalid_pixels,
-                frame.latency_us / 1000.0, stats.display_fps, static_cast<long long>(stats.viewer_dropped),
-                stats.session_ended ? "  (run ended)" : "");
-  const float detail_x = x + 2.0F * word_width + 120.0F;
-  draw->AddText(font_small_, 18.0F, ImVec2(detail_x, strip_y + 8.0F), IM_COL32(230, 230, 230, 255), line1);
-  draw->AddText(font_small_, 18.0F, ImVec2(detail_x, strip_y + 32.0F), IM_COL32(170, 170, 170, 255), line2);
-  draw->AddText(font_small_, 18.0F, ImVec2(detail_x, strip_y + 56.0F), IM_COL32(170, 170, 170, 255),
+                rates.latency_p50_us / 1000.0, rates.latency_p99_us / 1000.0, stats.session_ended ? "  (ended)" : "");
+  std::snprintf(line3, sizeof(line3), "capture %.1f  processing %.1f  view %.1f frames/s  view dropped %lld",
+                rates.capture_fps, rates.processing_fps, stats.display_fps,
+                static_cast<long long>(stats.viewer_dropped));
+  draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 68.0F), IM_COL32(230, 230, 230, 255), reason.c_str());
+  draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 88.0F), IM_COL32(170, 170, 170, 255), line2);
+  draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 108.0F), IM_COL32(170, 170, 170, 255), line3);
+  draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 128.0F), IM_COL32(140, 140, 140, 255),
                 "hrcsense is not a safety-rated device");
+  draw_timeline(draw, frame, stats, ImVec2(static_cast<float>(width - kBorderPx) - 16.0F - kTimelineWidthPx,
+                                           strip_y + 8.0F),
+                ImVec2(kTimelineWidthPx, static_cast<float>(kStatusPx) - 16.0F));
   draw->PopClipRect();
+}
+
+void Renderer::draw_timeline(ImDrawList* draw, const ViewFrame& frame, const ViewStats& stats, const ImVec2& at,
+                             const ImVec2& size) {
+  draw->AddRectFilled(at, ImVec2(at.x + size.x, at.y + size.y), IM_COL32(40, 40, 40, 255));
+  const std::vector<TimelinePoint>& points = stats.timeline;
+  // Distance 0 at the bottom to twice the slow distance at the top; the newest at the right
+  // edge, kTimelineSeconds of source time across.
+  const float top_m = std::max(2.0F * frame.slow_distance_m, 1.0F);
+  auto y_of = [&](float d) { return at.y + size.y - std::clamp(d / top_m, 0.0F, 1.0F) * size.y; };
+  for (const auto& [d, c] : {std::pair{frame.slow_distance_m, kSlowColor}, std::pair{frame.stop_distance_m, kStopColor}}) {
+    if (d > 0.0F) draw->AddLine(ImVec2(at.x, y_of(d)), ImVec2(at.x + size.x, y_of(d)), im_color(c, 160), 1.0F);
+  }
+  draw->AddText(font_small_, 16.0F, ImVec2(at.x + 4.0F, at.y + 2.0F), IM_COL32(200, 200, 200, 255),
+                "distance, last 10 s");
+  if (points.empty()) return;
+  const int64_t newest_ns = points.back().timestamp_ns;
+  const double span_ns = kTimelineSeconds * 1e9;
+  for (const TimelinePoint& p : points) {
+    const double age_ns = static_cast<double>(newest_ns - p.timestamp_ns);
+    if (age_ns < 0.0 || age_ns > span_ns) continue;
+    const float px = at.x + size.x * static_cast<float>(1.0 - age_ns / span_ns);
+    const Rgb c = p.state == VerdictState::run ? kRunColor : p.state == VerdictState::slow ? kSlowColor : kStopColor;
+    // No contact: a mark along the top (the cell clear, or no valid frame).
+    const float py = p.distance_m >= 0.0F ? y_of(p.distance_m) : at.y + 3.0F;
+    draw->AddRectFilled(ImVec2(px - 1.0F, py - 1.5F), ImVec2(px + 1.0F, py + 1.5F), im_color(c));
+  }
 }
 
 bool Renderer::snapshot(const ViewFrame& frame, const ColorImage& image, ShownState state, const ViewStats& stats,

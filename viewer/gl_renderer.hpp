@@ -9,9 +9,12 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 struct GLFWwindow;
+struct ImDrawList;
 struct ImFont;
+struct ImVec2;
 
 namespace hrcsense::view {
 
@@ -20,11 +23,14 @@ struct ViewStats {
   double display_fps = 0.0;     ///< frames drawn per second
   int64_t viewer_dropped = 0;   ///< frames the viewer never drew (ViewTap::dropped)
   bool session_ended = false;   ///< the run is over (the last frame stays on screen)
+  std::vector<TimelinePoint> timeline;  ///< every processed frame of the last seconds (ViewTap)
 };
 
 /// Window layout, in pixels of the framebuffer drawn to.
 inline constexpr int kBorderPx = 12;   ///< the state border, ≥ 8 px (issue E)
-inline constexpr int kStatusPx = 84;   ///< the status strip under the image, inside the border
+inline constexpr int kStatusPx = 150;  ///< the status strip under the image, inside the border
+inline constexpr float kTimelineWidthPx = 420.0F;  ///< the distance plot at the strip's right
+inline constexpr double kTimelineSeconds = 10.0;   ///< of source time across the plot
 
 class Renderer {
  public:
@@ -45,6 +51,8 @@ class Renderer {
   void upload(const ColorImage& image);
   void draw_overlay(const ViewFrame& frame, const ColorImage& image, ShownState state, const ViewStats& stats,
                     const Rect& image_rect, int width, int height);
+  void draw_timeline(ImDrawList* draw, const ViewFrame& frame, const ViewStats& stats, const ImVec2& at,
+                     const ImVec2& size);
 
   GLFWwindow* window_ = nullptr;
   unsigned program_ = 0, vao_ = 0, vbo_ = 0, texture_ = 0;

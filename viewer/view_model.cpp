@@ -26,28 +26,10 @@ float segment_segment_distance_sq(const Eigen::Vector3f& p1, const Eigen::Vector
   return ((p1 + s * (q1 - p1)) - (p2 + t * (q2 - p2))).squaredNorm();
 }
 
-void put_pixel(ColorImage& image, int u, int v, const Rgb& color) {
-  if (u < 0 || v < 0 || u >= image.width || v >= image.height) return;
-  uint8_t* px = &image.rgb[3 * (static_cast<size_t>(v) * image.width + u)];
-  px[0] = color[0];
-  px[1] = color[1];
-  px[2] = color[2];
-}
-
 void blend_pixel(ColorImage& image, int u, int v, const Rgb& toward, int weight_256) {
   if (u < 0 || v < 0 || u >= image.width || v >= image.height) return;
   uint8_t* px = &image.rgb[3 * (static_cast<size_t>(v) * image.width + u)];
   for (int c = 0; c < 3; ++c) px[c] = static_cast<uint8_t>((px[c] * (256 - weight_256) + toward[c] * weight_256) / 256);
-}
-
-void draw_disc(ColorImage& image, const Eigen::Vector2f& centre, int radius_px, const Rgb& color) {
-  const int cu = static_cast<int>(std::lround(centre.x()));
-  const int cv = static_cast<int>(std::lround(centre.y()));
-  for (int dv = -radius_px; dv <= radius_px; ++dv) {
-    for (int du = -radius_px; du <= radius_px; ++du) {
-      if (du * du + dv * dv <= radius_px * radius_px) put_pixel(image, cu + du, cv + dv, color);
-    }
-  }
 }
 
 // A line of 3 px width (DDA over the longer axis), clipped by put_pixel.
@@ -67,6 +49,24 @@ void draw_line(ColorImage& image, const Eigen::Vector2f& from, const Eigen::Vect
 }
 
 }  // namespace
+
+void put_pixel(ColorImage& image, int u, int v, const Rgb& color) {
+  if (u < 0 || v < 0 || u >= image.width || v >= image.height) return;
+  uint8_t* px = &image.rgb[3 * (static_cast<size_t>(v) * image.width + u)];
+  px[0] = color[0];
+  px[1] = color[1];
+  px[2] = color[2];
+}
+
+void draw_disc(ColorImage& image, const Eigen::Vector2f& centre, int radius_px, const Rgb& color) {
+  const int cu = static_cast<int>(std::lround(centre.x()));
+  const int cv = static_cast<int>(std::lround(centre.y()));
+  for (int dv = -radius_px; dv <= radius_px; ++dv) {
+    for (int du = -radius_px; du <= radius_px; ++du) {
+      if (du * du + dv * dv <= radius_px * radius_px) put_pixel(image, cu + du, cv + dv, color);
+    }
+  }
+}
 
 ViewCamera view_camera(const ViewFrame& frame) {
   ViewCamera camera;
@@ -266,6 +266,42 @@ void compose_2d(const ViewFrame& frame, float depth_alpha, int marker_radius_px,
   if (contact_px && robot_px) draw_line(out, *contact_px, *robot_px, kContactLine);
   if (robot_px) draw_disc(out, *robot_px, marker_radius_px, kRobotMarker);
   if (contact_px) draw_disc(out, *contact_px, marker_radius_px, kContactMarker);
+}
+
+Timeline::Timeline(double window_s, size_t max_points) : window_s_(window_s), max_points_(max_points) {
+  points_.reserve(max_points);
+}
+
+void Timeline::add(const TimelinePoint& point) {
+  points_.push_back(point);
+  const auto window_ns = static_cast<int64_t>(window_s_ * 1e9);
+  size_t first = 0;
+  while (first < points_.size() && (point.made_ns - points_[first].made_ns > window_ns ||
+                                    points_.size() - first > max_points_)) {
+    ++first;
+  }
+  if (first > 0) points_.erase(points_.begin(), points_.begin() + static_cast<std::ptrdiff_t>(first));
+}
+
+RateStats rate_stats(const std::vector<TimelinePoint>& points) {
+  RateStats stats;
+  if (points.size() < 2) return stats;
+  const double frames = static_cast<double>(points.size() - 1);
+  const double source_s = static_cast<double>(points.back().timestamp_ns - points.front().timestamp_ns) * 1e-9;
+  const double made_s = static_cast<double>(points.back().made_ns - points.front().made_ns) * 1e-9;
+  stats.capture_fps = source_s > 0.0 ? frames / source_s : 0.0;
+  stats.processing_fps = made_s > 0.0 ? frames / made_s : 0.0;
+  std::vector<double> latencies;
+  latencies.reserve(points.size());
+  for (const TimelinePoint& p : points) latencies.push_back(p.latency_us);
+  std::sort(latencies.begin(), latencies.end());
+  auto rank = [&](double q) {
+    const size_t k = static_cast<size_t>(std::ceil(q * static_cast<double>(latencies.size())));
+    return latencies[std::clamp<size_t>(k, 1, latencies.size()) - 1];
+  };
+  stats.latency_p50_us = rank(0.50);
+  stats.latency_p99_us = rank(0.99);
+  return stats;
 }
 
 ShownState shown_state(const ViewFrame& frame, int64_t now_ns, double max_frame_age_s) {

@@ -91,6 +91,11 @@ void colorize_depth(const DepthImage& depth, std::vector<uint32_t>& histogram_sc
 void robot_mask(const std::vector<Capsule>& capsules_base, const Pose& T_camera_base, const ViewCamera& camera,
                 std::vector<uint8_t>& mask);
 
+/// Sets pixel (u, v) of `image` to `color`; nothing outside the image.
+void put_pixel(ColorImage& image, int u, int v, const Rgb& color);
+/// A filled disc of `radius_px` around `centre` (rounded to the nearest pixel), clipped.
+void draw_disc(ColorImage& image, const Eigen::Vector2f& centre, int radius_px, const Rgb& color);
+
 /// Reusable buffers of compose_2d().
 struct ComposeScratch {
   AlignDepthToColor align;
@@ -118,6 +123,39 @@ struct ComposeScratch {
 /// `out` has the view camera's size.
 void compose_2d(const ViewFrame& frame, float depth_alpha, int marker_radius_px, ComposeScratch& scratch,
                 ColorImage& out);
+
+/// One processed frame on the timeline: every frame the pipeline made, drawn or not.
+struct TimelinePoint {
+  int64_t timestamp_ns = 0;  ///< the source's
+  int64_t made_ns = 0;       ///< steady clock, when the result was made
+  float distance_m = -1.0F;  ///< < 0: no contact (nothing in the cell, or no valid frame)
+  VerdictState state = VerdictState::stop;
+  double latency_us = 0.0;
+};
+
+/// The last `window_s` seconds of results (by made_ns), oldest first, bounded in count.
+class Timeline {
+ public:
+  explicit Timeline(double window_s = 10.0, size_t max_points = 4096);
+  void add(const TimelinePoint& point);
+  const std::vector<TimelinePoint>& points() const { return points_; }
+
+ private:
+  double window_s_;
+  size_t max_points_;
+  std::vector<TimelinePoint> points_;
+};
+
+/// The stats panel's figures over a timeline: source frames per second (by timestamp),
+/// processed per second (by made_ns), latency p50 / p99 (nearest rank). Zero with fewer than
+/// two points.
+struct RateStats {
+  double capture_fps = 0.0;
+  double processing_fps = 0.0;
+  double latency_p50_us = 0.0;
+  double latency_p99_us = 0.0;
+};
+RateStats rate_stats(const std::vector<TimelinePoint>& points);
 
 /// What the border and the word say.
 enum class ShownState { run, slow, stop, no_data };

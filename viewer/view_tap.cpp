@@ -68,10 +68,18 @@ void fill_view_frame(const Frame& frame, const Pipeline& pipeline, const FrameRe
 ViewTap::ViewTap(std::set<int64_t> snapshot_frames) : pending_(std::move(snapshot_frames)) {}
 
 void ViewTap::offer(const Frame& frame, const Pipeline& pipeline, const FrameResult& result) {
-  fill_view_frame(frame, pipeline, result, steady_now_ns(), scratch_);
-  const bool snapshot = result.source_frame && [&] {
+  const int64_t now_ns = steady_now_ns();
+  fill_view_frame(frame, pipeline, result, now_ns, scratch_);
+  TimelinePoint point;
+  point.timestamp_ns = result.timestamp_ns;
+  point.made_ns = now_ns;
+  point.distance_m = result.contact.valid ? result.contact.distance_m : -1.0F;
+  point.state = result.verdict.state;
+  point.latency_us = result.latency_us;
+  const bool snapshot = [&] {
     std::lock_guard<std::mutex> lock(mutex_);
-    return pending_.count(result.frame) > 0;
+    timeline_.add(point);
+    return result.source_frame && pending_.count(result.frame) > 0;
   }();
   if (!mailbox_.put(scratch_)) return;  // the renderer is gone
   if (!snapshot) return;
@@ -90,6 +98,11 @@ void ViewTap::close() {
   std::lock_guard<std::mutex> lock(mutex_);
   closed_ = true;
   drawn_.notify_all();
+}
+
+void ViewTap::timeline(std::vector<TimelinePoint>& out) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  out = timeline_.points();
 }
 
 size_t ViewTap::snapshots_pending() const {

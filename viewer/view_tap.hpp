@@ -41,6 +41,10 @@ class ViewTap {
   void close();
   bool closed() const { return mailbox_.closed(); }
 
+  /// Every processed frame of the last seconds (the timeline and the stats panel), copied
+  /// into `out`.
+  void timeline(std::vector<TimelinePoint>& out) const;
+
   /// Frames the renderer never took: `viewer_frames_dropped` in the summary.
   int64_t dropped() const { return mailbox_.dropped(); }
   /// Snapshot frames still to be drawn.
@@ -52,6 +56,7 @@ class ViewTap {
   mutable std::mutex mutex_;
   std::condition_variable drawn_;
   std::set<int64_t> pending_;  ///< snapshot frames not yet drawn
+  Timeline timeline_;          ///< under mutex_
   bool closed_ = false;
 };
 

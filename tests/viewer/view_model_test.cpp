@@ -207,22 +207,56 @@ TEST(ShownState, NoDataWhenNothingOrTooOld) {
 }
 
 TEST(Layout, PaneAndFit) {
-  const Rect pane = pane_area(1280, 720, 12, 84);
+  const Rect pane = pane_area(1280, 720, 12, 150);
   EXPECT_EQ(pane.x, 12);
   EXPECT_EQ(pane.y, 12);
   EXPECT_EQ(pane.width, 1256);
-  EXPECT_EQ(pane.height, 612);
-  // 848×480 into 1256×612: height-bound, 612·848/480 = 1081.2 → 1081 wide, centred.
+  EXPECT_EQ(pane.height, 546);
+  // 848×480 into 1256×546: height-bound, 546·848/480 = 964.6 → 964 wide, centred.
   const Rect fit = fit_rect(848, 480, pane);
-  EXPECT_EQ(fit.width, 1081);
-  EXPECT_EQ(fit.height, 612);
-  EXPECT_EQ(fit.x, 12 + (1256 - 1081) / 2);
+  EXPECT_EQ(fit.width, 964);
+  EXPECT_EQ(fit.height, 546);
+  EXPECT_EQ(fit.x, 12 + (1256 - 964) / 2);
   EXPECT_EQ(fit.y, 12);
-  // Width-bound: 400×100 into 1256×612 → 1256×314, centred vertically.
+  // Width-bound: 400×100 into 1256×546 → 1256×314, centred vertically.
   const Rect wide = fit_rect(400, 100, pane);
   EXPECT_EQ(wide.width, 1256);
   EXPECT_EQ(wide.height, 314);
-  EXPECT_EQ(wide.y, 12 + (612 - 314) / 2);
+  EXPECT_EQ(wide.y, 12 + (546 - 314) / 2);
+}
+
+TimelinePoint point_at(double made_s, double source_s, double latency_us) {
+  TimelinePoint p;
+  p.made_ns = static_cast<int64_t>(made_s * 1e9);
+  p.timestamp_ns = static_cast<int64_t>(source_s * 1e9);
+  p.latency_us = latency_us;
+  return p;
+}
+
+TEST(Timeline, KeepsTheLastSecondsOnly) {
+  Timeline timeline(2.0, 100);
+  for (int i = 0; i <= 40; ++i) timeline.add(point_at(0.1 * i, 0.1 * i, 1.0));  // 0 .. 4 s
+  // Made within 2 s of the newest (4.0 s): 2.0 .. 4.0 s, 21 points (2.0 s itself is at the edge,
+  // kept unless rounding of 0.1·i puts it just beyond).
+  ASSERT_GE(timeline.points().size(), 20U);
+  ASSERT_LE(timeline.points().size(), 21U);
+  EXPECT_NEAR(static_cast<double>(timeline.points().back().made_ns) * 1e-9, 4.0, 1e-9);
+  EXPECT_GE(timeline.points().front().made_ns, static_cast<int64_t>(1.999e9));
+  Timeline bounded(100.0, 5);
+  for (int i = 0; i < 12; ++i) bounded.add(point_at(0.01 * i, 0.01 * i, 1.0));
+  EXPECT_EQ(bounded.points().size(), 5U);
+}
+
+TEST(Timeline, RatesAndLatencyPercentiles) {
+  // 11 frames 1/30 s apart in source time, processed 1/60 s apart; latencies 100..1100 us.
+  std::vector<TimelinePoint> points;
+  for (int i = 0; i <= 10; ++i) points.push_back(point_at(i / 60.0, i / 30.0, 100.0 * (i + 1)));
+  const RateStats stats = rate_stats(points);
+  EXPECT_NEAR(stats.capture_fps, 30.0, 1e-6);
+  EXPECT_NEAR(stats.processing_fps, 60.0, 1e-6);
+  EXPECT_DOUBLE_EQ(stats.latency_p50_us, 600.0);   // nearest rank: the 6th of 11
+  EXPECT_DOUBLE_EQ(stats.latency_p99_us, 1100.0);  // the 11th
+  EXPECT_EQ(rate_stats({points.front()}).capture_fps, 0.0);
 }
 
 Pipeline walk_pipeline() {

@@ -78,7 +78,7 @@ Rgb verdict_color(const std::string& verdict) {
   return kStopColor;
 }
 
-// The layout as docs/VIEWER.md states it, worked out here: a 12 px border, an 84 px status strip
+// The layout as docs/VIEWER.md states it, worked out here: a 12 px border, a 150 px status strip
 // inside it at the bottom, the image fitted into the rest keeping its aspect ratio, centred.
 struct ScreenMap {
   double x0, y0, scale_x, scale_y;
@@ -90,7 +90,7 @@ struct ScreenMap {
 
 ScreenMap screen_map(int image_width, int image_height) {
   const int area_w = 1280 - 2 * 12;
-  const int area_h = 720 - 2 * 12 - 84;
+  const int area_h = 720 - 2 * 12 - 150;
   int w = area_w;
   int h = area_w * image_height / image_width;
   if (h > area_h) {
