@@ -189,9 +189,13 @@ void draw_contact(const ViewFrame& frame, const ViewCamera& camera, ColorImage& 
 }  // namespace
 
 OrbitCamera default_orbit(const ViewFrame& frame) {
-  const Eigen::Vector3f camera_base = frame.T_camera_base.inverse().translation().cast<float>();
+  const Pose T_base_camera = frame.T_camera_base.inverse();
+  const Eigen::Vector3f camera_base = T_base_camera.translation().cast<float>();
+  // A metre in front of the real camera: the middle of what it sees, also when the camera is
+  // the base frame itself (T_base_camera the identity, a recording without a cell).
+  const Eigen::Vector3f ahead_base = (T_base_camera * Eigen::Vector3d(0.0, 0.0, 1.0)).cast<float>();
   OrbitCamera orbit;
-  orbit.target_base = 0.5F * camera_base;
+  orbit.target_base = ahead_base;
   // From the real camera's side, so that the pane starts out familiar, but turned: from
   // straight behind the camera the cloud would hide its own depth.
   const float camera_yaw = std::atan2(camera_base.y(), camera_base.x());

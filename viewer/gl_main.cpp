@@ -2,9 +2,14 @@
 // hrcsense-view — `hrcsense run` with a window: the same flags, sinks and links, and the
 // viewer as one more consumer of the results (docs/VIEWER.md). The run goes on a thread of its
 // own; GLFW and OpenGL stay on the main thread, which reads the newest frame from the view
-// tap's latest-value mailbox. Headless: --snapshot DIR --snapshot-at LIST writes PNGs from an
-// offscreen framebuffer and exits after the last.
+// tap's latest-value mailbox; the panels' requests go back through a ControlInbox and a
+// recording's pause, step and seek through a PlaybackControl. Headless: --snapshot DIR
+// --snapshot-at LIST writes PNGs from an offscreen framebuffer and exits after the last.
+#include "viewer/cloud_view.hpp"
+#include "viewer/gl_panels.hpp"
 #include "viewer/gl_renderer.hpp"
+#include "viewer/playback.hpp"
+#include "viewer/view_control.hpp"
 #include "viewer/view_model.hpp"
 #include "viewer/view_tap.hpp"
 
@@ -16,6 +21,7 @@
 
 #include <CLI/CLI.hpp>
 #include <GLFW/glfw3.h>
+#include <imgui.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -30,6 +36,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -52,16 +59,44 @@ struct ViewArgs {
   std::string record;
   std::string snapshot_dir;
   std::string snapshot_at;
+  std::string pane = "2d";
   int slow_render_ms = 0;  ///< hidden: a deliberately slow renderer (tests of the mailbox)
 };
 
+// Set by GLFW's callbacks (main thread), read by the loop. Keys typed into an ImGui field
+// are ImGui's, not shortcuts.
 std::atomic<bool> g_quit{false};
 std::atomic<bool> g_screenshot{false};
+bool g_toggle_pause = false, g_step = false, g_relearn = false, g_next_pane = false;
+double g_cursor_x = 0.0, g_cursor_y = 0.0;
+float g_drag_x = 0.0F, g_drag_y = 0.0F, g_wheel = 0.0F;  ///< orbit input since the last frame
+
+bool imgui_has(bool keyboard) {
+  if (ImGui::GetCurrentContext() == nullptr) return false;
+  return keyboard ? ImGui::GetIO().WantCaptureKeyboard : ImGui::GetIO().WantCaptureMouse;
+}
 
 void on_key(GLFWwindow* /*window*/, int key, int /*scancode*/, int action, int /*mods*/) {
-  if (action != GLFW_PRESS) return;
+  if (action != GLFW_PRESS || imgui_has(true)) return;
   if (key == GLFW_KEY_Q || key == GLFW_KEY_ESCAPE) g_quit.store(true);
   if (key == GLFW_KEY_S) g_screenshot.store(true);
+  if (key == GLFW_KEY_SPACE) g_toggle_pause = true;
+  if (key == GLFW_KEY_PERIOD) g_step = true;
+  if (key == GLFW_KEY_R) g_relearn = true;
+  if (key == GLFW_KEY_V) g_next_pane = true;
+}
+
+void on_cursor(GLFWwindow* window, double x, double y) {
+  if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS && !imgui_has(false)) {
+    g_drag_x += static_cast<float>(x - g_cursor_x);
+    g_drag_y += static_cast<float>(y - g_cursor_y);
+  }
+  g_cursor_x = x;
+  g_cursor_y = y;
+}
+
+void on_scroll(GLFWwindow* /*window*/, double /*dx*/, double dy) {
+  if (!imgui_has(false)) g_wheel += static_cast<float>(dy);
 }
 
 std::set<int64_t> parse_frame_list(const std::string& text) {
@@ -105,6 +140,48 @@ std::string glfw_error_text() {
   return description != nullptr ? description : "unknown GLFW error";
 }
 
+// The keys and the mouse since the last frame: pause and step a recording, ask for a relearn,
+// cycle the panes, orbit the 3D view. True when the orbit camera moved.
+bool handle_input(PlaybackControl* playback, Panels& panels, PaneMode& mode, OrbitCamera* orbit) {
+  if (std::exchange(g_toggle_pause, false) && playback != nullptr) playback->set_paused(!playback->paused());
+  if (std::exchange(g_step, false) && playback != nullptr) playback->step();
+  if (std::exchange(g_relearn, false)) panels.ask_relearn();
+  if (std::exchange(g_next_pane, false)) {
+    mode = mode == PaneMode::view_2d ? PaneMode::view_3d : mode == PaneMode::view_3d ? PaneMode::split : PaneMode::view_2d;
+  }
+  const float dx = std::exchange(g_drag_x, 0.0F);
+  const float dy = std::exchange(g_drag_y, 0.0F);
+  const float wheel = std::exchange(g_wheel, 0.0F);
+  if (orbit == nullptr || mode == PaneMode::view_2d || (dx == 0.0F && dy == 0.0F && wheel == 0.0F)) return false;
+  orbit_drag(*orbit, dx, dy);
+  orbit_zoom(*orbit, wheel);
+  return true;
+}
+
+std::string paused_notice(const PlaybackControl& playback) {
+  char text[128];
+  std::snprintf(text, sizeof text, "PAUSED at %lld of %lld (space: play, .: step)",
+                static_cast<long long>(playback.position()), static_cast<long long>(playback.frame_count()));
+  return text;
+}
+
+// Draws the view offscreen at the snapshot size and writes DIR/frame_%06d.png. False when the
+// offscreen framebuffer cannot be made.
+bool write_snapshot(Renderer& renderer, const ViewFrame& frame, const PaneImages& panes, ShownState state,
+                    const ViewStats& stats, const std::string& dir, ColorImage& scratch) {
+  if (!renderer.snapshot(frame, panes, state, stats, kSnapshotWidth, kSnapshotHeight, scratch)) {
+    spdlog::error("snapshot: the offscreen framebuffer could not be made");
+    return false;
+  }
+  char name[64];
+  std::snprintf(name, sizeof(name), "frame_%06lld.png", static_cast<long long>(frame.frame));
+  const std::string path = (std::filesystem::path(dir) / name).string();
+  write_color_png(path, scratch);
+  spdlog::info("snapshot: {} ({}, distance {})", path, state_word(state),
+               frame.contact.valid ? std::to_string(frame.contact.distance_m) + " m" : std::string("none"));
+  return true;
+}
+
 int run_viewer(const ViewArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
   const bool snapshots = !args.snapshot_dir.empty();
@@ -116,6 +193,8 @@ int run_viewer(const ViewArgs& args) {
     throw ConfigError("--snapshot-at needs --snapshot DIR");
   }
   const double max_frame_age_s = config.pipeline.safety.max_frame_age_s;
+  const std::optional<PaneMode> pane_mode = parse_pane_mode(args.pane);
+  if (!pane_mode) throw ConfigError("--pane: '" + args.pane + "' is not 2d, 3d or split");
 
   // No display: one line and a non-zero exit, never a crash (GLFW would only say "X11: ...").
   const char* x_display = std::getenv("DISPLAY");
@@ -146,7 +225,10 @@ int run_viewer(const ViewArgs& args) {
   }
   glfwMakeContextCurrent(window);
   glfwSwapInterval(snapshots ? 0 : 1);
-  glfwSetKeyCallback(window, on_key);  // before ImGui's init, which chains it
+  // Before ImGui's init, which chains them.
+  glfwSetKeyCallback(window, on_key);
+  glfwSetCursorPosCallback(window, on_cursor);
+  glfwSetScrollCallback(window, on_scroll);
   Renderer renderer;
   std::string gl_error;
   if (!renderer.init(window, gl_error)) {
@@ -167,6 +249,18 @@ int run_viewer(const ViewArgs& args) {
     tap.offer(frame, pipeline, result);
   };
   options.viewer_frames_dropped = [&tap] { return tap.dropped(); };
+  options.with_color = true;
+  ControlInbox inbox;
+  options.before_process = [&inbox](Pipeline& pipeline, const FrameResult& previous) { inbox.apply(pipeline, previous); };
+  PlaybackControl playback;
+  // run_session wraps only recordings (.bag, folder); a headless run plays straight through.
+  const bool replay = !snapshots && (config.source.type == "bag" || config.source.type == "folder");
+  if (replay) {
+    options.wrap_recording = [&playback](std::unique_ptr<Source> opened, std::function<std::unique_ptr<Source>()> open) {
+      return std::make_unique<PlaybackSource>(std::move(opened), std::move(open), playback);
+    };
+  }
+  Panels panels(PanelContext{args.config_path, args.sets, &inbox, replay ? &playback : nullptr}, config);
   std::atomic<bool> session_done{false};
   int session_code = 0;
   std::thread session([&] {
@@ -179,9 +273,16 @@ int run_viewer(const ViewArgs& args) {
   });
 
   ViewFrame frame;
-  ColorImage image;
+  ColorImage image;  // the 2D pane
+  ColorImage cloud;  // the 3D pane
   ColorImage snapshot;
   ComposeScratch scratch;
+  Cloud3dScratch cloud_scratch;
+  OrbitCamera orbit;
+  bool orbit_ready = false;
+  bool reset_orbit = false;
+  PaneMode mode = *pane_mode;
+  int64_t serial = 0, serial_2d = -1, serial_3d = -1;  // which take() each pane image shows
   ViewStats stats;
   std::vector<double> frame_times_ms;   // compose + draw + swap of each new frame
   std::vector<double> compose_times_ms; // compose_2d alone (CPU)
@@ -195,45 +296,53 @@ int run_viewer(const ViewArgs& args) {
     if (g_quit.load() || glfwWindowShouldClose(window)) quit_requested = true;
     // Asked again every turn: a request made before the run installed its handlers is reset.
     if (quit_requested && !session_done.load()) app::request_session_stop();
+    const bool orbit_moved = handle_input(replay ? &playback : nullptr, panels, mode, orbit_ready ? &orbit : nullptr);
     const bool fresh = tap.take(frame, 1.0 / 60.0);
+    if (fresh) ++serial;
     if (session_done.load() && ended_ns == 0) ended_ns = steady_ns();
     if (snapshots && session_done.load() && !fresh) break;
     if (!snapshots && ended_ns != 0 && (quit_requested || steady_ns() - ended_ns > kLingerAfterEndS * 1e9)) break;
     const bool take_snapshot = snapshots && fresh && snapshot_frames.count(frame.frame) > 0;
     if (snapshots && !take_snapshot) continue;  // headless: only the listed frames are drawn
     const auto t0 = std::chrono::steady_clock::now();
-    if (fresh) {
-      if (args.slow_render_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(args.slow_render_ms));
+    int width = kSnapshotWidth, height = kSnapshotHeight;
+    if (!snapshots) glfwGetFramebufferSize(window, &width, &height);
+    const PaneRects rects = window_panes(mode, width, height);
+    if (fresh && args.slow_render_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(args.slow_render_ms));
+    if (rects.image_2d.width > 0 && serial_2d != serial) {
       const auto c0 = std::chrono::steady_clock::now();
       compose_2d(frame, kDepthAlpha, kMarkerRadiusPx, scratch, image);
       compose_times_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - c0).count());
+      serial_2d = serial;
+    }
+    if (frame.frame >= 0 && (!orbit_ready || reset_orbit)) {
+      orbit = default_orbit(frame);
+      orbit_ready = true;
+      reset_orbit = false;
+      serial_3d = -1;
+    }
+    if (rects.cloud_3d.width > 0 && (serial_3d != serial || orbit_moved || cloud.width != rects.cloud_3d.width ||
+                                     cloud.height != rects.cloud_3d.height)) {
+      compose_3d(frame, orbit, rects.cloud_3d.width, rects.cloud_3d.height, cloud_scratch, cloud);
+      serial_3d = serial;
     }
     stats.viewer_dropped = tap.dropped();
     tap.timeline(stats.timeline);
     stats.session_ended = ended_ns != 0;
+    stats.notice = replay && playback.paused() ? paused_notice(playback) : std::string();
     const double elapsed_s = static_cast<double>(steady_ns() - start_ns) * 1e-9;
     stats.display_fps = elapsed_s > 0.0 ? static_cast<double>(drawn) / elapsed_s : 0.0;
     // The state when drawn: a result older than max_frame_age_s is NO DATA (a frozen pipeline).
     const ShownState state = shown_state(frame, steady_ns(), max_frame_age_s);
+    const PaneImages panes{mode, rects.image_2d.width > 0 ? &image : nullptr, rects.cloud_3d.width > 0 ? &cloud : nullptr};
     if (take_snapshot || (!snapshots && g_screenshot.exchange(false))) {
-      if (!renderer.snapshot(frame, image, state, stats, kSnapshotWidth, kSnapshotHeight, snapshot)) {
-        spdlog::error("snapshot: the offscreen framebuffer could not be made");
-        exit_code = 1;
-      } else {
-        char name[64];
-        std::snprintf(name, sizeof(name), "frame_%06lld.png", static_cast<long long>(frame.frame));
-        const std::filesystem::path dir = snapshots ? std::filesystem::path(args.snapshot_dir) : std::filesystem::path(".");
-        const std::string path = (dir / name).string();
-        write_color_png(path, snapshot);
-        spdlog::info("snapshot: {} ({}, distance {})", path, state_word(state),
-                     frame.contact.valid ? std::to_string(frame.contact.distance_m) + " m" : std::string("none"));
-      }
+      const std::string dir = snapshots ? args.snapshot_dir : std::string(".");
+      if (!write_snapshot(renderer, frame, panes, state, stats, dir, snapshot)) exit_code = 1;
       if (take_snapshot) tap.rendered(frame.frame);
     }
     if (!snapshots) {
-      int width = 0, height = 0;
-      glfwGetFramebufferSize(window, &width, &height);
-      renderer.draw(frame, image, state, stats, width, height);
+      panels.take_events();
+      renderer.draw(frame, panes, state, stats, width, height, [&] { panels.draw(mode, reset_orbit); });
       glfwSwapBuffers(window);
     }
     if (fresh) {
@@ -276,6 +385,7 @@ int main(int argc, char** argv) {
   app.add_option("--record", args.record, "also record the source's frames to this RealSense .bag");
   app.add_option("--snapshot", args.snapshot_dir, "headless: write DIR/frame_%06d.png (1280x720) at --snapshot-at");
   app.add_option("--snapshot-at", args.snapshot_at, "comma-separated source frame indices for --snapshot");
+  app.add_option("--pane", args.pane, "what the window shows: 2d (default), 3d or split (key v cycles)");
   app.add_option("--slow-render-ms", args.slow_render_ms, "testing: sleep this long per frame drawn")
       ->group("")
       ->check(CLI::Range(0, 10'000));

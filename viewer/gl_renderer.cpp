@@ -98,13 +98,15 @@ bool Renderer::init(GLFWwindow* window, std::string& error) {
   glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 4 * sizeof(float), reinterpret_cast<void*>(2 * sizeof(float)));
   glEnableVertexAttribArray(1);
   glBindVertexArray(0);
-  glGenTextures(1, &texture_);
-  glBindTexture(GL_TEXTURE_2D, texture_);
-  // Nearest: each screen pixel takes one image pixel's exact colour (markers, outline).
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  for (PaneTexture* texture : {&texture_2d_, &texture_3d_}) {
+    glGenTextures(1, &texture->id);
+    glBindTexture(GL_TEXTURE_2D, texture->id);
+    // Nearest: each screen pixel takes one image pixel's exact colour (markers, outline).
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  }
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -134,27 +136,52 @@ void Renderer::shutdown() {
   }
   if (fbo_ != 0) glDeleteFramebuffers(1, &fbo_);
   if (fbo_texture_ != 0) glDeleteTextures(1, &fbo_texture_);
-  if (texture_ != 0) glDeleteTextures(1, &texture_);
+  for (PaneTexture* texture : {&texture_2d_, &texture_3d_}) {
+    if (texture->id != 0) glDeleteTextures(1, &texture->id);
+    *texture = PaneTexture{};
+  }
   if (vbo_ != 0) glDeleteBuffers(1, &vbo_);
   if (vao_ != 0) glDeleteVertexArrays(1, &vao_);
   if (program_ != 0) glDeleteProgram(program_);
-  fbo_ = fbo_texture_ = texture_ = vbo_ = vao_ = program_ = 0;
+  fbo_ = fbo_texture_ = vbo_ = vao_ = program_ = 0;
 }
 
-void Renderer::upload(const ColorImage& image) {
-  glBindTexture(GL_TEXTURE_2D, texture_);
+PaneRects window_panes(PaneMode mode, int width, int height) {
+  return pane_rects(mode, pane_area(width, height, kBorderPx, kStatusPx), kPaneGapPx);
+}
+
+void Renderer::draw_image(PaneTexture& texture, const ColorImage& image, const Rect& rect, int width, int height) {
+  if (rect.width <= 0 || rect.height <= 0 || image.rgb.empty()) return;
+  glBindTexture(GL_TEXTURE_2D, texture.id);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  if (image.width != texture_width_ || image.height != texture_height_) {
+  if (image.width != texture.width || image.height != texture.height) {
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, image.width, image.height, 0, GL_RGB, GL_UNSIGNED_BYTE, image.rgb.data());
-    texture_width_ = image.width;
-    texture_height_ = image.height;
+    texture.width = image.width;
+    texture.height = image.height;
   } else {
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, image.width, image.height, GL_RGB, GL_UNSIGNED_BYTE, image.rgb.data());
   }
+  const float x0 = 2.0F * rect.x / width - 1.0F;
+  const float x1 = 2.0F * (rect.x + rect.width) / width - 1.0F;
+  const float y0 = 1.0F - 2.0F * rect.y / height;
+  const float y1 = 1.0F - 2.0F * (rect.y + rect.height) / height;
+  // Triangle strip: top left, bottom left, top right, bottom right; the image's first row on top.
+  const std::array<float, 16> quad{x0, y0, 0.0F, 0.0F, x0, y1, 0.0F, 1.0F, x1, y0, 1.0F, 0.0F, x1, y1, 1.0F, 1.0F};
+  glScissor(rect.x, height - rect.y - rect.height, rect.width, rect.height);
+  glUseProgram(program_);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, texture.id);
+  glUniform1i(glGetUniformLocation(program_, "image"), 0);
+  glBindVertexArray(vao_);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo_);
+  glBufferSubData(GL_ARRAY_BUFFER, 0, sizeof(quad), quad.data());
+  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+  glBindVertexArray(0);
+  glUseProgram(0);
 }
 
-void Renderer::draw(const ViewFrame& frame, const ColorImage& image, ShownState state, const ViewStats& stats,
-                    int width, int height) {
+void Renderer::draw(const ViewFrame& frame, const PaneImages& panes, ShownState state, const ViewStats& stats,
+                    int width, int height, const std::function<void()>& panels) {
   glViewport(0, 0, width, height);
   glDisable(GL_FRAMEBUFFER_SRGB);
   glDisable(GL_BLEND);
@@ -162,27 +189,16 @@ void Renderer::draw(const ViewFrame& frame, const ColorImage& image, ShownState 
   // The border: the whole target in the state's colour, then the inside dark.
   clear_rect(0, 0, width, height, height, state_color(state));
   clear_rect(kBorderPx, kBorderPx, width - 2 * kBorderPx, height - 2 * kBorderPx, height, Rgb{24, 24, 24});
-  const Rect pane = pane_area(width, height, kBorderPx, kStatusPx);
-  const Rect fit = fit_rect(image.width, image.height, pane);
-  if (fit.width > 0 && fit.height > 0 && !image.rgb.empty()) {
-    upload(image);
-    const float x0 = 2.0F * fit.x / width - 1.0F;
-    const float x1 = 2.0F * (fit.x + fit.width) / width - 1.0F;
-    const float y0 = 1.0F - 2.0F * fit.y / height;
-    const float y1 = 1.0F - 2.0F * (fit.y + fit.height) / height;
-    // Triangle strip: top left, bottom left, top right, bottom right; the image's first row on top.
-    const std::array<float, 16> quad{x0, y0, 0.0F, 0.0F, x0, y1, 0.0F, 1.0F, x1, y0, 1.0F, 0.0F, x1, y1, 1.0F, 1.0F};
-    glScissor(fit.x, height - fit.y - fit.height, fit.width, fit.height);
-    glUseProgram(program_);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, texture_);
-    glUniform1i(glGetUniformLocation(program_, "image"), 0);
-    glBindVertexArray(vao_);
-    glBindBuffer(GL_ARRAY_BUFFER, vbo_);
-    glBufferSubData(GL_ARRAY_BUFFER, 0, sizeof(quad), quad.data());
-    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-    glBindVertexArray(0);
-    glUseProgram(0);
+  const PaneRects rects = window_panes(panes.mode, width, height);
+  Rect fit;
+  if (panes.image_2d != nullptr && rects.image_2d.width > 0) {
+    fit = fit_rect(panes.image_2d->width, panes.image_2d->height, rects.image_2d);
+    draw_image(texture_2d_, *panes.image_2d, fit, width, height);
+  }
+  if (panes.cloud_3d != nullptr && rects.cloud_3d.width > 0) {
+    // Composed at the rectangle's size; a stale size (the window just resized) is fitted.
+    draw_image(texture_3d_, *panes.cloud_3d, fit_rect(panes.cloud_3d->width, panes.cloud_3d->height, rects.cloud_3d),
+               width, height);
   }
   glDisable(GL_SCISSOR_TEST);
 
@@ -192,25 +208,27 @@ void Renderer::draw(const ViewFrame& frame, const ColorImage& image, ShownState 
   io.DisplaySize = ImVec2(static_cast<float>(width), static_cast<float>(height));
   io.DisplayFramebufferScale = ImVec2(1.0F, 1.0F);
   ImGui::NewFrame();
-  draw_overlay(frame, image, state, stats, fit, width, height);
+  draw_overlay(frame, panes.image_2d, state, stats, fit, width, height);
+  if (panels) panels();
   ImGui::Render();
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 }
 
-void Renderer::draw_overlay(const ViewFrame& frame, const ColorImage& image, ShownState state, const ViewStats& stats,
+void Renderer::draw_overlay(const ViewFrame& frame, const ColorImage* image, ShownState state, const ViewStats& stats,
                             const Rect& image_rect, int width, int height) {
   ImDrawList* draw = ImGui::GetForegroundDrawList();
   // Everything stays inside the border: clip to the inner rectangle.
   draw->PushClipRect(ImVec2(kBorderPx, kBorderPx), ImVec2(static_cast<float>(width - kBorderPx),
                                                            static_cast<float>(height - kBorderPx)));
   // The distance beside the line between the two closest points.
-  if (state != ShownState::no_data && frame.contact.valid && image.width > 0 && image_rect.width > 0) {
+  if (state != ShownState::no_data && frame.contact.valid && image != nullptr && image->width > 0 &&
+      image_rect.width > 0) {
     const ViewCamera camera = view_camera(frame);
     const std::optional<Eigen::Vector2f> a = project_to_view(camera, frame.contact.closest_camera);
     const Eigen::Vector3f robot_camera = frame.T_camera_base.cast<float>() * frame.contact.closest_robot_base;
     const std::optional<Eigen::Vector2f> b = project_to_view(camera, robot_camera);
     if (a && b) {
-      const float scale = static_cast<float>(image_rect.width) / static_cast<float>(image.width);
+      const float scale = static_cast<float>(image_rect.width) / static_cast<float>(image->width);
       const Eigen::Vector2f mid = (*a + *b) * 0.5F;
       const ImVec2 at(image_rect.x + (mid.x() + 0.5F) * scale + 12.0F, image_rect.y + (mid.y() + 0.5F) * scale - 14.0F);
       const std::string text = distance_text(frame);
@@ -245,8 +263,13 @@ void Renderer::draw_overlay(const ViewFrame& frame, const ColorImage& image, Sho
   draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 68.0F), IM_COL32(230, 230, 230, 255), reason.c_str());
   draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 88.0F), IM_COL32(170, 170, 170, 255), line2);
   draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 108.0F), IM_COL32(170, 170, 170, 255), line3);
-  draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 128.0F), IM_COL32(140, 140, 140, 255),
-                "hrcsense is not a safety-rated device");
+  const char* disclaimer = "hrcsense is not a safety-rated device";
+  draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 128.0F), IM_COL32(140, 140, 140, 255), disclaimer);
+  if (!stats.notice.empty()) {
+    const float after = font_small_->CalcTextSizeA(18.0F, 1e9F, 0.0F, disclaimer).x + 24.0F;
+    draw->AddText(font_small_, 18.0F, ImVec2(x + after, strip_y + 128.0F), IM_COL32(255, 210, 80, 255),
+                  stats.notice.c_str());
+  }
   draw_timeline(draw, frame, stats, ImVec2(static_cast<float>(width - kBorderPx) - 16.0F - kTimelineWidthPx,
                                            strip_y + 8.0F),
                 ImVec2(kTimelineWidthPx, static_cast<float>(kStatusPx) - 16.0F));
@@ -280,7 +303,7 @@ void Renderer::draw_timeline(ImDrawList* draw, const ViewFrame& frame, const Vie
   }
 }
 
-bool Renderer::snapshot(const ViewFrame& frame, const ColorImage& image, ShownState state, const ViewStats& stats,
+bool Renderer::snapshot(const ViewFrame& frame, const PaneImages& panes, ShownState state, const ViewStats& stats,
                         int width, int height, ColorImage& out) {
   if (fbo_ == 0 || fbo_width_ != width || fbo_height_ != height) {
     if (fbo_ != 0) glDeleteFramebuffers(1, &fbo_);
@@ -299,7 +322,7 @@ bool Renderer::snapshot(const ViewFrame& frame, const ColorImage& image, ShownSt
     fbo_height_ = height;
   }
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-  draw(frame, image, state, stats, width, height);
+  draw(frame, panes, state, stats, width, height);
   glFinish();
   std::vector<uint8_t> rows(static_cast<size_t>(width) * height * 3);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);

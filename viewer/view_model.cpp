@@ -361,4 +361,33 @@ Rect pane_area(int window_width, int window_height, int border_px, int status_px
   return r;
 }
 
+std::optional<PaneMode> parse_pane_mode(const std::string& name) {
+  if (name == "2d") return PaneMode::view_2d;
+  if (name == "3d") return PaneMode::view_3d;
+  if (name == "split") return PaneMode::split;
+  return std::nullopt;
+}
+
+const char* pane_mode_name(PaneMode mode) {
+  switch (mode) {
+    case PaneMode::view_2d: return "2d";
+    case PaneMode::view_3d: return "3d";
+    case PaneMode::split: return "split";
+  }
+  return "2d";
+}
+
+PaneRects pane_rects(PaneMode mode, const Rect& pane, int gap_px) {
+  PaneRects rects;
+  if (mode == PaneMode::view_2d) rects.image_2d = pane;
+  if (mode == PaneMode::view_3d) rects.cloud_3d = pane;
+  if (mode == PaneMode::split) {
+    const int inner = std::max(0, pane.width - gap_px);
+    const int left = inner - inner / 2;
+    rects.image_2d = Rect{pane.x, pane.y, left, pane.height};
+    rects.cloud_3d = Rect{pane.x + left + gap_px, pane.y, inner / 2, pane.height};
+  }
+  return rects;
+}
+
 }  // namespace hrcsense::view

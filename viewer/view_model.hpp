@@ -180,4 +180,21 @@ Rect fit_rect(int image_width, int image_height, const Rect& area);
 /// every side and a status strip of `status_px` at the bottom, inside the border.
 Rect pane_area(int window_width, int window_height, int border_px, int status_px);
 
+/// Which panes the window shows: the 2D image, the 3D cloud, or both side by side.
+enum class PaneMode { view_2d, view_3d, split };
+/// "2d", "3d", "split"; nullopt for another name.
+std::optional<PaneMode> parse_pane_mode(const std::string& name);
+const char* pane_mode_name(PaneMode mode);
+
+/// Where the panes go inside `pane` (pane_area()): the whole of it for one pane; for split,
+/// the left half for the 2D image and the right half for the 3D cloud with a gap of
+/// `gap_px` between them (the left half gets the odd pixel). A pane not shown has width 0.
+/// The 2D image is then fitted into its rectangle (fit_rect); the 3D cloud is composed at
+/// its rectangle's size.
+struct PaneRects {
+  Rect image_2d;
+  Rect cloud_3d;
+};
+PaneRects pane_rects(PaneMode mode, const Rect& pane, int gap_px);
+
 }  // namespace hrcsense::view

@@ -109,8 +109,14 @@ int run_session(const Config& config, const SessionOptions& args) {
   const bool paced = config.source.pace && !args.unpaced;
   SourceOptions source_options;
   source_options.stop_requested = &g_stop_requested;
+  source_options.with_color = args.with_color;
   std::unique_ptr<Source> source = make_source(config, source_options);
   std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config, *source);
+  const bool recording_source = config.source.type == "bag" || config.source.type == "folder";
+  if (args.wrap_recording && recording_source) {
+    // The robot states may come from the first source: the wrapper keeps it alive.
+    source = args.wrap_recording(std::move(source), [config, source_options] { return make_source(config, source_options); });
+  }
   const SourceInfo info = source->info();
   // --record: the source's frames, as delivered, to a bag on a writer thread (never blocking),
   // each with the robot state processing will measure it against.
@@ -163,6 +169,7 @@ int run_session(const Config& config, const SessionOptions& args) {
   options.max_frames = args.frames;
   options.stop_requested = &g_stop_requested;
   options.on_processed = args.on_processed;
+  options.before_process = args.before_process;
   install_signal_handlers();
   const RunSummary summary = run_pipeline(frames, *robot_states, pipeline, sinks, options, header);
   restore_signal_handlers();

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 
 namespace hrcsense::app {
@@ -25,6 +26,14 @@ struct SessionOptions {
   std::function<void(const Frame&, const Pipeline&, const FrameResult&)> on_processed;
   /// Set: the summary reports `viewer_frames_dropped` from it (read once the run has ended).
   std::function<int64_t()> viewer_frames_dropped;
+  /// RunOptions::before_process: the viewer's requests to the pipeline, between frames.
+  std::function<void(Pipeline&, const FrameResult&)> before_process;
+  /// Recorded sources decode their colour frames too (the viewer shows them).
+  bool with_color = false;
+  /// Set: a recording (.bag or folder source) is replaced by what this makes of it, given
+  /// the opened source and a way to open it again from its start (the viewer's playback).
+  std::function<std::unique_ptr<Source>(std::unique_ptr<Source> opened, std::function<std::unique_ptr<Source>()> open)>
+      wrap_recording;
 };
 
 /// Runs the configured cell to its end (source end, --frames, a signal or

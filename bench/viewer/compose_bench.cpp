@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // The viewer's CPU side per drawn frame (viewer/view_model.hpp): the whole 2D pane of a
 // processed 848×480 frame with colour, and its parts, on walk.yaml at the closest approach
-// (frame 198) and on the moving UR5 cell (frame 300: the arm's capsules in view).
+// (frame 198) and on the moving UR5 cell (frame 300: the arm's capsules in view); the 3D
+// pane of the same UR5 frame at 1280×720.
+#include "viewer/cloud_view.hpp"
 #include "viewer/view_model.hpp"
 #include "viewer/view_tap.hpp"
 
@@ -77,6 +79,17 @@ void BM_ComposeRobotMask(benchmark::State& state) {
   }
 }
 
+void BM_Compose3d(benchmark::State& state) {
+  const ViewFrame frame = processed_frame("cell-ur5-moving.yaml", 300);
+  const OrbitCamera orbit = default_orbit(frame);
+  Cloud3dScratch scratch;
+  ColorImage out;
+  for (auto _ : state) {
+    compose_3d(frame, orbit, 1280, 720, scratch, out);
+    benchmark::DoNotOptimize(out.rgb.data());
+  }
+}
+
 BENCHMARK_CAPTURE(BM_Compose, walk, "walk.yaml", 198)->Name("View/compose_walk/848x480")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Compose, ur5, "cell-ur5-moving.yaml", 300)
     ->Name("View/compose_ur5_moving/848x480")
@@ -84,6 +97,7 @@ BENCHMARK_CAPTURE(BM_Compose, ur5, "cell-ur5-moving.yaml", 300)
 BENCHMARK(BM_ComposeAlign)->Name("View/align_depth_to_color/848x480")->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ComposeColorize)->Name("View/colorize_depth/848x480")->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ComposeRobotMask)->Name("View/robot_mask_ur5/848x480")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Compose3d)->Name("View/compose_3d_ur5_moving/1280x720")->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace hrcsense::view

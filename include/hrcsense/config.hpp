@@ -146,6 +146,13 @@ RobotDescription load_robot_description(const std::string& path);
 /// The robot's capsules at the fixed pose robot.joints_rad (robot_model_at), base frame.
 RobotModel fixed_robot_model(const Config& config);
 
+/// `--set` overrides (KEY=VALUE) that give a configuration `tuning`: every option of the blocks
+/// in tuning.filters.order, foreground.k_sigma, min_margin_m and min_object_mm, and
+/// proximity.backend. load_config(file, sets + these) validates them as it validates a file,
+/// and its canonical_yaml is a configuration `hrcsense run --config` accepts (hrcsense-view's
+/// "save tuned parameters").
+std::vector<std::string> tuning_overrides(const LiveTuning& tuning);
+
 /// FNV-1a 64-bit hash of the effective configuration, as 16 hex digits.
 std::string config_hash(const Config& config);
 

@@ -48,6 +48,19 @@ struct PipelineParams {
   ProximityParams proximity;  ///< octree height, brute threads
 };
 
+/// What may change while the cell runs, between two frames (hrcsense-view's panels): the
+/// filters' parameters, the foreground extraction and the search backend. Not the filter
+/// order nor the decimation (they set the resolution the background was learnt at), and never
+/// the safety distances, the robot or the camera pose: those need a new run.
+struct LiveTuning {
+  FilterChainParams filters;
+  ForegroundParams foreground;
+  std::string backend = "brute";  ///< as PipelineParams::backend
+};
+
+/// The tunable part of `params`.
+LiveTuning tuning_of(const PipelineParams& params);
+
 /// The per-frame processing path: depth filters → background → foreground → robot capsules →
 /// proximity → verdict, on the caller's thread (run_pipeline gives it a thread of its own; the brute-force
 /// search may use a second one, `proximity.threads`). Owns the stages' state and scratch buffers.
@@ -66,6 +79,15 @@ class Pipeline {
   /// from `robot_state` (the arm's joints at the frame's time; ignored by robot.model points,
   /// but an invalid state is a stop for every model), without allocating once sized.
   void process(const Frame& frame, const RobotState& robot_state, FrameResult& result);
+  /// The tunable part of params() (LiveTuning).
+  LiveTuning tuning() const;
+  /// Takes `tuning` from the next frame on (call it between frames, on the processing thread).
+  /// Throws std::invalid_argument, naming the field, when it changes the filter order or the
+  /// decimation, or names no backend; the pipeline is then unchanged.
+  void retune(const LiveTuning& tuning);
+  /// Forgets the background (learnt or loaded) and learns a new one from the next frames,
+  /// which are stops (`learning_background`) until it is ready.
+  void relearn_background();
   /// The robot's capsules of the last frame that got as far as the search (base frame).
   const RobotModel& robot() const { return robot_; }
   /// The self-filter with the last frame's rendered robot (empty for robot.model points).
@@ -117,6 +139,11 @@ struct RunOptions {
   /// viewer's tap (hrcsense-view). It delays the output by what it costs, so it must copy and
   /// return, never wait (a headless snapshot, which waits on purpose, runs unpaced).
   std::function<void(const Frame&, const Pipeline&, const FrameResult&)> on_processed;
+  /// Called on the processing thread before each frame with the pipeline and the previous
+  /// frame's result (a default, invalid one before the first): where the viewer's requests
+  /// (Pipeline::retune, relearn_background) reach the pipeline between frames, never during
+  /// one. Like on_processed it must not wait.
+  std::function<void(Pipeline&, const FrameResult& previous)> before_process;
 };
 
 /// True when run_pipeline gives a frame without its own host time (Frame::host_time_ns 0) its

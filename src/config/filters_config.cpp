@@ -4,6 +4,7 @@
 #include "key_reader.hpp"
 
 #include <algorithm>
+#include <cstdio>
 
 namespace hrcsense::config_detail {
 namespace {
@@ -137,3 +138,26 @@ void read_filters(KeyReader& r, Config& c) {
 }
 
 }  // namespace hrcsense::config_detail
+
+namespace hrcsense {
+
+std::vector<std::string> tuning_overrides(const LiveTuning& tuning) {
+  // %.9g: enough digits for a float to read back as the same float.
+  const auto entry = [](const char* key, double value) {
+    char text[96];
+    std::snprintf(text, sizeof text, "%s=%.9g", key, value);
+    return std::string(text);
+  };
+  std::vector<std::string> sets;
+  for (const config_detail::BlockOption& option : config_detail::kBlockOptions) {
+    // Options of blocks outside the chain are refused by read_filters (they would be ignored).
+    if (config_detail::contains(tuning.filters.order, option.block)) sets.push_back(entry(option.key, option.value(tuning.filters)));
+  }
+  sets.push_back(entry("foreground.k_sigma", tuning.foreground.k_sigma));
+  sets.push_back(entry("foreground.min_margin_m", tuning.foreground.min_margin_m));
+  sets.push_back(entry("foreground.min_object_mm", tuning.foreground.min_object_mm));
+  sets.push_back("proximity.backend=" + tuning.backend);
+  return sets;
+}
+
+}  // namespace hrcsense

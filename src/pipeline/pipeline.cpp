@@ -137,6 +137,10 @@ ProximitySearch make_proximity_search(const PipelineParams& params) {
   return ProximitySearch(*backend, params.proximity);
 }
 
+bool contains_block(const std::vector<FilterBlock>& order, FilterBlock block) {
+  return std::find(order.begin(), order.end(), block) != order.end();
+}
+
 }  // namespace
 
 Pipeline::Pipeline(PipelineParams params)
@@ -145,6 +149,42 @@ Pipeline::Pipeline(PipelineParams params)
   extractor_.params = params_.foreground;
   filters_.params = params_.filters;
   self_filter_.params = params_.self_filter;
+}
+
+LiveTuning tuning_of(const PipelineParams& params) { return LiveTuning{params.filters, params.foreground, params.backend}; }
+
+LiveTuning Pipeline::tuning() const { return tuning_of(params_); }
+
+void Pipeline::retune(const LiveTuning& tuning) {
+  if (tuning.filters.order != params_.filters.order) {
+    throw std::invalid_argument("filters.order cannot change while the cell runs (the background is learnt after it)");
+  }
+  if (contains_block(params_.filters.order, FilterBlock::decimation) &&
+      tuning.filters.decimation.magnitude != params_.filters.decimation.magnitude) {
+    throw std::invalid_argument("filters.decimation.magnitude cannot change while the cell runs (it sets the "
+                                "background's resolution)");
+  }
+  PipelineParams next = params_;
+  next.filters = tuning.filters;
+  next.foreground = tuning.foreground;
+  next.backend = tuning.backend;
+  ProximitySearch search = make_proximity_search(next);  // throws for a bad name, nothing changed yet
+  params_ = std::move(next);
+  proximity_ = std::move(search);
+  filters_.params = params_.filters;
+  extractor_.params = params_.foreground;  // prepared_for() sees the change and re-prepares
+  check_.k_sigma = params_.foreground.k_sigma;
+  check_.min_margin_m = params_.foreground.min_margin_m;
+}
+
+void Pipeline::relearn_background() {
+  learner_ = BackgroundLearner{};
+  learner_.params = params_.background;
+  preset_background_ = false;
+  preset_model_ = BackgroundModel{};
+  check_ = BackgroundCheck{};
+  extractor_.clear_background();
+  filters_.reset();  // the temporal filter's history holds the scene as it was
 }
 
 std::optional<RobotPixels> Pipeline::render_robot(const Frame& frame, FrameResult& result) {

@@ -114,6 +114,7 @@ void capture_loop(Source& source, const RunOptions& options, RunClock& clock, do
   Captured slot;
   int64_t due_ns = 0;  // paced: when the current frame is to be delivered
   int64_t previous_ns = 0;
+  bool resync = true;  // pace from now: at the first frame and after a silence (a paused replay)
   for (int64_t n = 0;; ++n) {
     if (stop_requested(options)) {
       outcome.end_code = ReasonCode::stop_requested;
@@ -144,6 +145,7 @@ void capture_loop(Source& source, const RunOptions& options, RunClock& clock, do
     }
     if (status == Source::Status::idle) {  // no frame yet: the output loop's watchdog stops the cell
       --n;
+      resync = true;  // else the frames after the silence would all be due at once
       continue;
     }
     if (status == Source::Status::error) {
@@ -158,7 +160,8 @@ void capture_loop(Source& source, const RunOptions& options, RunClock& clock, do
     slot.timestamp_warning =
         n == 0 ? nullptr : check_timestamp_step(step_ns, nominal_fps, max_frame_age_s, outcome.timestamps);
     if (options.pace) {
-      due_ns = n == 0 ? clock.now_ns() : due_ns + pacing_step_ns(step_ns, nominal_fps, max_frame_age_ns);
+      due_ns = resync ? clock.now_ns() : due_ns + pacing_step_ns(step_ns, nominal_fps, max_frame_age_ns);
+      resync = false;
       clock.sleep_until(due_ns, options.stop_requested);
     }
     slot.captured_ns = clock.now_ns();
@@ -189,9 +192,11 @@ void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const R
   const int64_t camera_latency_ns = robot_state_lookup_offset_ns(robot_states.origin(), options.camera_latency_s);
   Captured in;
   FrameResult result;
+  FrameResult previous;  // for before_process; its buffers are reused
   RobotState robot_state;
   try {
     while (frames.take(in)) {
+      if (options.before_process) options.before_process(pipeline, previous);
       // The robot as it was when the camera saw the frame; none is a stop (Pipeline::process).
       if (!robot_states.state_at(in.frame.host_time_ns - camera_latency_ns, robot_state)) robot_state.valid = false;
       pipeline.process(in.frame, robot_state, result);
@@ -199,6 +204,7 @@ void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const R
       const int64_t age_ns = clock.now_ns() - in.captured_ns;
       if (age_ns > max_frame_age_ns) result.verdict = stop_verdict(ReasonCode::stale_frame, "stale frame");
       if (options.on_processed) options.on_processed(in.frame, pipeline, result);
+      if (options.before_process) previous = result;  // put() swaps `result` with an older buffer
       ++stats.processed;
       stats.latencies.add(result.latency_us);
       if (!(options.pace ? results.put(result) : results.put_wait(result))) break;  // the output ended

@@ -29,15 +29,6 @@ using test::Step;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int64_t kFrameNs = 33'333'333;
 
-// Learns the wall in `pipeline` (kLearnFrames frames), leaving `result` at the last one.
-void learn(Pipeline& pipeline, Frame& frame, FrameResult& result) {
-  for (int i = 0; i < test::kLearnFrames; ++i) {
-    fill_frame(i, 0.0F, frame);
-    pipeline.process(frame, fixed_robot_state({}), result);
-  }
-  ASSERT_TRUE(pipeline.background_ready());
-}
-
 // Item 1: an overflowed pose (here inf in the translation, as 1e39 cast to float gives) turns
 // every foreground point into inf/NaN; the search finds no contact, and that must be a stop.
 TEST(Failsafe, ForegroundWithoutContactIsStop) {
@@ -46,7 +37,7 @@ TEST(Failsafe, ForegroundWithoutContactIsStop) {
   Pipeline pipeline(params);
   Frame frame;
   FrameResult result;
-  learn(pipeline, frame, result);
+  ASSERT_TRUE(test::learn_wall(pipeline, frame, result));
   fill_frame(3, 1.5F, frame);  // a 40x40 px object at 1.5 m: 1600 foreground pixels
   pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.foreground_points, 1600U);
@@ -68,7 +59,7 @@ TEST(Failsafe, RobotAtInfinityIsStop) {
   Pipeline pipeline(params);
   Frame frame;
   FrameResult result;
-  learn(pipeline, frame, result);
+  ASSERT_TRUE(test::learn_wall(pipeline, frame, result));
   fill_frame(3, 1.5F, frame);
   pipeline.process(frame, fixed_robot_state({}), result);
   EXPECT_GT(result.foreground_points, 0U);
@@ -100,7 +91,7 @@ TEST(Failsafe, TooFewValidPixelsIsStop) {
   Pipeline pipeline(fake_params());
   Frame frame;
   FrameResult result;
-  learn(pipeline, frame, result);
+  ASSERT_TRUE(test::learn_wall(pipeline, frame, result));
   fill_frame(3, 0.0F, frame);
   std::fill(frame.depth.pixels.begin(), frame.depth.pixels.end(), uint16_t{0});
   frame.depth.pixels[100] = 2000;
@@ -131,7 +122,7 @@ TEST(Failsafe, InsideTheRobotIsStopWhateverTheZones) {
   Pipeline pipeline(params);
   Frame frame;
   FrameResult result;
-  learn(pipeline, frame, result);
+  ASSERT_TRUE(test::learn_wall(pipeline, frame, result));
   fill_frame(3, 1.5F, frame);
   pipeline.process(frame, fixed_robot_state({}), result);
   ASSERT_TRUE(result.contact.valid);

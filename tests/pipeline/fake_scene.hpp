@@ -227,6 +227,16 @@ class WatchedClock : public RunClock {
 };
 
 /// The background a pipeline learns from the empty fake scene (the wall at 2 m).
+/// Learns the wall in `pipeline` (kLearnFrames frames), leaving `result` at the last one;
+/// true when the background is then ready.
+inline bool learn_wall(Pipeline& pipeline, Frame& frame, FrameResult& result) {
+  for (int i = 0; i < kLearnFrames; ++i) {
+    fill_frame(i, 0.0F, frame);
+    pipeline.process(frame, fixed_robot_state({}), result);
+  }
+  return pipeline.background_ready();
+}
+
 inline BackgroundModel learn_empty_background() {
   Pipeline learner(fake_params());
   Frame frame;

@@ -476,5 +476,49 @@ TEST(RunPipeline, StopRequestEndsARunWhoseSourceIsSilent) {
   EXPECT_EQ(sink.results.back().verdict.state, VerdictState::stop);
 }
 
+// A replay paused for 2 s (the source says idle meanwhile, as hrcsense-view's PlaybackSource
+// does) goes on at its own pace afterwards: frame 5 when the pause ends, each later one a
+// frame period after it. Were the frames after the pause due at their old times, they would
+// all be due at once and the fake clock would not move after the pause.
+class PausesOnce : public Source {
+ public:
+  PausesOnce(FakeSource& frames, FakeClock& clock, CollectingSink& sink) : frames_(frames), clock_(clock), sink_(sink) {}
+  SourceInfo info() const override { return frames_.info(); }
+  Status next(Frame& out) override {
+    if (delivered_ == 5 && !paused_) {
+      paused_ = true;
+      if (!has_results(sink_, 5)) return Status::error;
+      clock_.advance(2'000'000'000);
+      return Status::idle;
+    }
+    const Status status = frames_.next(out);
+    if (status == Status::frame) ++delivered_;
+    return status;
+  }
+
+ private:
+  FakeSource& frames_;
+  FakeClock& clock_;
+  CollectingSink& sink_;
+  int delivered_ = 0;
+  bool paused_ = false;
+};
+
+TEST(RunPipeline, PacingStartsAgainAfterASilence) {
+  FakeSource frames(std::vector<Step>(10, Step{}));
+  CollectingSink sink;
+  frames.before_step = [&](size_t step) { return has_results(sink, step); };
+  FakeClock clock(1'000'000'000);
+  PausesOnce source(frames, clock, sink);
+  RunOptions options;
+  options.pace = true;
+  options.clock = &clock;
+  const RunSummary summary = test::run_fake(source, sink, fake_params(5.0), options);
+  EXPECT_EQ(summary.frames_in, 10);
+  EXPECT_EQ(summary.frames_dropped, 0);
+  // Frames 0-4 at 0, 1, ... 4 periods; the pause; frames 5-9 at 0 ... 4 periods after it.
+  EXPECT_EQ(clock.now_ns(), int64_t{1'000'000'000} + 4 * 33'333'333 + 2'000'000'000 + 4 * 33'333'333);
+}
+
 }  // namespace
 }  // namespace hrcsense

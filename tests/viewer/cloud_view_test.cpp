@@ -174,7 +174,8 @@ TEST(OrbitCamera, DefaultShowsTheBaseAndTheCamera) {
   T_base_camera.translation() = Eigen::Vector3d(2, 0, 2);
   frame.T_camera_base = T_base_camera.inverse();
   const OrbitCamera camera = default_orbit(frame);
-  EXPECT_NEAR((camera.target_base - Eigen::Vector3f(1, 0, 1)).norm(), 0.0F, 1e-5F);
+  // A metre along the camera's optical axis, which is base +z here.
+  EXPECT_NEAR((camera.target_base - Eigen::Vector3f(2, 0, 3)).norm(), 0.0F, 1e-5F);
   EXPECT_NEAR(camera.distance_m, 2.0F * std::sqrt(8.0F), 1e-4F);
   EXPECT_NEAR(camera.yaw_rad, kPi / 4.0F, 1e-5F);    // the camera's azimuth 0, turned 45°
   EXPECT_NEAR(camera.pitch_rad, kPi / 6.0F, 1e-5F);  // 30° above
@@ -189,7 +190,7 @@ TEST(OrbitCamera, DefaultShowsTheBaseAndTheCamera) {
     EXPECT_LT(px->y(), 720.0F);
   }
   const OrbitCamera home = default_orbit(ViewFrame{});
-  EXPECT_EQ(home.target_base, Eigen::Vector3f::Zero());
+  EXPECT_EQ(home.target_base, Eigen::Vector3f(0, 0, 1));
   EXPECT_FLOAT_EQ(home.distance_m, 3.0F);
 }
 

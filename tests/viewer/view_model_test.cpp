@@ -310,3 +310,39 @@ TEST(ViewTap, WaitsAtASnapshotFrameUntilDrawn) {
 
 }  // namespace
 }  // namespace hrcsense::view
+
+namespace hrcsense::view {
+namespace {
+
+TEST(PaneRects, OnePaneTakesAllAndSplitHalvesWithAGap) {
+  const Rect pane{12, 12, 1256, 546};
+  const PaneRects only_2d = pane_rects(PaneMode::view_2d, pane, 8);
+  EXPECT_EQ(only_2d.image_2d.width, 1256);
+  EXPECT_EQ(only_2d.cloud_3d.width, 0);
+  const PaneRects only_3d = pane_rects(PaneMode::view_3d, pane, 8);
+  EXPECT_EQ(only_3d.image_2d.width, 0);
+  EXPECT_EQ(only_3d.cloud_3d.x, 12);
+  EXPECT_EQ(only_3d.cloud_3d.width, 1256);
+  // 1256 − 8 = 1248: 624 each, the 3D pane starting at 12 + 624 + 8.
+  const PaneRects split = pane_rects(PaneMode::split, pane, 8);
+  EXPECT_EQ(split.image_2d.x, 12);
+  EXPECT_EQ(split.image_2d.width, 624);
+  EXPECT_EQ(split.cloud_3d.x, 644);
+  EXPECT_EQ(split.cloud_3d.width, 624);
+  EXPECT_EQ(split.cloud_3d.height, 546);
+  // An odd width: the left pane gets the odd pixel; nothing overlaps.
+  const PaneRects odd = pane_rects(PaneMode::split, Rect{0, 0, 109, 10}, 8);
+  EXPECT_EQ(odd.image_2d.width, 51);
+  EXPECT_EQ(odd.cloud_3d.x, 59);
+  EXPECT_EQ(odd.cloud_3d.width, 50);
+}
+
+TEST(PaneRects, ModeNamesReadBack) {
+  for (const PaneMode mode : {PaneMode::view_2d, PaneMode::view_3d, PaneMode::split}) {
+    EXPECT_EQ(parse_pane_mode(pane_mode_name(mode)), mode);
+  }
+  EXPECT_FALSE(parse_pane_mode("4d"));
+}
+
+}  // namespace
+}  // namespace hrcsense::view

@@ -17,7 +17,9 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -25,6 +27,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace hrcsense::view {
 namespace {
@@ -321,6 +324,101 @@ TEST_F(ViewerGl, SlowViewerCostsTheOutputNoFrame) {
   EXPECT_EQ(run.summary["frames_dropped"], 0);
   ASSERT_TRUE(run.summary["viewer_frames_dropped"].is_number_integer());
   EXPECT_GT(run.summary["viewer_frames_dropped"].get<int64_t>(), 0);
+}
+
+TEST_F(ViewerGl, CloudPaneShowsTheArmAndTheClosestPair) {
+  // The moving arm at frame 300: the hand 0.23 m from the arm, stop. The 3D pane alone.
+  const fs::path dir = fresh_dir("cloud");
+  const std::string command = kXvfb + kView + " --config " + kSource + "/config/cell-ur5-moving.yaml --pane 3d --snapshot " +
+                              dir.string() + " --snapshot-at 300 --out " + (dir / "run.jsonl").string() + " 2> " +
+                              (dir / "stderr.txt").string();
+  ASSERT_EQ(shell(command), 0) << "see " << (dir / "stderr.txt");
+  const Jsonl run = read_jsonl(dir / "run.jsonl");
+  const nlohmann::json& line = run.frames.at(300);
+  ASSERT_EQ(line["verdict"], "stop");
+  ColorImage png;
+  read_color_png((dir / "frame_000300.png").string(), png);
+  expect_border(png, kStopColor, "cloud");
+  // The pane: the window inside the border, above the 150 px strip (whose text is white too).
+  ColorImage pane;
+  pane.width = 1280 - 24;
+  pane.height = 720 - 24 - 150;
+  pane.rgb.resize(static_cast<size_t>(pane.width) * pane.height * 3);
+  for (int y = 0; y < pane.height; ++y) {
+    std::copy_n(&png.rgb[3 * (static_cast<size_t>(y + 12) * png.width + 12)], 3 * pane.width,
+                &pane.rgb[3 * static_cast<size_t>(y) * pane.width]);
+  }
+  const Eigen::Vector2d centre(pane.width / 2.0, pane.height / 2.0);
+  const int half = pane.width / 2;
+  const Blob contact = find_color(pane, kContactMarker, centre, half);
+  const Blob robot = find_color(pane, kRobotMarker, centre, half);
+  const Blob outline = find_color(pane, kRobotOutline, centre, half);
+  const Blob joining = find_color(pane, kContactLine, centre, half);
+  EXPECT_GE(contact.count, 20);   // a disc of radius 4 px: 49 pixels, less what the other covers
+  EXPECT_GE(robot.count, 20);
+  EXPECT_GE(outline.count, 100);  // the arm's edge
+  // 0.23 m apart a few metres from the orbit camera: tens of pixels, never across the pane.
+  EXPECT_LT((contact.centroid - robot.centroid).norm(), 120.0);
+  EXPECT_GE(joining.count + contact.count, 20);
+}
+
+bool have_xdotool() { return std::system("command -v xdotool > /dev/null 2>&1") == 0; }
+
+// The window as a person uses it, keys sent by xdotool: space pauses a replay, `s` writes a
+// screenshot, `.` steps one frame, `q` quits. While paused no frame reaches the pipeline, so
+// its watchdog writes stops (no_frame) and the view says NO DATA: a paused replay never says run.
+TEST_F(ViewerGl, PausedReplayStopsTheCellAndStepsOneFrame) {
+  if (!have_xdotool()) GTEST_SKIP() << "xdotool not installed (scripts/setup installs it)";
+  const fs::path dir = fresh_dir("replay");
+  const std::string config = kSource + "/config/walk.yaml";
+  ASSERT_EQ(shell(std::string(HRCSENSE_CLI) + " record --config " + config + " --out " + (dir / "walk.bag").string() +
+                  " 2> " + (dir / "record.txt").string()),
+            0)
+      << "see " << (dir / "record.txt");
+  const std::string view = kView + " --config " + config + " --set source.type=bag --set source.path=walk.bag" +
+                           " --set source.pace=true --out run.jsonl 2> stderr.txt";
+  // Every wait is bounded: xdotool's search by `timeout`, the viewer by the replay's length.
+  const std::string script = "cd " + dir.string() + " && " + view +
+                             " & pid=$!; w=$(timeout 30 xdotool search --sync --name hrcsense-view | head -1); "
+                             "xdotool windowfocus --sync \"$w\"; sleep 1; xdotool key space; sleep 1.5; xdotool key s; "
+                             "sleep 0.5; xdotool key period; sleep 1; xdotool key s; sleep 0.5; xdotool key q; wait $pid";
+  ASSERT_EQ(shell(kXvfb + "sh -c '" + script + "' > " + (dir / "xdotool.txt").string() + " 2>&1"), 0)
+      << "see " << (dir / "stderr.txt");
+  std::vector<int64_t> shots;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("frame_", 0) == 0) shots.push_back(std::stoll(name.substr(6, 6)));
+  }
+  std::sort(shots.begin(), shots.end());
+  ASSERT_EQ(shots.size(), 2U) << "see " << (dir / "stderr.txt");
+  EXPECT_EQ(shots[1], shots[0] + 1);  // `.` let exactly one frame through
+  ColorImage paused;
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%06lld.png", static_cast<long long>(shots[0]));
+  read_color_png((dir / name).string(), paused);
+  expect_border(paused, kNoDataColor, "paused");
+
+  // The output: the watchdog's stops while paused, between the two frames; the run ended by q.
+  std::ifstream in(dir / "run.jsonl");
+  std::string text;
+  int watchdog_stops = 0;
+  int64_t last_frame = -1;
+  nlohmann::json summary;
+  while (std::getline(in, text)) {
+    const nlohmann::json j = nlohmann::json::parse(text);
+    if (j["type"] == "summary") summary = j;
+    if (j["type"] == "verdict" && j["reason_code"] == "no_frame") {  // a stop that stands for no frame
+      EXPECT_EQ(j["verdict"], "stop");
+      EXPECT_EQ(j["frame"].get<int64_t>(), last_frame);  // repeats the last frame's index
+      // Paused at the first screenshot's frame, then (after the step) at the second's.
+      EXPECT_TRUE(last_frame == shots[0] || last_frame == shots[1]) << last_frame;
+      watchdog_stops += last_frame == shots[0] ? 1 : 0;
+    }
+    if (j["type"] == "frame") last_frame = j["frame"].get<int64_t>();
+  }
+  EXPECT_GE(watchdog_stops, 2);  // 1.5 s paused at frame shots[0], safety.max_frame_age_s 0.5 s
+  EXPECT_EQ(summary["end_reason_code"], "stop_requested") << summary.dump();
+  EXPECT_LT(summary["frames_in"].get<int64_t>(), 201);
 }
 
 TEST(ViewerNoDisplay, OneLineAndANonZeroExit) {

@@ -1,0 +1,209 @@
+// SPDX-License-Identifier: Apache-2.0
+// The panels' requests to the running pipeline: relearning is refused while the robot moves
+// or anything is near it, and nothing reaches the pipeline but between frames.
+
+#include "viewer/view_control.hpp"
+
+#include <gtest/gtest.h>
+
+#include "hrcsense/io.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+
+namespace hrcsense::view {
+namespace {
+
+// A 20×10 wall at 2 m, optionally with a 6×4 px block at `object_m`, seen by a camera at the
+// robot base (identity pose); the robot a point at the origin (slow 1 m, stop 0.5 m).
+void wall_frame(int64_t index, float object_m, Frame& out) {
+  out.index = index;
+  out.timestamp_ns = index * 33'333'333;
+  out.intrinsics.width = 20;
+  out.intrinsics.height = 10;
+  out.intrinsics.fx = out.intrinsics.fy = 20.0F;
+  out.intrinsics.ppx = 9.5F;
+  out.intrinsics.ppy = 4.5F;
+  out.stereo_baseline_mm = 50.0F;
+  out.depth.resize(20, 10);
+  for (int v = 0; v < 10; ++v) {
+    for (int u = 0; u < 20; ++u) {
+      const bool in_object = object_m > 0.0F && u >= 7 && u < 13 && v >= 3 && v < 7;
+      out.depth.pixels[static_cast<size_t>(v) * 20 + u] =
+          static_cast<uint16_t>(in_object ? object_m * 1000.0F : 2000.0F);
+    }
+  }
+}
+
+PipelineParams point_robot_params() {
+  PipelineParams params;
+  params.background.frames = 2;
+  params.robot.points.capsules.push_back(Capsule{});
+  params.safety.slow_distance_m = 1.0F;
+  params.safety.stop_distance_m = 0.5F;
+  params.foreground.min_object_mm = 0.0F;
+  return params;
+}
+
+FrameResult still_and_clear() {
+  FrameResult result;
+  result.frame = 7;
+  result.valid = true;
+  result.robot_state = fixed_robot_state({});
+  result.verdict.state = VerdictState::run;
+  result.verdict.code = ReasonCode::clear;
+  return result;
+}
+
+TEST(RelearnRefusal, AllowedWhenStillAndClear) { EXPECT_EQ(relearn_refusal(still_and_clear()), ""); }
+
+TEST(RelearnRefusal, RefusedWhileTheRobotMoves) {
+  FrameResult result = still_and_clear();
+  result.robot_state.qd_rad_s[2] = 0.05F;
+  const std::string why = relearn_refusal(result);
+  EXPECT_NE(why.find("moving"), std::string::npos) << why;
+  EXPECT_NE(why.find("joint 3"), std::string::npos) << why;
+  result.robot_state.qd_rad_s[2] = -0.05F;  // either direction
+  EXPECT_NE(relearn_refusal(result), "");
+  result.robot_state.qd_rad_s[2] = std::nanf("");  // unknown speed is no proof of standing still
+  EXPECT_NE(relearn_refusal(result), "");
+  result.robot_state.qd_rad_s[2] = 0.0005F;  // below kRobotMovingRadS: still
+  EXPECT_EQ(relearn_refusal(result), "");
+}
+
+TEST(RelearnRefusal, RefusedWhileAnythingIsNear) {
+  for (const ReasonCode code : {ReasonCode::in_slow_zone, ReasonCode::in_stop_zone, ReasonCode::inside_robot}) {
+    FrameResult result = still_and_clear();
+    result.verdict.code = code;
+    result.contact.valid = true;
+    result.contact.distance_m = 0.42F;
+    const std::string why = relearn_refusal(result);
+    EXPECT_NE(why.find("0.42 m"), std::string::npos) << why;
+  }
+}
+
+TEST(RelearnRefusal, RefusedWithoutARobotState) {
+  FrameResult result = still_and_clear();
+  result.robot_state.valid = false;
+  EXPECT_NE(relearn_refusal(result), "");
+  EXPECT_NE(relearn_refusal(FrameResult{}), "");  // before the first frame
+}
+
+TEST(ControlInbox, NothingPostedLeavesThePipelineAlone) {
+  Pipeline pipeline(point_robot_params());
+  ControlInbox inbox;
+  inbox.apply(pipeline, still_and_clear());
+  EXPECT_TRUE(inbox.take_events().empty());
+  EXPECT_EQ(pipeline.params().foreground.k_sigma, ForegroundParams{}.k_sigma);
+}
+
+TEST(ControlInbox, LatestTuningWinsAndIsAppliedOnce) {
+  Pipeline pipeline(point_robot_params());
+  ControlInbox inbox;
+  LiveTuning tuning = pipeline.tuning();
+  tuning.foreground.k_sigma = 2.0F;
+  inbox.post_tuning(tuning);
+  tuning.foreground.k_sigma = 3.0F;
+  inbox.post_tuning(tuning);
+  EXPECT_EQ(pipeline.params().foreground.k_sigma, ForegroundParams{}.k_sigma);  // not before apply()
+  inbox.apply(pipeline, still_and_clear());
+  EXPECT_EQ(pipeline.params().foreground.k_sigma, 3.0F);
+  const std::vector<ControlEvent> events = inbox.take_events();
+  ASSERT_EQ(events.size(), 1U);
+  EXPECT_FALSE(events[0].refused);
+  EXPECT_EQ(events[0].after_frame, 7);
+  inbox.apply(pipeline, still_and_clear());
+  EXPECT_TRUE(inbox.take_events().empty());
+}
+
+TEST(ControlInbox, RefusedTuningIsReportedAndChangesNothing) {
+  Pipeline pipeline(point_robot_params());
+  ControlInbox inbox;
+  LiveTuning tuning = pipeline.tuning();
+  tuning.backend = "no_such_backend";
+  inbox.post_tuning(tuning);
+  inbox.apply(pipeline, still_and_clear());
+  const std::vector<ControlEvent> events = inbox.take_events();
+  ASSERT_EQ(events.size(), 1U);
+  EXPECT_TRUE(events[0].refused);
+  EXPECT_EQ(pipeline.params().backend, "brute");
+}
+
+TEST(ControlInbox, RelearnRefusedNearTheRobotThenDoneWhenClear) {
+  Pipeline pipeline(point_robot_params());
+  Frame frame;
+  FrameResult result;
+  for (int i = 0; i < 2; ++i) {
+    wall_frame(i, 0.0F, frame);
+    pipeline.process(frame, fixed_robot_state({}), result);
+  }
+  ASSERT_TRUE(pipeline.background_ready());
+  wall_frame(2, 0.7F, frame);  // a block 0.7 m from the robot point: slow
+  pipeline.process(frame, fixed_robot_state({}), result);
+  ASSERT_EQ(result.verdict.code, ReasonCode::in_slow_zone);
+
+  ControlInbox inbox;
+  inbox.post_relearn();
+  inbox.apply(pipeline, result);
+  std::vector<ControlEvent> events = inbox.take_events();
+  ASSERT_EQ(events.size(), 1U);
+  EXPECT_TRUE(events[0].refused);
+  EXPECT_TRUE(pipeline.background_ready());  // still the old background
+  // The request is not kept for later: a refused relearn must be asked for again.
+  wall_frame(3, 0.0F, frame);
+  pipeline.process(frame, fixed_robot_state({}), result);
+  ASSERT_EQ(result.verdict.state, VerdictState::run);
+  inbox.apply(pipeline, result);
+  EXPECT_TRUE(inbox.take_events().empty());
+  EXPECT_TRUE(pipeline.background_ready());
+
+  inbox.post_relearn();
+  inbox.apply(pipeline, result);
+  events = inbox.take_events();
+  ASSERT_EQ(events.size(), 1U);
+  EXPECT_FALSE(events[0].refused);
+  EXPECT_FALSE(pipeline.background_ready());
+  wall_frame(4, 0.0F, frame);
+  pipeline.process(frame, fixed_robot_state({}), result);
+  EXPECT_EQ(result.verdict.code, ReasonCode::learning_background);
+}
+
+TEST(SaveTuned, TheSavedFileRunsAsTheTunedCellWithTheRunsOverrides) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("hrcsense_view_save_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string saved = (dir / "tuned.yaml").string();
+  // The run's --set stays in what is saved; the tuning comes on top of it.
+  const std::vector<std::string> sets = {"safety.slow_distance_m=1.4", "filters.preset=thesis"};
+  LiveTuning tuning = tuning_of(load_config("", sets).pipeline);
+  tuning.foreground.k_sigma = 5.5F;
+  tuning.backend = "octree";
+  const Config tuned = tuned_config("", sets, tuning);
+  save_tuned_config(tuned, saved);
+  const Config reloaded = load_config(saved, {});
+  EXPECT_EQ(reloaded.pipeline.foreground.k_sigma, 5.5F);
+  EXPECT_EQ(reloaded.pipeline.backend, "octree");
+  EXPECT_EQ(reloaded.pipeline.safety.slow_distance_m, 1.4F);
+  EXPECT_EQ(reloaded.filters_preset, "thesis");
+  EXPECT_EQ(config_hash(reloaded), config_hash(tuned));
+  EXPECT_THROW(save_tuned_config(tuned, (dir / "no_such_dir" / "x.yaml").string()), IoError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SaveTuned, AValueTheParserRefusesIsAConfigErrorNamingTheKey) {
+  LiveTuning tuning = tuning_of(load_config("", {}).pipeline);
+  tuning.filters.order = {FilterBlock::threshold, FilterBlock::spatial};
+  tuning.filters.threshold.min_m = 3.0F;  // min above max
+  tuning.filters.threshold.max_m = 1.0F;
+  try {
+    (void)tuned_config("", {"filters.order=[threshold, spatial]"}, tuning);
+    ADD_FAILURE() << "no ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("filters.threshold"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace hrcsense::view
