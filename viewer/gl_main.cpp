@@ -327,6 +327,7 @@ int run_viewer(const ViewArgs& args) {
       serial_3d = serial;
     }
     stats.viewer_dropped = tap.dropped();
+    stats.pipeline_dropped = tap.index_gaps() - playback.skipped();
     tap.timeline(stats.timeline);
     stats.session_ended = ended_ns != 0;
     stats.notice = replay && playback.paused() ? paused_notice(playback) : std::string();

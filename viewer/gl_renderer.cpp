@@ -257,9 +257,9 @@ void Renderer::draw_overlay(const ViewFrame& frame, const ColorImage* image, Sho
   std::snprintf(line2, sizeof(line2), "frame %lld  fg %zu pts  invalid %zu px  latency %.2f / %.2f ms%s",
                 static_cast<long long>(frame.frame), frame.foreground_points, frame.invalid_pixels,
                 rates.latency_p50_us / 1000.0, rates.latency_p99_us / 1000.0, stats.session_ended ? "  (ended)" : "");
-  std::snprintf(line3, sizeof(line3), "capture %.1f  processing %.1f  view %.1f frames/s  view dropped %lld",
+  std::snprintf(line3, sizeof(line3), "capture %.1f  processing %.1f  view %.1f frames/s  dropped %lld, view %lld",
                 rates.capture_fps, rates.processing_fps, stats.display_fps,
-                static_cast<long long>(stats.viewer_dropped));
+                static_cast<long long>(stats.pipeline_dropped), static_cast<long long>(stats.viewer_dropped));
   draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 68.0F), IM_COL32(230, 230, 230, 255), reason.c_str());
   draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 88.0F), IM_COL32(170, 170, 170, 255), line2);
   draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 108.0F), IM_COL32(170, 170, 170, 255), line3);

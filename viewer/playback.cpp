@@ -50,6 +50,16 @@ int64_t PlaybackControl::position() const {
   return position_;
 }
 
+int64_t PlaybackControl::skipped() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return skipped_;
+}
+
+void PlaybackControl::add_skipped(int64_t frames) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  skipped_ += frames;
+}
+
 int64_t PlaybackControl::frame_count() const {
   const std::lock_guard<std::mutex> lock(mutex_);
   return frame_count_;
@@ -97,7 +107,8 @@ Source::Status PlaybackSource::next(Frame& out) {
 }
 
 Source::Status PlaybackSource::reposition(int64_t position, Frame& scratch) {
-  if (position < next_position_) {
+  const bool back = position < next_position_;
+  if (back) {
     reopened_ = open_();
     current_ = reopened_.get();
     next_position_ = 0;
@@ -106,6 +117,7 @@ Source::Status PlaybackSource::reposition(int64_t position, Frame& scratch) {
     const Status status = current_->next(scratch);
     if (status != Status::frame) return status;  // past the end: the recording ends there
     ++next_position_;
+    if (!back) control_.add_skipped(1);  // a gap in the processed frames' indices (ViewTap::index_gaps)
   }
   return Status::frame;
 }

@@ -27,6 +27,9 @@ class PlaybackControl {
   void seek(int64_t position);
   /// The position of the newest frame delivered (0-based); -1 before the first.
   int64_t position() const;
+  /// Frames a seek forward read and dropped so far.
+  int64_t skipped() const;
+  void add_skipped(int64_t frames);
   /// The recording's length in frames, -1 when unknown (set by PlaybackSource).
   int64_t frame_count() const;
   void set_frame_count(int64_t count);
@@ -47,6 +50,7 @@ class PlaybackControl {
   int64_t seek_to_ = -1;    ///< pending seek, -1: none
   int64_t position_ = -1;   ///< of the newest frame delivered
   int64_t frame_count_ = -1;
+  int64_t skipped_ = 0;
 };
 
 /// A recording that follows a PlaybackControl. A seek forward reads and drops the frames in

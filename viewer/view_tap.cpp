@@ -79,12 +79,21 @@ void ViewTap::offer(const Frame& frame, const Pipeline& pipeline, const FrameRes
   const bool snapshot = [&] {
     std::lock_guard<std::mutex> lock(mutex_);
     timeline_.add(point);
+    // Frames the pipeline dropped (paced: processing behind the source) leave gaps in the
+    // processed frames' source indices.
+    if (last_index_ >= 0 && result.frame > last_index_ + 1) index_gaps_ += result.frame - last_index_ - 1;
+    last_index_ = result.frame;
     return result.source_frame && pending_.count(result.frame) > 0;
   }();
   if (!mailbox_.put(scratch_)) return;  // the renderer is gone
   if (!snapshot) return;
   std::unique_lock<std::mutex> lock(mutex_);
   drawn_.wait(lock, [&] { return closed_ || pending_.count(result.frame) == 0; });
+}
+
+int64_t ViewTap::index_gaps() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return index_gaps_;
 }
 
 void ViewTap::rendered(int64_t index) {

@@ -45,6 +45,10 @@ class ViewTap {
   /// into `out`.
   void timeline(std::vector<TimelinePoint>& out) const;
 
+  /// Source frames that never reached processing, as seen from here: the gaps between the
+  /// source indices of consecutive processed frames (a seek forward makes one too; the viewer
+  /// subtracts PlaybackControl::skipped()).
+  int64_t index_gaps() const;
   /// Frames the renderer never took: `viewer_frames_dropped` in the summary.
   int64_t dropped() const { return mailbox_.dropped(); }
   /// Snapshot frames still to be drawn.
@@ -57,6 +61,8 @@ class ViewTap {
   std::condition_variable drawn_;
   std::set<int64_t> pending_;  ///< snapshot frames not yet drawn
   Timeline timeline_;          ///< under mutex_
+  int64_t last_index_ = -1;    ///< under mutex_: the last processed frame's source index
+  int64_t index_gaps_ = 0;     ///< under mutex_
   bool closed_ = false;
 };
 

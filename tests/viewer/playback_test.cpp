@@ -98,6 +98,7 @@ TEST(Playback, SeekForwardDropsTheFramesBetweenWithoutReopening) {
   EXPECT_EQ(replay.next(), 7);
   EXPECT_EQ(replay.opens, 0);
   EXPECT_EQ(replay.control.position(), 7);
+  EXPECT_EQ(replay.control.skipped(), 5);  // frames 1-5: a gap the viewer does not count as dropped
 }
 
 TEST(Playback, SeekBackReopensAndPausedShowsTheFrameSought) {
@@ -111,6 +112,7 @@ TEST(Playback, SeekBackReopensAndPausedShowsTheFrameSought) {
   replay.control.seek(0);
   EXPECT_EQ(replay.next(), 0);
   EXPECT_EQ(replay.opens, 2);
+  EXPECT_EQ(replay.control.skipped(), 0);  // back: the frames read up to the position leave no gap
   replay.control.set_paused(false);
   EXPECT_EQ(replay.next(), 1);
 }

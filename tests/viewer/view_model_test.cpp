@@ -282,6 +282,19 @@ TEST(ViewTap, NeverWaitsAndCountsWhatTheRendererMissed) {
   EXPECT_FALSE(tap.take(newest, 0.0));
 }
 
+TEST(ViewTap, CountsTheSourceFramesProcessingSkipped) {
+  const Pipeline pipeline = walk_pipeline();
+  ViewTap tap;
+  Frame frame;
+  FrameResult result;
+  // Processed: 0, 1, 4, 5, 9 (2, 3, 6, 7, 8 dropped), then 2 after a seek back: no gap.
+  for (const int64_t i : {0, 1, 4, 5, 9, 2, 3}) {
+    result.frame = i;
+    tap.offer(frame, pipeline, result);
+  }
+  EXPECT_EQ(tap.index_gaps(), 5);
+}
+
 TEST(ViewTap, WaitsAtASnapshotFrameUntilDrawn) {
   const Pipeline pipeline = walk_pipeline();
   ViewTap tap({3});
