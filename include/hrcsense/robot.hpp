@@ -105,6 +105,14 @@ Pose T_base_base_link();
 /// Forward kinematics: every link frame in `base` (DH frame 0) for the joint state.
 LinkFrames forward_kinematics(const RobotDescription& description, const JointAngles& joints_rad);
 
+/// Velocity (m/s, in `frame`) of a point fixed to link `link` (0..6, or kToolLink, which moves
+/// with the flange) at `point` (in `frame`), for joint angles `joints_rad` and velocities
+/// `joint_velocities_rad_s`: the sum over joints 1..link of ω_j · z_{j−1} × (p − o_{j−1}),
+/// joint j turning about the z axis of DH frame j−1. Zero for link 0 (the fixed base).
+Eigen::Vector3d point_velocity(const RobotDescription& description, const JointAngles& joints_rad,
+                               const JointAngles& joint_velocities_rad_s, int link, const Eigen::Vector3d& point,
+                               BaseFrame frame);
+
 /// The capsules the proximity search uses, in `frame`: every link and tool capsule moved by
 /// forward kinematics, radius = link radius + `padding_m`, Capsule::link = link index 0..6,
 /// kToolLink for the tool. Writes into `out`, reusing its buffer (no allocation once sized).
