@@ -207,6 +207,8 @@ class RtdeRobotState final : public RobotStateSource {
   void on_data(const rtde::Frame& frame, Connection& connection);
   void on_text(const rtde::Frame& frame);
   void problem(const std::string& what, bool malformed);
+  /// Keeps why the last connection ended (error() and stats().last_problem); mutex_ held.
+  void record_error_locked(const std::string& error);
 
   const RtdeParams params_;
   RunClock& clock_;

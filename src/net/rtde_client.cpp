@@ -147,6 +147,11 @@ void RtdeRobotState::problem(const std::string& what, bool malformed) {
   if (malformed) ++stats_.malformed;
 }
 
+void RtdeRobotState::record_error_locked(const std::string& error) {
+  error_ = error;
+  if (!error.empty()) stats_.last_problem = error;
+}
+
 void RtdeRobotState::run() {
   double backoff_s = params_.backoff_initial_s;
   while (!stop_) {
@@ -166,14 +171,14 @@ void RtdeRobotState::run() {
       ++stats_.disconnects;
       status_.streaming = false;
       history_.clear();  // no valid state from a connection that is gone
+      // Under the same lock as the disconnect: stats() never shows one without its reason.
+      if (!stop_) record_error_locked(error);
       if (streamed) backoff_s = params_.backoff_initial_s;
+    } else if (!stop_) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      record_error_locked(error);
     }
     if (stop_) break;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      error_ = error;
-      if (!error.empty()) stats_.last_problem = error;
-    }
     // Back off: a reconnect loop can lock the pendant (ur-rtde.md, known field problems).
     clock_.sleep_until(clock_.now_ns() + to_ns(backoff_s), &stop_);
     backoff_s = std::min(params_.backoff_max_s, 2.0 * backoff_s);

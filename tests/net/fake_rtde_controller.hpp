@@ -182,11 +182,15 @@ class FakeRtdeController {
   }
   // True when the client has closed its end (what it sent before is dropped).
   static bool peer_closed(int fd) {
+    // The client's close may not have reached this end yet (loopback under load): wait up to
+    // 100 ms for it before taking the peer as still there; else the stream would go on into a
+    // dead connection and wait for reads that never come.
     uint8_t bytes[256];
-    for (pollfd p{fd, POLLIN, 0}; ::poll(&p, 1, 0) > 0;) {
+    for (int wait_ms = 100;; wait_ms = 0) {
+      pollfd p{fd, POLLIN, 0};
+      if (::poll(&p, 1, wait_ms) <= 0) return false;
       if (::recv(fd, bytes, sizeof bytes, 0) <= 0) return true;
     }
-    return false;
   }
   // After a refusal: waits for the client to close, then holds.
   void refuse_and_hold(int fd) {
