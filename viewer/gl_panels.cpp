@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <cstring>
 #include <utility>
 
 namespace hrcsense::view {
@@ -16,10 +15,6 @@ namespace {
 constexpr size_t kLogLines = 6;
 constexpr const char* kBackends[] = {"brute", "kdtree", "octree", "auto"};
 constexpr const char* kRelearnPopup = "Relearn the background?";
-
-bool in_chain(const LiveTuning& tuning, FilterBlock block) {
-  return std::find(tuning.filters.order.begin(), tuning.filters.order.end(), block) != tuning.filters.order.end();
-}
 
 // A slider that reports a change once it is let go (dragging would parse the configuration
 // every frame); the ranges are the configuration's (docs/CONFIG.md), so what the slider gives
@@ -139,25 +134,25 @@ void Panels::draw_filters() {
   if (!ImGui::CollapsingHeader("Depth filters")) return;
   FilterChainParams& f = edit_.filters;
   if (f.order.empty()) ImGui::TextUnformatted("no filters (filters.preset none)");
-  if (in_chain(edit_, FilterBlock::threshold)) {
+  if (has_block(edit_.filters.order, FilterBlock::threshold)) {
     edited_ |= slider("threshold min (m)", f.threshold.min_m, 0.0F, 16.0F);
     edited_ |= slider("threshold max (m)", f.threshold.max_m, 0.0F, 16.0F);
   }
-  if (in_chain(edit_, FilterBlock::decimation)) {
+  if (has_block(edit_.filters.order, FilterBlock::decimation)) {
     ImGui::Text("decimation magnitude %d (sets the background's size: not live)", f.decimation.magnitude);
   }
-  if (in_chain(edit_, FilterBlock::spatial)) {
+  if (has_block(edit_.filters.order, FilterBlock::spatial)) {
     edited_ |= slider("spatial alpha", f.spatial.alpha, 0.25F, 1.0F);
     edited_ |= slider("spatial delta", f.spatial.delta, 1, 50);
     edited_ |= slider("spatial magnitude", f.spatial.magnitude, 1, 5);
     edited_ |= slider("spatial holes_fill", f.spatial.holes_fill, 0, 5);
   }
-  if (in_chain(edit_, FilterBlock::temporal)) {
+  if (has_block(edit_.filters.order, FilterBlock::temporal)) {
     edited_ |= slider("temporal alpha", f.temporal.alpha, 0.0F, 1.0F);
     edited_ |= slider("temporal delta", f.temporal.delta, 1, 100);
     edited_ |= slider("temporal persistence", f.temporal.persistence, 0, 8);
   }
-  if (in_chain(edit_, FilterBlock::hole_filling)) edited_ |= slider("hole_filling mode", f.hole_filling.mode, 0, 2);
+  if (has_block(edit_.filters.order, FilterBlock::hole_filling)) edited_ |= slider("hole_filling mode", f.hole_filling.mode, 0, 2);
 }
 
 void Panels::draw_foreground() {

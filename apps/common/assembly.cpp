@@ -223,7 +223,7 @@ RunHeader make_run_header(const Config& config, const SourceInfo& info) {
   filters.preset = config.filters_preset;
   filters.domain = filter_domain(chain, info.stereo_baseline_mm);
   const bool wants_disparity =
-      std::find(chain.order.begin(), chain.order.end(), FilterBlock::to_disparity) != chain.order.end();
+      has_block(chain.order, FilterBlock::to_disparity);
   if (wants_disparity && filters.domain == "depth") {
     filters.note = "no stereo baseline: to_disparity/to_depth skipped, spatial and temporal run on depth "
                    "(set source.stereo_baseline_mm)";

@@ -189,6 +189,9 @@ const char* filter_domain(const FilterChainParams& params, float stereo_baseline
 /// inside the disparity domain, to_depth without to_disparity before it or the reverse.
 std::string check_filter_order(const std::vector<FilterBlock>& order);
 
+/// Whether `block` is in `order`.
+bool has_block(const std::vector<FilterBlock>& order, FilterBlock block);
+
 /// Runs a chain on frames. Without a stereo baseline (Frame::stereo_baseline_mm 0) the
 /// disparity transforms are skipped and the blocks between them run in the depth domain.
 /// Parameters are read at every frame, so a change takes effect on the next frame.

@@ -9,10 +9,6 @@
 namespace hrcsense::config_detail {
 namespace {
 
-bool contains(const std::vector<FilterBlock>& order, FilterBlock block) {
-  return std::find(order.begin(), order.end(), block) != order.end();
-}
-
 // A float option with the SDK's inclusive range; the error names the key and the range.
 void ranged(KeyReader& r, const std::string& key, float& value, float min, float max, const char* range) {
   r.number(key, value, Bound::any);
@@ -48,9 +44,9 @@ std::vector<FilterBlock> apply_enabled(KeyReader& r, const std::vector<FilterBlo
   for (const FilterBlock block : kFilterBlocks) {
     const std::string key = std::string("filters.") + filter_block_name(block) + ".enabled";
     bool& on = enabled[static_cast<size_t>(block)];
-    on = contains(order, block);
+    on = has_block(order, block);
     r.flag(key, on);
-    if (on && order_given && !contains(order, block)) r.fail(key, "the block is not in filters.order; add it there");
+    if (on && order_given && !has_block(order, block)) r.fail(key, "the block is not in filters.order; add it there");
   }
   std::vector<FilterBlock> result;
   for (const FilterBlock block : order_given ? order : std::vector<FilterBlock>(kFilterBlocks.begin(), kFilterBlocks.end())) {
@@ -109,7 +105,7 @@ const BlockOption kBlockOptions[] = {
 void refuse_options_outside_the_chain(KeyReader& r, const Config& c, const FilterChainParams& preset) {
   const FilterChainParams& f = c.pipeline.filters;
   for (const BlockOption& option : kBlockOptions) {
-    if (contains(f.order, option.block) || option.value(f) == option.value(preset)) continue;
+    if (has_block(f.order, option.block) || option.value(f) == option.value(preset)) continue;
     r.fail(option.key, std::string("the ") + filter_block_name(option.block) +
                            " block is not in the chain (filters.preset " + c.filters_preset +
                            "), so this option would be ignored; add the block to filters.order or remove the option");
@@ -151,7 +147,7 @@ std::vector<std::string> tuning_overrides(const LiveTuning& tuning) {
   std::vector<std::string> sets;
   for (const config_detail::BlockOption& option : config_detail::kBlockOptions) {
     // Options of blocks outside the chain are refused by read_filters (they would be ignored).
-    if (config_detail::contains(tuning.filters.order, option.block)) sets.push_back(entry(option.key, option.value(tuning.filters)));
+    if (has_block(tuning.filters.order, option.block)) sets.push_back(entry(option.key, option.value(tuning.filters)));
   }
   sets.push_back(entry("foreground.k_sigma", tuning.foreground.k_sigma));
   sets.push_back(entry("foreground.min_margin_m", tuning.foreground.min_margin_m));

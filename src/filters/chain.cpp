@@ -6,6 +6,10 @@
 
 namespace hrcsense {
 
+bool has_block(const std::vector<FilterBlock>& order, FilterBlock block) {
+  return std::find(order.begin(), order.end(), block) != order.end();
+}
+
 const char* filter_block_name(FilterBlock block) {
   switch (block) {
     case FilterBlock::threshold: return "threshold";
@@ -50,7 +54,7 @@ std::optional<FilterChainParams> filter_preset(std::string_view name) {
 }
 
 Intrinsics filtered_intrinsics(const FilterChainParams& params, const Intrinsics& source) {
-  if (std::find(params.order.begin(), params.order.end(), FilterBlock::decimation) == params.order.end()) {
+  if (!has_block(params.order, FilterBlock::decimation)) {
     return source;
   }
   // Decimating an empty image of the source's size keeps one definition of the output size
@@ -65,7 +69,7 @@ Intrinsics filtered_intrinsics(const FilterChainParams& params, const Intrinsics
 const char* filter_domain(const FilterChainParams& params, float stereo_baseline_mm) {
   if (params.order.empty()) return "none";
   const bool wants_disparity =
-      std::find(params.order.begin(), params.order.end(), FilterBlock::to_disparity) != params.order.end();
+      has_block(params.order, FilterBlock::to_disparity);
   return wants_disparity && stereo_baseline_mm > 0.0F ? "disparity" : "depth";
 }
 
@@ -103,7 +107,7 @@ void FilterChain::start(const Frame& in, Frame& out) {
 
   // Without a baseline the transforms are skipped and the blocks between them work on depth.
   const bool wants_disparity =
-      std::find(params.order.begin(), params.order.end(), FilterBlock::to_disparity) != params.order.end();
+      has_block(params.order, FilterBlock::to_disparity);
   disparity_domain_ = wants_disparity && in.stereo_baseline_mm > 0.0F;
   planned_.clear();
   for (const FilterBlock block : params.order) {

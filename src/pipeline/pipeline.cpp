@@ -137,10 +137,6 @@ ProximitySearch make_proximity_search(const PipelineParams& params) {
   return ProximitySearch(*backend, params.proximity);
 }
 
-bool contains_block(const std::vector<FilterBlock>& order, FilterBlock block) {
-  return std::find(order.begin(), order.end(), block) != order.end();
-}
-
 }  // namespace
 
 Pipeline::Pipeline(PipelineParams params)
@@ -159,7 +155,7 @@ void Pipeline::retune(const LiveTuning& tuning) {
   if (tuning.filters.order != params_.filters.order) {
     throw std::invalid_argument("filters.order cannot change while the cell runs (the background is learnt after it)");
   }
-  if (contains_block(params_.filters.order, FilterBlock::decimation) &&
+  if (has_block(params_.filters.order, FilterBlock::decimation) &&
       tuning.filters.decimation.magnitude != params_.filters.decimation.magnitude) {
     throw std::invalid_argument("filters.decimation.magnitude cannot change while the cell runs (it sets the "
                                 "background's resolution)");
