@@ -113,6 +113,22 @@ struct RecordConfig {
   int queue_frames = 16;            ///< `record.queue_frames`: frames waiting for the disk before drops
 };
 
+/// `link.*`: the verdict sent to the robot controller (docs/SAFETY.md, "The link").
+struct LinkConfig {
+  /// `link.udp.address`: "host:port" (numeric IPv4 or [IPv6]) the datagrams go to; empty: no
+  /// UDP link.
+  std::string udp_address;
+  std::string udp_format = "binary";  ///< `link.udp.format`: binary (the HRCS layout) or json (the frame line)
+  double heartbeat_hz = 20.0;         ///< `link.heartbeat_hz`: heartbeats while no frame comes, Hz
+  /// `link.rtde.write`: off (default), speed_slider or register: the speed scale written to the
+  /// controller at robot.state.host over RTDE.
+  std::string rtde_write = "off";
+  int rtde_register = 24;             ///< `link.rtde.register`: input_double_register_N, N in 24..47
+  /// `link.rtde.min_speed_slider`: the slider never goes below this fraction (a hard 0 then
+  /// another value has caused protective stops); stops go through the register path.
+  double rtde_min_speed_slider = 0.01;
+};
+
 struct Config {
   std::string file;                ///< where it was read from ("" for defaults only)
   SourceConfig source;
@@ -132,6 +148,7 @@ struct Config {
   int proximity_octree_height = 4;       ///< `proximity.octree.height` (1-10), for the octree backend
   RecordConfig record;                   ///< `record.*`
   PublishConfig publish;                 ///< `publish.*`
+  LinkConfig link;                       ///< `link.*`
   std::string canonical_yaml;      ///< the effective configuration, for the hash in the header
 };
 

@@ -117,6 +117,16 @@ class Pipeline {
   SelfFilter self_filter_;  ///< the arm's remembered poses rendered into the filtered frame
   BackgroundCheck check_;  ///< of a loaded background against the first frames
 
+  // The previous frame and contact, for the filters' lag and the contact's speed (Z_d).
+  bool have_previous_frame_ = false;
+  int64_t previous_timestamp_ns_ = 0;
+  bool have_previous_contact_ = false;
+  int64_t previous_contact_ns_ = 0;
+  float previous_contact_depth_m_ = 0.0F;
+
+  /// Z_d and v_r of the frame's contact (FrameResult::distance_uncertainty_m,
+  /// robot_speed_towards_mps), NaN without a contact.
+  void measure_contact(const Frame& frame, const RobotState& robot_state, FrameResult& result);
   bool enough_valid_depth(const Frame& frame, FrameResult& result) const;
   /// Remembers robot_ and renders the remembered poses into the filtered `frame`; the robot's
   /// pixels, or none without an arm.

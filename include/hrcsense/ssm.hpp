@@ -6,6 +6,8 @@
 // careful integrator, not a safety function.
 #pragma once
 
+#include <limits>
+
 namespace hrcsense {
 
 /// `safety.*` of the `ssm` mode. Defaults and their sources: docs/SAFETY.md.
@@ -62,5 +64,29 @@ double allowed_robot_speed_mps(const SsmParams& params, const SsmInput& input);
 /// already does; for a robot that stands still or moves away, 1 when the separation is at
 /// least S_p at zero speed, else 0. 0 for NaN input.
 float ssm_speed_scale(const SsmParams& params, const SsmInput& input);
+
+/// What Z_d of one contact is made of (contact_uncertainty_m).
+struct ContactUncertaintyInput {
+  float depth_m = 0.0F;        ///< the contact's depth along the camera's z axis
+  /// σ_z / z² of the camera's depth noise (1/m): subpixel RMS / (fx · baseline) for a stereo
+  /// camera, else the learnt noise floor.
+  float noise_per_z2 = 0.0F;
+  float fx_px = 0.0F;          ///< focal length of the image the contact was found in (after decimation)
+  /// The filters' lag (s): how long ago the scene the filtered depth shows is on average (the
+  /// temporal filter's smoothing); 0 without a temporal filter.
+  double filter_lag_s = 0.0;
+  /// The contact's measured speed (m/s; NaN when not known: counts as the human speed).
+  float contact_speed_mps = std::numeric_limits<float>::quiet_NaN();
+};
+
+/// How many σ of the depth noise Z_d covers. One-sided: only a contact measured farther than
+/// it is matters, and the closest of many noisy points already leans towards the robot.
+inline constexpr float kDepthNoiseSigmas = 2.0F;
+
+/// Z_d, the measurement uncertainty of a contact (m): kDepthNoiseSigmas · σ_z(z), plus the
+/// pixel footprint (half a pixel's diagonal at the contact's depth: the true closest point may
+/// lie between two samples), plus the filter lag times the contact's speed, capped at the
+/// human speed. NaN input gives NaN (a stop).
+float contact_uncertainty_m(const SsmParams& params, const ContactUncertaintyInput& input);
 
 }  // namespace hrcsense

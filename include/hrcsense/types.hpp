@@ -2,10 +2,13 @@
 // hrcsense — the plain value types that flow between the pipeline's stages.
 #pragma once
 
+#include "hrcsense/ssm.hpp"
+
 #include <Eigen/Geometry>
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -202,33 +205,42 @@ enum class VerdictState { run, slow, stop };
 /// Why a verdict is what it is, as a stable code (`reason_code` in the output, its snake_case
 /// name from reason_code_name(); docs/OUTPUT.md lists them). Control flow uses the code, never
 /// the human-readable Verdict::reason.
-enum class ReasonCode {
-  clear,                 ///< run: the contact is at or beyond the slow distance
-  no_foreground,         ///< run: nothing in the cell
-  in_slow_zone,          ///< slow
-  in_stop_zone,          ///< stop: below the stop distance
-  inside_robot,          ///< stop: a foreground point inside a robot capsule
-  non_finite_input,      ///< stop: a NaN/Inf distance or point, or foreground the search cannot place
-  learning_background,   ///< stop: the background is being learnt
-  checking_background,   ///< stop: a loaded background is compared with the first frames
-  no_valid_depth,        ///< stop: no valid pixel, before or after the filters
-  low_valid_share,       ///< stop: fewer valid pixels after the filters than safety.min_valid_share
-  background_mismatch,   ///< stop: the background is not of the filtered frame's size
-  no_robot_model,        ///< stop: no capsules to measure against
-  no_robot_state,        ///< stop: no valid robot state for the frame (an arm needs its joints)
-  robot_state_stale,     ///< stop: the newest robot state is older than robot.state.max_age_s
-  foreground_failed,     ///< stop: the foreground test could not run
-  stale_frame,           ///< stop: the frame is older than safety.max_frame_age_s
-  no_frame,              ///< stop: the watchdog saw no frame for safety.max_frame_age_s
-  source_ended,          ///< stop: end of the run, the source ended
-  frame_limit_reached,   ///< stop: end of the run, --frames reached
-  stop_requested,        ///< stop: end of the run, SIGINT, SIGTERM or SIGHUP
-  source_error,          ///< stop: end of the run, the source failed
-  processing_error,      ///< stop: end of the run, processing failed
-  output_error,          ///< stop: end of the run, the output failed
+enum class ReasonCode : uint16_t {
+  clear = 0,                ///< run: the contact is at or beyond the slow distance
+  no_foreground = 1,        ///< run: nothing in the cell
+  in_slow_zone = 2,         ///< slow
+  in_stop_zone = 3,         ///< stop: below the stop distance
+  inside_robot = 4,         ///< stop: a foreground point inside a robot capsule
+  non_finite_input = 5,     ///< stop: a NaN/Inf distance or point, or foreground the search cannot place
+  learning_background = 6,  ///< stop: the background is being learnt
+  checking_background = 7,  ///< stop: a loaded background is compared with the first frames
+  no_valid_depth = 8,       ///< stop: no valid pixel, before or after the filters
+  low_valid_share = 9,      ///< stop: fewer valid pixels after the filters than safety.min_valid_share
+  background_mismatch = 10, ///< stop: the background is not of the filtered frame's size
+  no_robot_model = 11,      ///< stop: no capsules to measure against
+  no_robot_state = 12,      ///< stop: no valid robot state for the frame (an arm needs its joints)
+  robot_state_stale = 13,   ///< stop: the newest robot state is older than robot.state.max_age_s
+  foreground_failed = 14,   ///< stop: the foreground test could not run
+  stale_frame = 15,         ///< stop: the frame is older than safety.max_frame_age_s
+  no_frame = 16,            ///< stop: the watchdog saw no frame for safety.max_frame_age_s
+  source_ended = 17,        ///< stop: end of the run, the source ended
+  frame_limit_reached = 18, ///< stop: end of the run, --frames reached
+  stop_requested = 19,      ///< stop: end of the run, SIGINT, SIGTERM or SIGHUP
+  source_error = 20,        ///< stop: end of the run, the source failed
+  processing_error = 21,    ///< stop: end of the run, processing failed
+  output_error = 22,        ///< stop: end of the run, the output failed
   /// stop: the watchdog saw no frame because the live camera is unplugged (Source::silence_reason),
   /// until the same serial is back and streams again
-  camera_disconnected,
+  camera_disconnected = 23,
+  // Numbered for the controller link's datagrams (docs/OUTPUT.md, docs/SAFETY.md): a number,
+  // once given, is never reused.
+  unknown_space = 24,        ///< stop: unknown space within safety.unknown_stop_within_m of the robot
+  envelope_invalid = 25,     ///< stop: too many invalid pixels inside the robot's projected envelope
+  camera_blocked = 26,       ///< stop: a large surface right in front of the camera
+  camera_moved = 27,         ///< stop: the static background no longer matches the learnt one
+  below_protective_distance = 28,  ///< stop (ssm): closer than S_p with the robot at rest
+  speed_limited = 29,        ///< slow (ssm): the speed scale keeps the separation at S_p
+  holding = 30,              ///< the verdict holds a stricter state (safety.hysteresis_m, min_hold_s)
 };
 
 struct Verdict {
@@ -274,6 +286,16 @@ struct FrameResult {
   /// sink (apps/common) sets it from the simulator; static text or owned by that sink.
   const char* truth_contact_label = nullptr;
   double latency_us = 0.0;       ///< from the frame entering processing to the result
+  /// `safety.mode: ssm`, a valid frame with a contact: S_p's terms at the robot's present
+  /// speed (Verdict::protective_distance_m is S_p at rest, the stop threshold); none otherwise.
+  std::optional<SsmTerms> ssm;
+  /// Z_d of the contact (ssm mode), m; NaN when not computed (no contact, zones mode).
+  float distance_uncertainty_m = std::numeric_limits<float>::quiet_NaN();
+  /// v_r: the robot's speed towards the contact at its closest point, m/s (negative: away);
+  /// NaN when not computed.
+  float robot_speed_towards_mps = std::numeric_limits<float>::quiet_NaN();
+  /// The robot's distance to the nearest unknown ray (docs/SAFETY.md), m; NaN: none known.
+  float unknown_distance_m = std::numeric_limits<float>::quiet_NaN();
   /// The proximity backend that searched this frame (static name, e.g. "octree" when `auto`
   /// picked it); null when no search ran.
   const char* backend = nullptr;

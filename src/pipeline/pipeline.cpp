@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <utility>
@@ -74,6 +75,38 @@ void begin_result(const Frame& frame, const RobotState& robot_state, FrameResult
   result.timings.clear();  // keeps its capacity: one entry per filter block and stage after the first frame
   result.truth.reset();
   if (frame.truth) result.truth = frame.truth->contact;
+  result.ssm.reset();
+  result.distance_uncertainty_m = std::numeric_limits<float>::quiet_NaN();
+  result.robot_speed_towards_mps = std::numeric_limits<float>::quiet_NaN();
+  result.unknown_distance_m = std::numeric_limits<float>::quiet_NaN();
+}
+
+// v_r: the velocity of the arm's closest point projected on the direction from it to the
+// contact (positive: towards the person). 0 for fixed capsules (robot.model points) and for a
+// contact on the capsule's axis (no direction: the speed along it is then the full speed).
+float robot_speed_towards(const RobotParams& robot, const RobotState& state, const Contact& contact) {
+  if (!robot.arm) return 0.0F;
+  const Eigen::Vector3d robot_point = contact.closest_robot_base.cast<double>();
+  const Eigen::Vector3d velocity =
+      point_velocity(*robot.arm, state.q_rad, state.qd_rad_s, contact.robot_link, robot_point, robot.base_frame);
+  const Eigen::Vector3d towards = contact.closest_base.cast<double>() - robot_point;
+  const double length = towards.norm();
+  if (!(length > 1e-9)) return static_cast<float>(velocity.norm());
+  return static_cast<float>(velocity.dot(towards) / length);
+}
+
+// The focal length of the camera's own image from the filtered one's (decimation divides it).
+float source_fx_px(float filtered_fx_px, const FilterChainParams& filters) {
+  if (!has_block(filters.order, FilterBlock::decimation)) return filtered_fx_px;
+  return filtered_fx_px * static_cast<float>(std::max(1, filters.decimation.magnitude));
+}
+
+// How long ago, on average, the scene the temporal filter's output shows was seen: its
+// exponential smoothing with weight α on the newest frame lags (1 − α) / α frames.
+double temporal_lag_s(const FilterChainParams& filters, double frame_period_s) {
+  if (!has_block(filters.order, FilterBlock::temporal)) return 0.0;
+  const double alpha = std::clamp(static_cast<double>(filters.temporal.alpha), 0.01, 1.0);
+  return (1.0 - alpha) / alpha * frame_period_s;
 }
 
 // The stop verdict of a learning frame, with the learner's last restart message if any.
@@ -279,10 +312,54 @@ void Pipeline::process(const Frame& source_frame, const RobotState& robot_state,
   });
   result.foreground_points = foreground_.points_base.size();
   timed(result, "safety", [&] {
-    result.verdict = verdict_for_contact(params_.safety, result.contact, result.foreground_points);
+    measure_contact(frame, robot_state, result);
+    const Decision decision =
+        decide_verdict(params_.safety, verdict_input(result, static_cast<double>(elapsed_us(start)) * 1e-6));
+    result.verdict = decision.verdict;
+    result.ssm = decision.ssm;
   });
   result.valid = true;
   finish(result, start);
+}
+
+void Pipeline::measure_contact(const Frame& frame, const RobotState& robot_state, FrameResult& result) {
+  const Contact& contact = result.contact;
+  // The period between frames, for the filter's lag; the nominal 30 frames/s until two frames
+  // were seen, and never more than a second (a pause in a replay).
+  double period_s = 1.0 / 30.0;
+  if (have_previous_frame_ && frame.timestamp_ns > previous_timestamp_ns_) {
+    period_s = std::min(1.0, static_cast<double>(frame.timestamp_ns - previous_timestamp_ns_) * 1e-9);
+  }
+  have_previous_frame_ = true;
+  previous_timestamp_ns_ = frame.timestamp_ns;
+  if (!contact.valid || contact.inside || !contact.closest_base.allFinite()) {
+    have_previous_contact_ = false;
+    return;
+  }
+  result.robot_speed_towards_mps = robot_speed_towards(params_.robot, robot_state, contact);
+  ContactUncertaintyInput in;
+  in.depth_m = contact.closest_camera.z();
+  in.fx_px = frame.intrinsics.fx;
+  const float baseline_m = frame.stereo_baseline_mm * 1e-3F;
+  const double learnt = preset_background_ ? 0.0 : learner_.noise_per_z2();
+  // The stereo noise is in the camera's own pixels: the source's focal length, not the
+  // decimated one (decimation and the spatial filter only lower it).
+  const float source_fx = source_fx_px(frame.intrinsics.fx, params_.filters);
+  in.noise_per_z2 = baseline_m > 0.0F && source_fx > 0.0F
+                        ? params_.foreground.subpixel_rms_px / (source_fx * baseline_m)
+                        : static_cast<float>(learnt > 0.0 ? learnt : params_.background.max_noise_per_z2);
+  in.filter_lag_s = temporal_lag_s(params_.filters, period_s);
+  // The filters lag in depth only, so the contact's speed along the camera's axis counts,
+  // from the last frame's contact; the contact may jump to another body part, which
+  // overstates it, and the cap at the human speed bounds that.
+  if (have_previous_contact_ && frame.timestamp_ns > previous_contact_ns_) {
+    const double dt_s = static_cast<double>(frame.timestamp_ns - previous_contact_ns_) * 1e-9;
+    in.contact_speed_mps = static_cast<float>(std::abs(contact.closest_camera.z() - previous_contact_depth_m_) / dt_s);
+  }
+  have_previous_contact_ = true;
+  previous_contact_ns_ = frame.timestamp_ns;
+  previous_contact_depth_m_ = contact.closest_camera.z();
+  result.distance_uncertainty_m = contact_uncertainty_m(params_.safety.ssm, in);
 }
 
 // The filtered frame must still see the cell: no valid pixel at all, or fewer than

@@ -31,6 +31,9 @@ double ns_to_seconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
 struct Captured {
   Frame frame;
   int64_t captured_ns = 0;
+  /// The frame's age counts from here on the run's clock: its host time when the source set
+  /// one (a live camera's capture time), else the delivery (captured_ns).
+  int64_t seen_ns = 0;
   const char* timestamp_warning = nullptr;  ///< static text; null when the timestamp is in order
 };
 
@@ -165,6 +168,7 @@ void capture_loop(Source& source, const RunOptions& options, RunClock& clock, do
       clock.sleep_until(due_ns, options.stop_requested);
     }
     slot.captured_ns = clock.now_ns();
+    slot.seen_ns = slot.frame.host_time_ns != 0 ? std::min(slot.frame.host_time_ns, slot.captured_ns) : slot.captured_ns;
     if (slot.frame.host_time_ns == 0) {
       slot.frame.host_time_ns = host_time_is_source_time ? slot.frame.timestamp_ns : slot.captured_ns;
     }
@@ -194,6 +198,8 @@ void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const R
   FrameResult result;
   FrameResult previous;  // for before_process; its buffers are reused
   RobotState robot_state;
+  const SafetyParams& safety = pipeline.params().safety;
+  VerdictHold hold;
   try {
     while (frames.take(in)) {
       if (options.before_process) options.before_process(pipeline, previous);
@@ -201,8 +207,18 @@ void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const R
       if (!robot_states.state_at(in.frame.host_time_ns - camera_latency_ns, robot_state)) robot_state.valid = false;
       pipeline.process(in.frame, robot_state, result);
       result.timestamp_warning = in.timestamp_warning;
-      const int64_t age_ns = clock.now_ns() - in.captured_ns;
-      if (age_ns > max_frame_age_ns) result.verdict = stop_verdict(ReasonCode::stale_frame, "stale frame");
+      const int64_t now_ns = clock.now_ns();
+      const int64_t age_ns = now_ns - in.captured_ns;
+      // The verdict again with the frame's age as it is now, T_r of the protective distance.
+      const VerdictInput input = verdict_input(result, ns_to_seconds(now_ns - in.seen_ns));
+      Decision decision{std::move(result.verdict), result.ssm};  // moved, not copied: no allocation
+      if (result.valid) decision = decide_verdict(safety, input);
+      if (age_ns > max_frame_age_ns) decision.verdict = stop_verdict(ReasonCode::stale_frame, "stale frame");
+      // Held on the frames' own times: a replay faster than real time holds as many frames
+      // as the live cell would.
+      hold.apply(safety, input, result.host_time_ns, decision);
+      result.verdict = std::move(decision.verdict);
+      result.ssm = decision.ssm;
       if (options.on_processed) options.on_processed(in.frame, pipeline, result);
       if (options.before_process) previous = result;  // put() swaps `result` with an older buffer
       ++stats.processed;

@@ -85,4 +85,14 @@ float ssm_speed_scale(const SsmParams& params, const SsmInput& input) {
   return static_cast<float>(std::min(1.0, allowed / v_r));
 }
 
+float contact_uncertainty_m(const SsmParams& params, const ContactUncertaintyInput& input) {
+  const double z = input.depth_m;
+  const double noise_m = kDepthNoiseSigmas * static_cast<double>(input.noise_per_z2) * z * z;
+  const double footprint_m = input.fx_px > 0.0F ? 0.5 * std::sqrt(2.0) * z / input.fx_px : z;  // no focal length: a metre per metre
+  const double v_h = human_speed(params, 0.0);  // the cap: the faster of the two speeds
+  const double speed = std::isnan(input.contact_speed_mps) ? v_h : std::min<double>(input.contact_speed_mps, v_h);
+  const double lag_m = non_negative(input.filter_lag_s) * non_negative(speed);
+  return static_cast<float>(noise_m + footprint_m + lag_m);
+}
+
 }  // namespace hrcsense

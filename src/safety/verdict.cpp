@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 namespace hrcsense {
@@ -61,6 +62,119 @@ Verdict verdict_for_contact(const SafetyParams& params, const Contact& contact, 
   return run(ReasonCode::clear, "clear");
 }
 
+namespace {
+
+int strictness(VerdictState state) {
+  switch (state) {
+    case VerdictState::run: return 0;
+    case VerdictState::slow: return 1;
+    case VerdictState::stop: return 2;
+  }
+  return 2;
+}
+
+Verdict ssm_verdict(const SafetyParams& params, const VerdictInput& input, float distance_m,
+                    std::optional<SsmTerms>& terms) {
+  SsmInput ssm;
+  ssm.distance_m = distance_m;
+  ssm.frame_age_s = input.frame_age_s;
+  ssm.robot_speed_mps = input.robot_speed_towards_mps;
+  ssm.distance_uncertainty_m = input.distance_uncertainty_m;
+  terms = protective_distance(params.ssm, ssm, input.robot_speed_towards_mps);
+  const float at_rest_m = protective_distance(params.ssm, ssm, 0.0F).protective_distance_m;
+  // NaN anywhere (an unknown speed or uncertainty) fails these comparisons: a stop.
+  if (!std::isfinite(terms->protective_distance_m) || !std::isfinite(input.robot_speed_towards_mps) ||
+      !(distance_m >= at_rest_m)) {
+    const bool bad = !std::isfinite(terms->protective_distance_m) || !std::isfinite(input.robot_speed_towards_mps);
+    return make_verdict(VerdictState::stop, 0.0F, terms->protective_distance_m,
+                        bad ? ReasonCode::non_finite_input : ReasonCode::below_protective_distance,
+                        bad ? "invalid ssm input" : "below S_p");
+  }
+  const float scale = ssm_speed_scale(params.ssm, ssm);
+  if (scale >= 1.0F) {
+    return make_verdict(VerdictState::run, 1.0F, terms->protective_distance_m, ReasonCode::clear, "clear");
+  }
+  return make_verdict(VerdictState::slow, scale, terms->protective_distance_m, ReasonCode::speed_limited,
+                      "speed limited");
+}
+
+}  // namespace
+
+VerdictInput verdict_input(const FrameResult& result, double frame_age_s) {
+  VerdictInput input;
+  input.contact = result.contact;
+  input.foreground_points = result.foreground_points;
+  input.distance_uncertainty_m = result.distance_uncertainty_m;
+  input.robot_speed_towards_mps = result.robot_speed_towards_mps;
+  input.unknown_distance_m = result.unknown_distance_m;
+  input.frame_age_s = frame_age_s;
+  return input;
+}
+
+Decision decide_verdict(const SafetyParams& params, const VerdictInput& input, float distance_margin_m) {
+  Decision decision;
+  Contact contact = input.contact;
+  if (contact.valid) contact.distance_m = std::max(0.0F, contact.distance_m - distance_margin_m);
+  // The checks of the contact itself (none, invalid, inside) are the same in both modes.
+  decision.verdict = verdict_for_contact(params, contact, input.foreground_points);
+  const bool measured = contact.valid && decision.verdict.code != ReasonCode::non_finite_input &&
+                        decision.verdict.code != ReasonCode::inside_robot;
+  if (params.mode == SafetyParams::Mode::ssm && measured) {
+    decision.verdict = ssm_verdict(params, input, contact.distance_m, decision.ssm);
+  } else if (params.mode == SafetyParams::Mode::ssm && !contact.valid) {
+    // Nobody there: S_p at rest for a person at walking speed, where one who appears stops the robot.
+    SsmInput far;
+    far.distance_m = std::numeric_limits<float>::infinity();
+    far.frame_age_s = input.frame_age_s;
+    decision.verdict.protective_distance_m = protective_distance(params.ssm, far, 0.0F).protective_distance_m;
+  }
+  if (params.unknown_policy == SafetyParams::UnknownPolicy::stop_within_m &&
+      input.unknown_distance_m <= params.unknown_stop_within_m + distance_margin_m &&
+      decision.verdict.state != VerdictState::stop) {
+    decision.verdict = make_verdict(VerdictState::stop, 0.0F, decision.verdict.protective_distance_m,
+                                    ReasonCode::unknown_space, "unknown space");
+  }
+  return decision;
+}
+
+void VerdictHold::apply(const SafetyParams& params, const VerdictInput& input, int64_t time_ns, Decision& decision) {
+  Verdict& verdict = decision.verdict;
+  if (!have_ || strictness(verdict.state) >= strictness(held_)) {
+    // As strict or stricter: taken at once, and the hold starts again from this frame.
+    have_ = true;
+    held_ = verdict.state;
+    since_ns_ = time_ns;
+    held_scale_ = verdict.speed_scale;
+    return;
+  }
+  // More relaxed. It must have been so for min_hold_s, and hold with the distance less the
+  // hysteresis; it relaxes only as far as that stricter reading allows.
+  const double held_s = static_cast<double>(time_ns - since_ns_) * 1e-9;
+  const Decision with_margin = decide_verdict(params, input, params.hysteresis_m);
+  const VerdictState target = strictness(with_margin.verdict.state) > strictness(verdict.state)
+                                  ? with_margin.verdict.state
+                                  : verdict.state;
+  if (held_s >= params.min_hold_s && strictness(target) < strictness(held_)) {
+    held_ = target;
+    since_ns_ = time_ns;
+    if (target != verdict.state) {  // only as far as the hysteresis allows
+      held_scale_ = with_margin.verdict.speed_scale;
+      verdict.state = target;
+      verdict.speed_scale = held_scale_;
+      verdict.code = ReasonCode::holding;
+      verdict.reason = "holding";
+    } else {
+      held_scale_ = verdict.speed_scale;
+    }
+    return;
+  }
+  // Held: the stricter state stays, at its last speed scale (never above the frame's own).
+  verdict.state = held_;
+  verdict.speed_scale = held_ == VerdictState::stop ? 0.0F : std::min(held_scale_, verdict.speed_scale);
+  verdict.code = ReasonCode::holding;
+  verdict.reason = "holding";
+}
+
 Verdict stop_verdict(ReasonCode code, std::string reason) {
   Verdict verdict;
   verdict.state = VerdictState::stop;
@@ -97,6 +211,13 @@ const char* reason_code_name(ReasonCode code) {
     case ReasonCode::processing_error: return "processing_error";
     case ReasonCode::output_error: return "output_error";
     case ReasonCode::camera_disconnected: return "camera_disconnected";
+    case ReasonCode::unknown_space: return "unknown_space";
+    case ReasonCode::envelope_invalid: return "envelope_invalid";
+    case ReasonCode::camera_blocked: return "camera_blocked";
+    case ReasonCode::camera_moved: return "camera_moved";
+    case ReasonCode::below_protective_distance: return "below_protective_distance";
+    case ReasonCode::speed_limited: return "speed_limited";
+    case ReasonCode::holding: return "holding";
   }
   return "unknown";
 }

@@ -248,6 +248,27 @@ void JsonLinesSink::frame(const FrameResult& result) {
   m.number("speed_scale", result.verdict.speed_scale);
 
   m.number_or_null("distance_m", contact.valid, contact.distance_m);
+  m.number("protective_distance_m", result.verdict.protective_distance_m);
+  // S_p's terms (safety.mode ssm, a frame with a contact); null otherwise.
+  if (result.ssm) {
+    m.open("ssm");
+    m.number("s_h_m", result.ssm->s_h_m);
+    m.number("s_r_m", result.ssm->s_r_m);
+    m.number("s_s_m", result.ssm->s_s_m);
+    m.number("c_m", result.ssm->c_m);
+    m.number("z_d_m", result.ssm->z_d_m);
+    m.number("z_r_m", result.ssm->z_r_m);
+    m.number("reaction_time_s", result.ssm->reaction_time_s);
+    m.number("stop_time_s", result.ssm->stop_time_s);
+    m.close();
+  } else {
+    m.null("ssm");
+  }
+  m.number_or_null("distance_uncertainty_m", std::isfinite(result.distance_uncertainty_m),
+                   result.distance_uncertainty_m);
+  m.number_or_null("robot_speed_towards_mps", std::isfinite(result.robot_speed_towards_mps),
+                   result.robot_speed_towards_mps);
+  m.number_or_null("unknown_distance_m", std::isfinite(result.unknown_distance_m), result.unknown_distance_m);
   m.point_or_null("closest_camera", contact.valid, contact.closest_camera);
   m.point_or_null("closest_base", contact.valid, contact.closest_base);
   m.point_or_null("closest_robot_base", contact.valid, contact.closest_robot_base);
