@@ -124,6 +124,7 @@ Ros2CameraSource::Ros2CameraSource(Ros2SourceParams params) : params_(std::move(
                     "(ROS_DOMAIN_ID), reachable under CYCLONEDDS_URI's network settings?");
   }
   info_.type = "ros2";
+  info_.live = true;
   info_.description = "ROS 2 " + topics.depth_image + " (" + domain + ")";
   info_.intrinsics = depth_intrinsics_;
   info_.stereo_baseline_mm = params_.stereo_baseline_mm;

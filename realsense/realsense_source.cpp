@@ -177,6 +177,7 @@ struct RealSenseSource::Impl {
     depth_scale_m = depth_sensor.get_depth_scale();
     const auto depth = profile.get_stream(RS2_STREAM_DEPTH).as<rs2::video_stream_profile>();
     info.type = "realsense";
+    info.live = !device.as<rs2::playback>();  // a file played through the SDK comes when asked
     info.intrinsics = intrinsics_from_sdk(sdk_intrinsics(depth));
     info.nominal_fps = depth.fps();
     info.camera_name = info_or_empty(device, RS2_CAMERA_INFO_NAME);

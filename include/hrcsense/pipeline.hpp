@@ -3,6 +3,7 @@
 // interfaces it joins are in source.hpp, sink.hpp and mailbox.hpp.
 #pragma once
 
+#include "hrcsense/cell_checks.hpp"
 #include "hrcsense/clock.hpp"
 #include "hrcsense/filters.hpp"
 #include "hrcsense/mailbox.hpp"
@@ -42,6 +43,7 @@ struct PipelineParams {
   /// masks them whatever self_filter.enabled says.
   SelfFilterParams self_filter;
   SafetyParams safety;
+  CellCheckParams checks;  ///< the image watchdogs (camera blocked or moved, robot envelope invalid)
   /// `proximity.backend`: brute, kdtree, octree or auto (depth_space later); the pipeline throws
   /// std::invalid_argument for another name.
   std::string backend = "brute";
@@ -124,6 +126,11 @@ class Pipeline {
   int64_t previous_contact_ns_ = 0;
   float previous_contact_depth_m_ = 0.0F;
 
+  std::vector<uint32_t> moved_reference_;  ///< moved_reference_pixels of the background in use
+  bool moved_reference_ready_ = false;
+
+  /// The image watchdogs that need only the background: camera_blocked, camera_moved.
+  bool camera_sees_the_cell(const Frame& frame, FrameResult& result);
   /// Z_d and v_r of the frame's contact (FrameResult::distance_uncertainty_m,
   /// robot_speed_towards_mps), NaN without a contact.
   void measure_contact(const Frame& frame, const RobotState& robot_state, FrameResult& result);

@@ -18,6 +18,9 @@ struct SourceInfo {
   float stereo_baseline_mm = 0.0F;  ///< 0 when unknown
   double nominal_fps = 30.0;    ///< for pacing when frames carry no usable timestamps
   int64_t frame_count = -1;     ///< -1 when unknown
+  /// Frames come at the camera's own rate, not when asked for (a live camera, ROS 2 topics):
+  /// the watchdog then also fires after safety.max_frame_gap_periods nominal periods.
+  bool live = false;
   /// A live camera's own name, serial number and firmware version (empty for other sources);
   /// the JSON header reports them so a log names the device it came from.
   std::string camera_name;

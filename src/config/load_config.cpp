@@ -192,6 +192,11 @@ void read_safety_behaviour(KeyReader& r, Config& c) {
   safety.unknown_policy =
       policy == "stop_within_m" ? SafetyParams::UnknownPolicy::stop_within_m : SafetyParams::UnknownPolicy::report;
   r.number("safety.unknown_stop_within_m", safety.unknown_stop_within_m, Bound::non_negative, 10.0F);
+  CellCheckParams& checks = c.pipeline.checks;
+  r.number("safety.blocked_depth_m", checks.blocked_depth_m, Bound::non_negative, 10.0F);
+  r.number("safety.blocked_share", checks.blocked_share, Bound::positive, 1.0F);
+  r.number("safety.max_envelope_invalid_share", checks.max_envelope_invalid_share, Bound::non_negative, 1.0F);
+  r.number("safety.moved_share", checks.moved_share, Bound::positive, 1.0F);
   // At least one period (a gap below one period fires between any two frames), at most 100.
   r.number_in("safety.max_frame_gap_periods", safety.max_frame_gap_periods, 1.0, 100.0, " periods");
 }

@@ -207,6 +207,7 @@ void Pipeline::retune(const LiveTuning& tuning) {
 }
 
 void Pipeline::relearn_background() {
+  moved_reference_ready_ = false;
   learner_ = BackgroundLearner{};
   learner_.params = params_.background;
   preset_background_ = false;
@@ -236,6 +237,7 @@ void Pipeline::set_background(BackgroundModel model, std::string origin) {
   check_.min_margin_m = params_.foreground.min_margin_m;
   check_.min_valid_ratio = params_.background.min_valid_ratio;
   extractor_.clear_background();  // its tables belong to the previous model
+  moved_reference_ready_ = false;
 }
 
 double Pipeline::unknown_background_share() const {
@@ -281,6 +283,7 @@ void Pipeline::process(const Frame& source_frame, const RobotState& robot_state,
     return finish_stop(result, ReasonCode::background_mismatch, "background size mismatch", start);
   }
   if (!background_checked(frame, result)) return finish(result, start);
+  if (!camera_sees_the_cell(frame, result)) return finish(result, start);
   if (!robot_state.valid || !all_finite(robot_state.q_rad)) self_filter_.clear_poses();  // its poses are history
   if (!robot_state.valid) {
     // A state with a sample time had samples that are now too old; one without never had any.
@@ -298,6 +301,16 @@ void Pipeline::process(const Frame& source_frame, const RobotState& robot_state,
   if (robot_.capsules.empty()) return finish_stop(result, ReasonCode::no_robot_model, "no robot model", start);
   const std::optional<RobotPixels> robot_pixels = render_robot(frame, result);
   const RobotPixels* self_filter = params_.self_filter.enabled && robot_pixels ? &*robot_pixels : nullptr;
+  if (robot_pixels) {
+    // A person next to the arm may hide in depth the camera cannot measure there.
+    const EnvelopeCount envelope = envelope_invalid(frame.depth, background(), &*robot_pixels);
+    if (envelope.share() > params_.checks.max_envelope_invalid_share) {
+      char text[96];
+      std::snprintf(text, sizeof text, "%.0f %% of the robot's envelope without depth (max_envelope_invalid_share %.2f)",
+                    100.0 * envelope.share(), static_cast<double>(params_.checks.max_envelope_invalid_share));
+      return finish_stop(result, ReasonCode::envelope_invalid, text, start);
+    }
+  }
   bool extracted = false;
   timed(result, "foreground", [&] {
     extracted = extract_foreground(extractor_, background(), frame, params_.T_base_camera, self_filter, foreground_);
@@ -360,6 +373,34 @@ void Pipeline::measure_contact(const Frame& frame, const RobotState& robot_state
   previous_contact_ns_ = frame.timestamp_ns;
   previous_contact_depth_m_ = contact.closest_camera.z();
   result.distance_uncertainty_m = contact_uncertainty_m(params_.safety.ssm, in);
+}
+
+// A large surface right in front of the lens, or the static scene seen farther than it was
+// learnt at the sparse reference pixels (the camera was knocked or moved): the background no
+// longer describes what the camera sees, so nothing it says can be trusted.
+bool Pipeline::camera_sees_the_cell(const Frame& frame, FrameResult& result) {
+  const CellCheckParams& checks = params_.checks;
+  const float blocked = blocked_share(checks, frame.depth, background());
+  if (blocked >= checks.blocked_share) {
+    char text[96];
+    std::snprintf(text, sizeof text, "%.0f %% of the image nearer than %.2f m: camera blocked", 100.0 * blocked,
+                  static_cast<double>(checks.blocked_depth_m));
+    set_stop(result.verdict, ReasonCode::camera_blocked, text);
+    return false;
+  }
+  if (!moved_reference_ready_) {
+    moved_reference_ = moved_reference_pixels(checks, background());
+    moved_reference_ready_ = true;
+  }
+  const MovedCount moved = moved_count(checks, frame.depth, background(), moved_reference_);
+  if (moved.valid >= checks.moved_min_valid && moved.share() >= checks.moved_share) {
+    char text[112];
+    std::snprintf(text, sizeof text, "%.0f %% of %zu reference pixels farther than the background: camera moved",
+                  100.0 * moved.share(), moved.valid);
+    set_stop(result.verdict, ReasonCode::camera_moved, text);
+    return false;
+  }
+  return true;
 }
 
 // The filtered frame must still see the cell: no valid pixel at all, or fewer than

@@ -282,16 +282,39 @@ bool take_until(Mailbox<FrameResult>& results, FrameResult& out, const RunClock&
   }
 }
 
-// Writes every result; when none arrives within max_frame_age_s (on the run clock), writes a
-// watchdog stop (with the source's reason for the silence: no_frame, or camera_disconnected),
-// and another each max_frame_age_s after it. The wait for the next result
+// How long the output waits for a result before its watchdog stop, and the rule that says so.
+struct Watchdog {
+  int64_t after_ns = 0;
+  char rule[64] = {};  ///< e.g. "max_frame_age_s 0.500", "max_frame_gap_periods 2 at 30 frames/s"
+};
+
+// safety.max_frame_age_s, and for live or paced sources (frames at a rate, not on demand)
+// safety.max_frame_gap_periods nominal periods when that is shorter.
+Watchdog watchdog_for(const SafetyParams& safety, const SourceInfo& info, bool paced) {
+  Watchdog w;
+  w.after_ns = seconds_to_ns(safety.max_frame_age_s);
+  std::snprintf(w.rule, sizeof w.rule, "max_frame_age_s %.3f", safety.max_frame_age_s);
+  if ((info.live || paced) && info.nominal_fps > 0.0) {
+    const int64_t gap_ns = seconds_to_ns(safety.max_frame_gap_periods / info.nominal_fps);
+    if (gap_ns < w.after_ns) {
+      w.after_ns = gap_ns;
+      std::snprintf(w.rule, sizeof w.rule, "max_frame_gap_periods %g at %g frames/s", safety.max_frame_gap_periods,
+                    info.nominal_fps);
+    }
+  }
+  return w;
+}
+
+// Writes every result; when none arrives within the watchdog's limit (on the run clock), writes
+// a watchdog stop (with the source's reason for the silence: no_frame, or camera_disconnected),
+// and another each limit after it. The wait for the next result
 // starts when the last write ended, at the one clock reading after each write (tests rely on
 // it). Ends early when the sink fails (a closed pipe, a full disk): closes `results` so that
 // processing and capture end too, and says why in `error`. Returns the last result written
 // (for the final stop's frame index).
-FrameResult output_loop(Sink& sink, const Source& source, const RunClock& clock, double max_frame_age_s,
+FrameResult output_loop(Sink& sink, const Source& source, const RunClock& clock, const Watchdog& watchdog_limit,
                         Mailbox<FrameResult>& results, RunSummary& summary, std::string& error) {
-  const int64_t max_frame_age_ns = seconds_to_ns(max_frame_age_s);
+  const int64_t max_frame_age_ns = watchdog_limit.after_ns;
   FrameResult result, last, watchdog;
   int64_t last_arrival_ns = clock.now_ns();
   int64_t waiting_since_ns = last_arrival_ns;
@@ -311,9 +334,9 @@ FrameResult output_loop(Sink& sink, const Source& source, const RunClock& clock,
       if (results.closed()) break;
       const ReasonCode silence = source.silence_reason();
       char reason[128];
-      std::snprintf(reason, sizeof reason, "%sno frame for %.3f s (max_frame_age_s %.3f)",
+      std::snprintf(reason, sizeof reason, "%sno frame for %.3f s (%s)",
                     silence == ReasonCode::camera_disconnected ? "camera disconnected: " : "",
-                    ns_to_seconds(clock.now_ns() - last_arrival_ns), max_frame_age_s);
+                    ns_to_seconds(clock.now_ns() - last_arrival_ns), watchdog_limit.rule);
       write_stop(sink, watchdog, last, silence, reason);
       waiting_since_ns = clock.now_ns();
     }
@@ -360,7 +383,8 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
   std::thread capture([&] { capture_loop(source, options, clock, max_frame_age_s, source_time, frames, outcome); });
   std::thread processing(
       [&] { processing_loop(pipeline, robot_states, options, clock, max_frame_age_s, frames, results, stats); });
-  const FrameResult last = output_loop(sink, source, clock, max_frame_age_s, results, summary, output_error);
+  const Watchdog watchdog = watchdog_for(pipeline.params().safety, source.info(), options.pace);
+  const FrameResult last = output_loop(sink, source, clock, watchdog, results, summary, output_error);
   processing.join();
   capture.join();
 

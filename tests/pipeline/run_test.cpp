@@ -179,6 +179,64 @@ TEST(RunPipeline, WatchdogStopsWhenTheSourceStalls) {
   EXPECT_EQ(sink.results.back().verdict.reason, "source ended");
 }
 
+// A live source (frames at the camera's rate) at 30 frames/s: no frame for 2 periods
+// (safety.max_frame_gap_periods, 66.7 ms) is a stop although max_frame_age_s is 0.5 s. The
+// source stalls 70 ms of fake time before frame 4, as above: exactly one watchdog stop.
+class LiveFakeSource : public FakeSource {
+ public:
+  using FakeSource::FakeSource;
+  SourceInfo info() const override {
+    SourceInfo info = FakeSource::info();
+    info.live = true;
+    info.nominal_fps = 30.0;
+    return info;
+  }
+};
+
+TEST(RunPipeline, WatchdogStopsALiveSourceAfterTwoFramePeriods) {
+  test::WatchedClock clock;
+  LiveFakeSource source(after_learning({{1.5F}, {1.5F}, {1.5F}}));
+  CollectingSink sink;
+  source.before_step = [&](size_t step) {
+    if (step != 4) return true;
+    if (!has_results(sink, 4) || !clock.wait_output_reads_above(clock.output_reads())) return false;
+    clock.fake.advance(70'000'000);
+    return sink.wait_until([](const std::vector<FrameResult>& results) {
+      return !results.empty() && results.back().verdict.code == ReasonCode::no_frame;
+    });
+  };
+  RunOptions options;
+  options.clock = &clock;
+  run(source, sink, fake_params(0.5), options);
+
+  ASSERT_EQ(sink.results.size(), 8U);  // 6 frames, the watchdog's stop, the final stop
+  const FrameResult& watchdog = sink.results[4];
+  EXPECT_EQ(watchdog.verdict.code, ReasonCode::no_frame);
+  EXPECT_EQ(watchdog.verdict.reason, "no frame for 0.070 s (max_frame_gap_periods 2 at 30 frames/s)");
+  EXPECT_FALSE(watchdog.source_frame);
+}
+
+// The same stall of 70 ms from a source that delivers on demand (a recording, unpaced): only
+// max_frame_age_s counts, so there is no watchdog stop.
+TEST(RunPipeline, FrameGapDoesNotApplyToAnUnpacedRecording) {
+  test::WatchedClock clock;
+  FakeSource source(after_learning({{1.5F}, {1.5F}, {1.5F}}));
+  CollectingSink sink;
+  source.before_step = [&](size_t step) {
+    if (step != 4) return true;
+    if (!has_results(sink, 4) || !clock.wait_output_reads_above(clock.output_reads())) return false;
+    clock.fake.advance(70'000'000);
+    // The output looks at the clock after the jump at least twice (10 ms slices): time to fire.
+    const int64_t reads = clock.output_reads();
+    return clock.wait_output_reads_above(reads + 1);
+  };
+  RunOptions options;
+  options.clock = &clock;
+  run(source, sink, fake_params(0.5), options);
+  ASSERT_EQ(sink.results.size(), 7U);  // 6 frames, the final stop
+  for (const FrameResult& r : sink.results) EXPECT_NE(r.verdict.code, ReasonCode::no_frame);
+}
+
 // A live camera that is unplugged says so (Source::silence_reason): the watchdog's stop then
 // carries camera_disconnected instead of no_frame, and the camera's return ends it. Same fake
 // clock choreography as above: the source is "unplugged" during the stall before frame 4.
