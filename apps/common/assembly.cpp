@@ -4,6 +4,7 @@
 #include "common/assembly.hpp"
 
 #include "hrcsense/io.hpp"
+#include "hrcsense/link.hpp"
 #include "hrcsense/recordings.hpp"
 #include "hrcsense/rtde.hpp"
 #include "hrcsense/udp_json.hpp"
@@ -20,6 +21,8 @@
 #include <algorithm>
 #include <filesystem>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace hrcsense {
@@ -207,6 +210,65 @@ void save_learnt_background(const Config& config, const Pipeline& pipeline) {
   if (!parent.empty()) std::filesystem::create_directories(parent);
   save_background(config.background_path, pipeline.background());
   spdlog::info("background saved to {}", config.background_path);
+}
+
+std::unique_ptr<UdpLinkSink> make_udp_link_sink(const Config& config, const RunClock* clock) {
+  const LinkConfig& link = config.link;
+  if (link.udp_address.empty()) return nullptr;
+  static SteadyClock steady_clock;  // stateless: reads the same time as the run's
+  UdpLinkParams params;
+  params.address = link.udp_address;
+  params.format = link.udp_format == "json" ? UdpLinkParams::Format::json : UdpLinkParams::Format::binary;
+  params.heartbeat_hz = link.heartbeat_hz;
+  try {
+    return std::make_unique<UdpLinkSink>(params, clock != nullptr ? *clock : steady_clock);
+  } catch (const std::invalid_argument& e) {
+    // The message names link.udp.address (or link.heartbeat_hz); add the file.
+    throw ConfigError((config.file.empty() ? std::string("configuration") : config.file) + ": " + e.what());
+  }
+}
+
+std::unique_ptr<RtdeLinkSink> make_rtde_link_sink(const Config& config, const RunClock* clock) {
+  const LinkConfig& link = config.link;
+  if (link.rtde_write == "off") return nullptr;
+  const std::string where = config.file.empty() ? std::string("configuration") : config.file;
+  if (config.robot_state.host.empty()) {
+    throw ConfigError(where + ": link.rtde.write: needs the controller's address robot.state.host");
+  }
+  static SteadyClock steady_clock;
+  RtdeLinkParams params;
+  params.host = config.robot_state.host;
+  params.port = config.robot_state.port;
+  params.mode = link.rtde_write == "speed_slider" ? RtdeLinkParams::Mode::speed_slider
+                                                  : RtdeLinkParams::Mode::input_register;
+  params.register_index = link.rtde_register;
+  params.min_speed_slider = link.rtde_min_speed_slider;
+  params.heartbeat_hz = link.heartbeat_hz;
+  try {
+    return std::make_unique<RtdeLinkSink>(params, clock != nullptr ? *clock : steady_clock);
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(where + ": " + e.what());
+  }
+}
+
+std::string describe_link_counters(const RtdeLinkSink& link) {
+  const RtdeLinkCounters c = link.counters();
+  std::string text = "RTDE link (" + link.input_names() + "): " + std::to_string(c.writes) + " writes (" +
+                     std::to_string(c.stop_writes) + " stops) over " + std::to_string(c.streaming) + " of " +
+                     std::to_string(c.connections) + " connections; " + std::to_string(c.disconnects) +
+                     " lost, " + std::to_string(c.refusals) + " refused, " + std::to_string(c.malformed) +
+                     " malformed replies";
+  if (!c.last_problem.empty()) text += " (last: " + c.last_problem + ")";
+  return text;
+}
+
+std::string describe_link_counters(const UdpLinkSink& link) {
+  const UdpLinkCounters c = link.counters();
+  std::string text = "link to " + link.address() + ": " + std::to_string(c.frames) + " frames, " +
+                     std::to_string(c.heartbeats) + " heartbeats, " + std::to_string(c.final_stops) +
+                     " final stop sent; " + std::to_string(c.send_errors) + " send errors";
+  if (!c.last_error.empty()) text += " (last: " + c.last_error + ")";
+  return text;
 }
 
 RunHeader make_run_header(const Config& config, const SourceInfo& info) {

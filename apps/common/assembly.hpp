@@ -7,6 +7,8 @@
 
 #include "hrcsense/clock.hpp"
 #include "hrcsense/config.hpp"
+#include "hrcsense/link.hpp"
+#include "hrcsense/rtde.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/sim.hpp"
@@ -16,6 +18,7 @@
 #include <atomic>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace hrcsense {
@@ -65,6 +68,23 @@ bool load_background_file(const Config& config, const SourceInfo& info, Pipeline
 /// Saves the learnt background to background.path (creating its folder); a warning on stderr
 /// when learning did not finish. Nothing without background.path.
 void save_learnt_background(const Config& config, const Pipeline& pipeline);
+
+/// The link to the robot controller (`link.udp.*`, docs/LINK.md): a UdpLinkSink sending to
+/// link.udp.address, on `clock` (null: the steady clock, run_pipeline's default; it must
+/// outlive the sink); null when link.udp.address is empty. Throws ConfigError naming the file
+/// and link.udp.address for an address that is not numeric host:port.
+std::unique_ptr<UdpLinkSink> make_udp_link_sink(const Config& config, const RunClock* clock = nullptr);
+
+/// `link.rtde.write` (speed_slider or register): an RtdeLinkSink writing to the controller at
+/// robot.state.host:port with its own connection; null for `off`. Throws ConfigError naming
+/// the file and the key for a value outside its range (load_config checks them first).
+std::unique_ptr<RtdeLinkSink> make_rtde_link_sink(const Config& config, const RunClock* clock = nullptr);
+
+/// What an RTDE link did, as one line for the log.
+std::string describe_link_counters(const RtdeLinkSink& link);
+
+/// What a link sent, as one line for the log: "link to ADDRESS: N frames, M heartbeats, ...".
+std::string describe_link_counters(const UdpLinkSink& link);
 
 /// The JSON Lines header of a run: config hash, source, filters (with a note when a chain that
 /// asks for disparity runs on depth). Version and commit are the sink's.

@@ -151,7 +151,16 @@ int run_session(const Config& config, const SessionOptions& args) {
   // Simulated runs: truth.contact_label from the simulator's own labels (TruthLabelSink).
   std::optional<TruthLabelSink> labelled;
   if (config.source.type == "sim") labelled.emplace(make_simulator(config), jsonl);
-  TeeSink tee{labelled ? static_cast<Sink*>(&*labelled) : &jsonl, &console};
+  // link.udp.address: the verdicts to the controller, first, so that no file or console write
+  // delays a datagram.
+  const std::unique_ptr<UdpLinkSink> link = make_udp_link_sink(config);
+  if (link) spdlog::info("link: verdicts to {} ({}, heartbeat {} Hz)", link->address(), config.link.udp_format,
+                         config.link.heartbeat_hz);
+  // link.rtde.write: the speed scale to the controller's RTDE inputs (its own connection).
+  const std::unique_ptr<RtdeLinkSink> rtde_link = make_rtde_link_sink(config);
+  if (rtde_link) spdlog::info("link: speed scale to RTDE {}:{} ({})", config.robot_state.host, config.robot_state.port,
+                              rtde_link->input_names());
+  TeeSink tee{link.get(), rtde_link.get(), labelled ? static_cast<Sink*>(&*labelled) : &jsonl, &console};
   std::optional<RecordCountersSink> with_record;
   if (recorder) with_record.emplace(tee, *recorder);
   Sink& recorded = with_record ? static_cast<Sink&>(*with_record) : tee;
@@ -175,6 +184,21 @@ int run_session(const Config& config, const SessionOptions& args) {
   restore_signal_handlers();
   if (g_stop_signal.load() != 0) spdlog::info("{} received: the run ended with a stop", signal_name(g_stop_signal.load()));
 
+  if (link) {
+    if (link->counters().send_errors > 0) {
+      spdlog::warn("{}", describe_link_counters(*link));
+    } else {
+      spdlog::info("{}", describe_link_counters(*link));
+    }
+  }
+  if (rtde_link) {
+    const RtdeLinkCounters counters = rtde_link->counters();
+    if (counters.disconnects + counters.refusals + counters.malformed > 0 || counters.writes == 0) {
+      spdlog::warn("{}", describe_link_counters(*rtde_link));
+    } else {
+      spdlog::info("{}", describe_link_counters(*rtde_link));
+    }
+  }
   if (recorder) log_recording(recorder->close());
   if (!background_loaded) save_learnt_background(config, pipeline);
   const std::string out_name = args.out.empty() ? "stdout" : args.out;

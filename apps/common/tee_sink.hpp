@@ -10,11 +10,15 @@
 
 namespace hrcsense::app {
 
-/// Forwards header, frames and summary to each sink in the order given. The sinks must
-/// outlive the tee.
+/// Forwards header, frames and summary to each sink in the order given; null entries (a sink
+/// the configuration leaves off) are skipped. The sinks must outlive the tee.
 class TeeSink : public Sink {
  public:
-  TeeSink(std::initializer_list<Sink*> sinks) : sinks_(sinks) {}
+  TeeSink(std::initializer_list<Sink*> sinks) {
+    for (Sink* sink : sinks) {
+      if (sink != nullptr) sinks_.push_back(sink);
+    }
+  }
   void header(const RunHeader& header) override {
     for (Sink* sink : sinks_) sink->header(header);
   }

@@ -8,10 +8,12 @@
 #include "hrcsense/robot.hpp"
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/robot_state_history.hpp"
+#include "hrcsense/sink.hpp"
 #include "hrcsense/types.hpp"
 
 #include <array>
 #include <atomic>
+#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
 #include <mutex>
@@ -136,6 +138,34 @@ bool make_output_recipe(const SetupReply& reply, const std::string& names, Outpu
 /// A DATA_PACKAGE of `recipe`: false on another recipe id or a payload of the wrong size.
 bool parse_data_package(const Frame& frame, const OutputRecipe& recipe, DataSample& out, std::string& error);
 
+// ---- Writing inputs (link.rtde.write).
+
+/// CONTROL_PACKAGE_SETUP_INPUTS: the comma-separated input names (≤ 2048 bytes;
+/// std::invalid_argument when longer).
+std::vector<uint8_t> encode_setup_inputs(const std::string& names);
+
+/// One value of an input DATA_PACKAGE: UINT32 or DOUBLE, the types hrcsense writes.
+struct InputValue {
+  enum class Type : uint8_t { uint32, double_value } type = Type::double_value;
+  uint32_t u32 = 0;
+  double f64 = 0.0;
+};
+
+/// A DATA_PACKAGE the client sends: the input recipe id, then the values in the recipe's order.
+std::vector<uint8_t> encode_input_data(uint8_t recipe_id, const std::vector<InputValue>& values);
+
+/// Checks an input setup reply to the request `names` (comma-separated) against the types
+/// hrcsense will write (`expected_types`, e.g. {"UINT32", "DOUBLE"}): false naming the variable
+/// when another client owns it (IN_USE), the controller does not know it (NOT_FOUND), its
+/// type differs, or the counts differ.
+bool check_input_setup(const SetupReply& reply, const std::string& names,
+                       const std::vector<std::string>& expected_types, std::string& error);
+
+/// A TCP connection to `host`:`port` (name or numeric; TCP_NODELAY, non-blocking), waiting at
+/// most `timeout_s` in slices of 20 ms that look at `stop`; -1 with `error` ("RTDE host:port: ...").
+int connect_tcp(const std::string& host, int port, double timeout_s, const std::atomic<bool>& stop,
+                std::string& error);
+
 }  // namespace rtde
 
 /// RtdeRobotState's parameters (robot.state.* in a configuration).
@@ -219,6 +249,106 @@ class RtdeRobotState final : public RobotStateSource {
   RtdeStatus status_;
   std::string error_;
   std::thread thread_;  // last: started once everything above exists
+};
+
+/// RtdeLinkSink's parameters (`link.rtde.*`, robot.state.host/port; docs/LINK.md).
+struct RtdeLinkParams {
+  std::string host;  ///< `robot.state.host`
+  int port = 30004;  ///< `robot.state.port`
+  /// `link.rtde.write`: speed_slider (speed_slider_mask and speed_slider_fraction) or
+  /// input_register (input_double_register_N, for a URScript to read).
+  enum class Mode { speed_slider, input_register } mode = Mode::input_register;
+  int register_index = 24;        ///< `link.rtde.register`: N, 24..47 (0..23 belong to fieldbus adapters)
+  double min_speed_slider = 0.01; ///< `link.rtde.min_speed_slider`: the slider never goes below this (0, 1]
+  /// `link.heartbeat_hz`: while no frame comes for one period, the stop value is written at
+  /// this rate (a URScript watchdog sees writes, but only stops).
+  double heartbeat_hz = 20.0;
+  double connect_timeout_s = 1.0;   ///< TCP connect, real time
+  double receive_timeout_s = 1.0;   ///< each handshake reply, real time
+  double backoff_initial_s = 0.1;   ///< first wait before reconnecting, doubling...
+  double backoff_max_s = 2.0;       ///< ...up to this
+  /// How long, in real time, the writer waits at most before it looks at the clock and the
+  /// socket again, ns (bounds a heartbeat's lateness on a fake clock).
+  int64_t max_wait_ns = 2'000'000;
+};
+
+/// What RtdeLinkSink has done, for the log and the tests.
+struct RtdeLinkCounters {
+  int64_t connections = 0;    ///< TCP connections made
+  int64_t streaming = 0;      ///< of those, set up and started (inputs accepted)
+  int64_t disconnects = 0;    ///< connections lost or closed after a problem
+  int64_t refusals = 0;       ///< setups refused: IN_USE, NOT_FOUND, wrong type, start refused
+  int64_t malformed = 0;      ///< controller packages that could not be framed or parsed
+  int64_t writes = 0;         ///< input DATA_PACKAGEs sent
+  int64_t stop_writes = 0;    ///< of those, the stop value (stop verdicts, heartbeats, the final stop)
+  bool connected = false;     ///< streaming now
+  double last_value = -1.0;   ///< the last value written (fraction or register); -1: none
+  std::string last_problem;   ///< names link.rtde.write and the controller; empty when none
+};
+
+/// `link.rtde.write`: the verdict's speed scale written to the controller over its own RTDE
+/// connection (robot.state.host:port), one input DATA_PACKAGE per frame. speed_slider writes
+/// speed_slider_mask 1 and speed_slider_fraction = speed_scale clamped to
+/// [min_speed_slider, 1] (never 0: a slider set to 0 and then to another value has caused
+/// protective stops; a stop is min_speed_slider, so the slider alone never stops the robot);
+/// input_register writes input_double_register_N = speed_scale, 0 for stop.
+/// frame() only hands the value to a writer thread and returns (it never waits for the
+/// network); the writer connects, sets up the inputs (an IN_USE reply is a refusal naming the
+/// input and link.rtde.write), starts, writes the newest value, drains what the controller
+/// sends (text messages; anything unparseable is counted and ends the connection), and after a
+/// lost connection reconnects with back-off, writing the newest value first. While no frame
+/// comes for one heartbeat period it writes the stop value; summary() and the destructor write
+/// a final stop (the destructor waits for a connection attempt under way, at most the connect
+/// and receive timeouts, not for a writer that is backing off).
+class RtdeLinkSink final : public Sink {
+ public:
+  /// Starts the writer thread; `clock` must outlive the sink. std::invalid_argument naming the
+  /// key for a register outside 24..47, a slider minimum outside (0, 1] or a non-positive rate.
+  RtdeLinkSink(RtdeLinkParams params, const RunClock& clock);
+  ~RtdeLinkSink() override;
+  RtdeLinkSink(const RtdeLinkSink&) = delete;
+  RtdeLinkSink& operator=(const RtdeLinkSink&) = delete;
+
+  void header(const RunHeader&) override {}
+  void frame(const FrameResult& result) override;
+  void summary(const RunSummary& summary) override;
+
+  RtdeLinkCounters counters() const;
+  /// The value a verdict is written as: the slider fraction or the register value.
+  double value_for(VerdictState state, float speed_scale) const;
+  /// The input names set up, comma-separated (e.g. "input_double_register_24").
+  const std::string& input_names() const { return names_; }
+
+ private:
+  struct Connection;
+  void run();
+  bool connect_and_stream();            // false: no connection, or it was never set up
+  bool setup(Connection& connection);   // false: refused or failed (counted, problem kept)
+  void stream(Connection& connection);  // until the connection ends or the final stop is written
+  bool write(Connection& connection, double value, bool stop_value);
+  bool drain(Connection& connection);   // reads what the controller sent; false: the connection ended
+  void problem_locked(const std::string& what);
+
+  const RtdeLinkParams params_;
+  const RunClock& clock_;
+  std::string names_;
+  std::vector<std::string> types_;
+  int64_t period_ns_ = 0;
+  std::atomic<bool> stop_{false};
+
+  mutable std::mutex mutex_;  // guards everything below
+  std::condition_variable wake_;
+  bool pending_ = false;        ///< a frame's value not yet written
+  double pending_value_ = 0.0;
+  bool pending_stop_ = true;
+  bool have_value_ = false;     ///< a frame came (its value is written first on a new connection)
+  int64_t last_frame_ns_ = 0;   ///< clock time of the last frame() (or of construction)
+  bool final_requested_ = false;
+  bool final_written_ = false;
+  bool attempting_ = false;     ///< connecting, setting up or streaming (the destructor waits for it)
+  RtdeLinkCounters counters_;
+
+  std::thread writer_;  // last: started once everything above exists
 };
 
 }  // namespace hrcsense

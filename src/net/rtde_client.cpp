@@ -30,15 +30,17 @@ int64_t to_ns(double seconds) { return static_cast<int64_t>(std::llround(seconds
 
 std::string system_error(const char* what) { return std::string(what) + ": " + std::strerror(errno); }
 
-// A non-blocking TCP connection with TCP_NODELAY, or -1 with `error`.
-int connect_to(const RtdeParams& params, const std::atomic<bool>& stop, std::string& error) {
+}  // namespace
+
+int rtde::connect_tcp(const std::string& host, int port_number, double timeout_s, const std::atomic<bool>& stop,
+                      std::string& error) {
   addrinfo hints{};
   hints.ai_family = AF_UNSPEC;
   hints.ai_socktype = SOCK_STREAM;
   addrinfo* found = nullptr;
-  const std::string port = std::to_string(params.port);
-  const std::string where = params.host + ":" + port;
-  if (const int rc = ::getaddrinfo(params.host.c_str(), port.c_str(), &hints, &found); rc != 0) {
+  const std::string port = std::to_string(port_number);
+  const std::string where = host + ":" + port;
+  if (const int rc = ::getaddrinfo(host.c_str(), port.c_str(), &hints, &found); rc != 0) {
     error = "RTDE " + where + ": " + ::gai_strerror(rc);
     return -1;
   }
@@ -52,7 +54,7 @@ int connect_to(const RtdeParams& params, const std::atomic<bool>& stop, std::str
     int rc = ::connect(fd, a->ai_addr, a->ai_addrlen);
     if (rc != 0 && errno == EINPROGRESS) {
       pollfd p{fd, POLLOUT, 0};
-      for (int waited = 0; !stop && waited < params.connect_timeout_s * 1000.0; waited += kPollSliceMs) {
+      for (int waited = 0; !stop && waited < timeout_s * 1000.0; waited += kPollSliceMs) {
         if ((rc = ::poll(&p, 1, kPollSliceMs)) != 0) break;
       }
       int so_error = ETIMEDOUT;
@@ -69,6 +71,13 @@ int connect_to(const RtdeParams& params, const std::atomic<bool>& stop, std::str
   }
   ::freeaddrinfo(found);
   return fd;
+}
+
+namespace {
+
+// A non-blocking TCP connection with TCP_NODELAY, or -1 with `error`.
+int connect_to(const RtdeParams& params, const std::atomic<bool>& stop, std::string& error) {
+  return rtde::connect_tcp(params.host, params.port, params.connect_timeout_s, stop, error);
 }
 
 }  // namespace

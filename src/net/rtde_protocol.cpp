@@ -3,6 +3,7 @@
 // Pure functions over byte buffers; everything big-endian (../shared/specs/ur-rtde.md).
 #include "hrcsense/rtde.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 
@@ -260,6 +261,73 @@ bool parse_data_package(const Frame& frame, const OutputRecipe& recipe, DataSamp
       case OutputField::other: break;
     }
     p += entry.size;
+  }
+  return true;
+}
+
+std::vector<uint8_t> encode_setup_inputs(const std::string& names) {
+  if (names.size() > kMaxNamesBytes) {
+    throw std::invalid_argument("CONTROL_PACKAGE_SETUP_INPUTS: variable names of " + std::to_string(names.size()) +
+                                " bytes (at most 2048)");
+  }
+  // Sized once and written by index (GCC 12 misreads package()'s push_backs inlined here).
+  std::vector<uint8_t> out(kHeaderSize + names.size());
+  const size_t size = out.size();
+  out[0] = static_cast<uint8_t>(size >> 8);
+  out[1] = static_cast<uint8_t>(size & 0xFF);
+  out[2] = static_cast<uint8_t>(PackageType::setup_inputs);
+  if (!names.empty()) std::memcpy(out.data() + kHeaderSize, names.data(), names.size());
+  return out;
+}
+
+std::vector<uint8_t> encode_input_data(uint8_t recipe_id, const std::vector<InputValue>& values) {
+  size_t size = kHeaderSize + 1;
+  for (const InputValue& v : values) size += v.type == InputValue::Type::uint32 ? 4 : 8;
+  std::vector<uint8_t> out(size);
+  out[0] = static_cast<uint8_t>(size >> 8);
+  out[1] = static_cast<uint8_t>(size & 0xFF);
+  out[2] = static_cast<uint8_t>(PackageType::data);
+  out[3] = recipe_id;
+  size_t at = 4;
+  for (const InputValue& v : values) {
+    uint64_t bits = v.u32;
+    int bytes = 4;
+    if (v.type == InputValue::Type::double_value) {
+      std::memcpy(&bits, &v.f64, sizeof bits);
+      bytes = 8;
+    }
+    for (int shift = 8 * (bytes - 1); shift >= 0; shift -= 8) out[at++] = static_cast<uint8_t>(bits >> shift);
+  }
+  return out;
+}
+
+bool check_input_setup(const SetupReply& reply, const std::string& names,
+                       const std::vector<std::string>& expected_types, std::string& error) {
+  const std::vector<std::string> variables = split_commas(names);
+  if (variables.size() != reply.types.size() || variables.size() != expected_types.size()) {
+    error = "CONTROL_PACKAGE_SETUP_INPUTS: " + std::to_string(reply.types.size()) + " types for " +
+            std::to_string(variables.size()) + " requested inputs";
+    return false;
+  }
+  for (size_t i = 0; i < variables.size(); ++i) {
+    const std::string& type = reply.types[i];
+    if (type == "IN_USE") {
+      error = "CONTROL_PACKAGE_SETUP_INPUTS: input '" + variables[i] +
+              "' is IN_USE: another RTDE client (UR's ROS driver, a fieldbus adapter) already writes it";
+      return false;
+    }
+    if (type == "NOT_FOUND") {
+      error = "CONTROL_PACKAGE_SETUP_INPUTS: input '" + variables[i] + "' NOT_FOUND on this controller";
+      return false;
+    }
+    if (type != expected_types[i]) {
+      const bool printable = type.size() <= 32 && std::all_of(type.begin(), type.end(), [](char c) {
+                               return c >= 0x20 && c < 0x7F;
+                             });
+      error = "CONTROL_PACKAGE_SETUP_INPUTS: input '" + variables[i] + "' is " +
+              (printable ? "'" + type + "'" : std::string("an unreadable type")) + ", expected " + expected_types[i];
+      return false;
+    }
   }
   return true;
 }

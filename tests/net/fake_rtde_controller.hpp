@@ -6,6 +6,10 @@
 // FakeClock, after each data package it calls the test's `after_send` (which waits until the
 // client has read it), so a 30 s trajectory plays in well under a second and every arrival time
 // is exact; on the steady clock it streams in real time, for a client in another process.
+// A client that sets up inputs instead of outputs (link.rtde.write) gets an input session: the
+// fake answers the setup with this controller's types (IN_USE for the inputs the script says
+// another client owns), then records every input DATA_PACKAGE it receives, decoded by those
+// types, and counts the ones that do not fit the recipe.
 #pragma once
 
 #include "hrcsense/clock.hpp"
@@ -35,7 +39,16 @@
 namespace hrcsense::test {
 
 enum class RtdeFault { none, close, stall, truncated, oversized, unknown_type, wrong_recipe, nan_joints,
-                       not_found, protocol1_only };
+                       not_found, protocol1_only,
+                       // input sessions: the setup reply has no recipe id (an empty payload); the
+                       // connection is closed after fault_at input packages
+                       malformed_input_reply, close_inputs };
+
+/// One input DATA_PACKAGE the fake received, decoded by its recipe's types.
+struct FakeInputWrite {
+  int64_t connection = 0;       ///< which connection (from 1)
+  std::vector<double> values;   ///< in the recipe's order (UINT32 and INT32 as numbers)
+};
 
 /// The fake's default trajectory at controller time t_s: joint j = 0.5 sin(2π·0.2·t + j) + 0.1 j.
 inline double fake_q(double t_s, int j) { return 0.5 * std::sin(2.0 * M_PI * 0.2 * t_s + j) + 0.1 * j; }
@@ -61,6 +74,8 @@ struct FakeRtdeScript {
   /// robot_mode, safety_mode and speed_scaling of data package k (from 0, per connection);
   /// empty: running, normal, 1.0.
   std::function<FakeModes(int64_t k)> modes;
+  /// Inputs another client owns: the input setup reply says IN_USE for them (every connection).
+  std::vector<std::string> in_use;
 };
 
 class FakeRtdeController {
@@ -105,6 +120,19 @@ class FakeRtdeController {
   }
   int64_t data_sent() const { return data_sent_; }
   int64_t connections() const { return connections_; }
+  /// Input sessions: each setup's requested names, the writes received, and the input packages
+  /// that did not fit the recipe (wrong id, wrong size, another type).
+  std::vector<std::string> input_setups() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return input_setups_;
+  }
+  std::vector<FakeInputWrite> inputs() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return inputs_;
+  }
+  int64_t input_errors() const { return input_errors_; }
+  /// The recipe id the fake gives input recipes (not 1, so that a client must use the reply's).
+  static constexpr uint8_t kInputRecipeId = 3;
   /// The frequency each connection's setup asked for.
   std::vector<double> frequencies() const {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -123,6 +151,9 @@ class FakeRtdeController {
   std::condition_variable cv_;
   bool released_ = false;
   std::vector<double> frequencies_;
+  std::vector<std::string> input_setups_;
+  std::vector<FakeInputWrite> inputs_;
+  std::atomic<int64_t> input_errors_{0};
   std::thread thread_;
 
   static void be16(std::vector<uint8_t>& b, uint16_t v) { b.push_back(v >> 8); b.push_back(v & 0xFF); }
@@ -223,7 +254,9 @@ class FakeRtdeController {
     std::vector<uint8_t> version;
     for (uint32_t v : {script_.major, script_.minor, 0U, 0U}) be32(version, v);
     send_all(fd, pack('v', version));
-    if (!read_package(fd, type, in) || type != 'O' || in.size() < 8) return true;
+    if (!read_package(fd, type, in)) return true;
+    if (type == 'I') return serve_inputs(fd, in, fault, connections_.load());
+    if (type != 'O' || in.size() < 8) return true;
     uint64_t bits = 0;
     for (int i = 0; i < 8; ++i) bits = (bits << 8) | in[i];
     double frequency_hz;
@@ -266,6 +299,95 @@ class FakeRtdeController {
     send_all(fd, pack('M', text));
     send_all(fd, pack('S', {1}));
     return stream(fd, names, frequency_hz, fault);
+  }
+
+  static double be_value(const uint8_t* p, const std::string& type) {
+    uint64_t bits = 0;
+    const size_t n = type == "DOUBLE" ? 8 : 4;
+    for (size_t i = 0; i < n; ++i) bits = (bits << 8) | p[i];
+    if (type == "UINT32") return static_cast<double>(static_cast<uint32_t>(bits));
+    if (type == "INT32") return static_cast<double>(static_cast<int32_t>(static_cast<uint32_t>(bits)));
+    double v;
+    std::memcpy(&v, &bits, 8);
+    return v;
+  }
+
+  // An input session (the client asked for inputs after the version): the setup reply, then
+  // the client's DATA_PACKAGEs recorded until it closes or the fake stops. False when it
+  // closed the socket itself.
+  bool serve_inputs(int fd, const std::vector<uint8_t>& in, RtdeFault fault, int64_t connection) {
+    const std::string all(in.begin(), in.end());
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      input_setups_.push_back(all);
+    }
+    if (fault == RtdeFault::malformed_input_reply) {
+      send_all(fd, pack('I', {}));  // no recipe id
+      drain_until_closed(fd);
+      return true;
+    }
+    std::vector<std::string> types;
+    std::string reply_types;
+    bool refused = false;
+    for (size_t at = 0; at <= all.size();) {
+      size_t comma = all.find(',', at);
+      if (comma == std::string::npos) comma = all.size();
+      const std::string name = all.substr(at, comma - at);
+      at = comma + 1;
+      std::string t = "NOT_FOUND";
+      if (name == "speed_slider_mask") t = "UINT32";
+      if (name == "speed_slider_fraction") t = "DOUBLE";
+      for (int r = 0; r < 48; ++r) {
+        if (name == "input_double_register_" + std::to_string(r)) t = "DOUBLE";
+        if (name == "input_int_register_" + std::to_string(r)) t = "INT32";
+      }
+      for (const std::string& owned : script_.in_use) {
+        if (name == owned) t = "IN_USE";
+      }
+      refused = refused || t == "NOT_FOUND" || t == "IN_USE";
+      types.push_back(t);
+      reply_types += (reply_types.empty() ? "" : ",") + t;
+    }
+    std::vector<uint8_t> reply{kInputRecipeId};
+    reply.insert(reply.end(), reply_types.begin(), reply_types.end());
+    send_all(fd, pack('I', reply));
+    if (refused) {
+      drain_until_closed(fd);
+      return true;
+    }
+    char type = 0;
+    std::vector<uint8_t> payload;
+    if (!read_package(fd, type, payload) || type != 'S' || !payload.empty()) return true;
+    send_all(fd, pack('S', {1}));
+    size_t expected = 1;
+    for (const std::string& t : types) expected += t == "DOUBLE" ? 8 : 4;
+    int64_t received = 0;
+    while (!stop_) {
+      pollfd p{fd, POLLIN, 0};
+      if (::poll(&p, 1, 20) <= 0) continue;
+      if (!read_package(fd, type, payload)) return true;  // the client closed
+      if (type != 'U' || payload.size() != expected || payload[0] != kInputRecipeId) {
+        ++input_errors_;
+        continue;
+      }
+      FakeInputWrite write;
+      write.connection = connection;
+      const uint8_t* at = payload.data() + 1;
+      for (const std::string& t : types) {
+        write.values.push_back(be_value(at, t));
+        at += t == "DOUBLE" ? 8 : 4;
+      }
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        inputs_.push_back(write);
+      }
+      if (fault == RtdeFault::close_inputs && ++received == script_.fault_at) {
+        faulted_ = true;
+        ::close(fd);
+        return false;
+      }
+    }
+    return true;
   }
 
   bool stream(int fd, const std::vector<std::string>& names, double frequency_hz, RtdeFault fault) {

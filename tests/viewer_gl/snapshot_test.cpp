@@ -375,8 +375,11 @@ TEST_F(ViewerGl, PausedReplayStopsTheCellAndStepsOneFrame) {
                   " 2> " + (dir / "record.txt").string()),
             0)
       << "see " << (dir / "record.txt");
+  // The watchdog at max_frame_age_s (0.5 s, 15 periods) rather than 2 frame periods: this test
+  // is about pausing, and a paced replay that falls behind its 30 frames/s on a loaded machine
+  // (the viewer renders with llvmpipe beside it) would get watchdog stops of its own.
   const std::string view = kView + " --config " + config + " --set source.type=bag --set source.path=walk.bag" +
-                           " --set source.pace=true --out run.jsonl 2> stderr.txt";
+                           " --set source.pace=true --set safety.max_frame_gap_periods=15 --out run.jsonl 2> stderr.txt";
   // Every wait is bounded: xdotool's search by `timeout`, the viewer by the replay's length.
   const std::string script = "cd " + dir.string() + " && " + view +
                              " & pid=$!; w=$(timeout 30 xdotool search --sync --name hrcsense-view | head -1); "
