@@ -126,6 +126,7 @@ class Pipeline {
   int64_t previous_contact_ns_ = 0;
   float previous_contact_depth_m_ = 0.0F;
 
+  std::vector<uint8_t> no_depth_frames_;  ///< per filtered pixel: frames in a row without depth
   std::vector<uint32_t> moved_reference_;  ///< moved_reference_pixels of the background in use
   bool moved_reference_ready_ = false;
 

@@ -33,7 +33,7 @@ struct SafetyParams {
   double min_hold_s = 0.0;
   /// `safety.unknown_policy`: report (unknown_distance_m only) or stop_within_m.
   enum class UnknownPolicy { report, stop_within_m } unknown_policy = UnknownPolicy::report;
-  float unknown_stop_within_m = 0.3F;  ///< `safety.unknown_stop_within_m`
+  float unknown_stop_within_m = 0.1F;  ///< `safety.unknown_stop_within_m`, m from the padded capsules
   /// `safety.max_frame_gap_periods`: no frame for this many nominal frame periods is a stop
   /// (`no_frame`); safety.max_frame_age_s stays the absolute ceiling.
   double max_frame_gap_periods = 2.0;

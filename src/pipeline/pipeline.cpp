@@ -2,6 +2,7 @@
 // hrcsense — the per-frame processing path: background → foreground → proximity → verdict.
 
 #include "hrcsense/pipeline.hpp"
+#include "hrcsense/unknown_space.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -261,6 +262,7 @@ void Pipeline::process(const Frame& source_frame, const RobotState& robot_state,
     return finish_stop(result, ReasonCode::no_valid_depth, "no valid depth", start);
   }
   const Frame& frame = run_filters(filters_, source_frame, filtered_, result);
+  count_no_depth_frames(frame.depth, no_depth_frames_);  // for unknown space; every filtered frame counts
   if (!enough_valid_depth(frame, result)) return finish(result, start);
   if (!background_ready()) {
     // Motion counts near the robot where it is now, and the robot's own pixels are no samples;
@@ -324,6 +326,12 @@ void Pipeline::process(const Frame& source_frame, const RobotState& robot_state,
     result.backend = proximity_backend_name(proximity_.last_backend());
   });
   result.foreground_points = foreground_.points_base.size();
+  timed(result, "unknown_space", [&] {
+    const UnknownSpace unknown = unknown_space(frame.depth, frame.intrinsics, background(), foreground_.mask,
+                                               robot_pixels ? &*robot_pixels : nullptr, params_.T_base_camera, robot_,
+                                               frame.stereo_baseline_mm * 1e-3F, no_depth_frames_);
+    result.unknown_distance_m = unknown.distance_m;
+  });
   timed(result, "safety", [&] {
     measure_contact(frame, robot_state, result);
     const Decision decision =

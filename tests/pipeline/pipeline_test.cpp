@@ -45,10 +45,11 @@ TEST(Pipeline, LearnsThenMeasuresTheObject) {
   EXPECT_EQ(result.verdict.state, VerdictState::slow);
   EXPECT_EQ(result.foreground_points, 40U * 40U);
   EXPECT_EQ(result.invalid_pixels, 0U);
-  ASSERT_EQ(result.timings.size(), 3U);
+  ASSERT_EQ(result.timings.size(), 4U);
   EXPECT_STREQ(result.timings[0].stage, "foreground");
   EXPECT_STREQ(result.timings[1].stage, "proximity");
-  EXPECT_STREQ(result.timings[2].stage, "safety");
+  EXPECT_STREQ(result.timings[2].stage, "unknown_space");
+  EXPECT_STREQ(result.timings[3].stage, "safety");
   EXPECT_GE(result.latency_us, 0.0);
 
   // The wall alone again: nothing in the cell, run.

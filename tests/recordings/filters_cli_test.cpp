@@ -127,7 +127,7 @@ TEST(FiltersCli, FrameLinesTimeEveryBlockOfTheChainUnderItsName) {
   using Names = std::vector<std::string>;
   const Names sdk{"threshold", "decimation", "to_disparity", "spatial", "temporal", "to_depth"};
   const Names learning{"background"};
-  const Names processing{"foreground", "proximity", "safety"};
+  const Names processing{"foreground", "proximity", "unknown_space", "safety"};
   const auto expect_chain = [&](const std::string& extra, const Names& blocks) {
     const std::vector<Names> frames = frame_timing_keys(dir, extra);
     ASSERT_EQ(frames.size(), 4U) << extra;
