@@ -4,6 +4,7 @@
 
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/safety.hpp"
+#include "hrcsense/sinks.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -53,6 +54,7 @@ void ConsoleSink::header(const RunHeader& header) {
   const Intrinsics& in = header.source.intrinsics;
   spdlog::info("source {} ({}), {}x{}, {} frames, config {}", header.source.type, header.source.description,
                in.width, in.height, header.source.frame_count, header.config_hash);
+  spdlog::warn("{}", kSafetyNotice);
 }
 
 void ConsoleSink::frame(const FrameResult& result) {

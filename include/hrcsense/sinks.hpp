@@ -10,6 +10,11 @@
 
 namespace hrcsense {
 
+/// `safety_notice` of every output's header (JSON Lines, the console's first line).
+inline constexpr const char* kSafetyNotice =
+    "hrcsense is not a safety-rated device: its verdict may request a slower or stopped robot, but a "
+    "safety function must come from rated equipment (docs/SAFETY.md)";
+
 /// Writes one JSON object per line: a header, one line per frame, a summary; each line is
 /// flushed as soon as it is written.
 /// Field names are binding (DESIGN.md "Names other tools rely on").

@@ -186,6 +186,8 @@ void JsonLinesSink::header(const RunHeader& header) {
   m.text("version", header.version.empty() ? HRCSENSE_VERSION : header.version);
   m.text("commit", header.commit.empty() ? HRCSENSE_COMMIT : header.commit);
   m.text("config_hash", header.config_hash);
+  // Every output says it, where a reader of the file would otherwise assume it (issue G2).
+  m.text("safety_notice", kSafetyNotice);
   if (!header.robot_state.empty()) {
     m.text("robot_state", header.robot_state);
     put_key(line_, "robot_state_reports");

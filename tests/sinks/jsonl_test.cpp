@@ -98,6 +98,8 @@ TEST(JsonLinesSink, HeaderCarriesVersionSourceAndIntrinsics) {
   EXPECT_EQ(h["version"], "9.8.7");
   EXPECT_EQ(h["commit"], "abc123");
   EXPECT_EQ(h["config_hash"], "0123456789abcdef");
+  // Every output says what hrcsense is not (issue G2).
+  EXPECT_NE(h["safety_notice"].get<std::string>().find("not a safety-rated device"), std::string::npos);
   EXPECT_EQ(h["robot_state"], "udp_json");
   EXPECT_EQ(h["unknown_background_share"].get<double>(), 0.125);
   EXPECT_EQ(h["source"]["type"], "sim");
