@@ -54,6 +54,10 @@ struct VerdictInput {
   /// v_r: the robot's speed towards the contact at its closest point, m/s; ssm mode only.
   float robot_speed_towards_mps = 0.0F;
   float unknown_distance_m = std::numeric_limits<float>::quiet_NaN();  ///< NaN: no unknown space known
+  /// The share of its programmed speed the robot runs at now (the controller's speed_scaling,
+  /// slider times safety scaling, RTDE); 1 when the robot state does not say. The speed scale
+  /// is a fraction of the programmed speed: v_r / robot_speed_scaling.
+  double robot_speed_scaling = 1.0;
   double frame_age_s = 0.0;      ///< the frame's age at the verdict: host time to now
 };
 

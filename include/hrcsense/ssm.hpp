@@ -22,7 +22,7 @@ struct SsmParams {
   /// > 0: the robot brakes at this rate after robot_stop_time_s (m/s², from its stopping
   /// data); 0: stopping takes robot_stop_time_s whatever the speed.
   float robot_decel_mps2 = 0.0F;
-  float detection_mm = 40.0F;         ///< d, the detection capability; C = 8·(d − 14) mm, ≥ 0
+  float detection_mm = 40.0F;         ///< d, the detection capability; C = 8·(d − 14) mm, ≥ 0, up to 40 mm; 850 mm beyond
   float robot_uncertainty_m = 0.01F;  ///< Z_r, the robot's position uncertainty
 };
 

@@ -287,9 +287,10 @@ struct FrameResult {
   const char* truth_contact_label = nullptr;
   double latency_us = 0.0;       ///< from the frame entering processing to the result
   /// `safety.mode: ssm`, a valid frame with a contact: S_p's terms at the robot's present
-  /// speed (Verdict::protective_distance_m is S_p at rest, the stop threshold); none otherwise.
+  /// speed (their sum is Verdict::protective_distance_m; the stop threshold is S_p at rest);
+  /// none otherwise.
   std::optional<SsmTerms> ssm;
-  /// Z_d of the contact (ssm mode), m; NaN when not computed (no contact, zones mode).
+  /// Z_d of the contact, m (computed in both modes); NaN without a measured contact.
   float distance_uncertainty_m = std::numeric_limits<float>::quiet_NaN();
   /// v_r: the robot's speed towards the contact at its closest point, m/s (negative: away);
   /// NaN when not computed.

@@ -166,6 +166,12 @@ void read_safety_behaviour(KeyReader& r, Config& c) {
   r.number("safety.human_speed_mps", ssm.human_speed_mps, Bound::positive, 10.0F);
   r.number("safety.human_speed_near_mps", ssm.human_speed_near_mps, Bound::positive, 10.0F);
   r.number("safety.human_near_m", ssm.human_near_m, Bound::non_negative, 10.0F);
+  if (ssm.human_speed_near_mps < ssm.human_speed_mps) {
+    r.fail_pair("safety.human_speed_near_mps", "safety.human_speed_mps",
+                "expected the near speed (a reaching hand) >= the walking speed, got " +
+                    config_detail::float_text(ssm.human_speed_near_mps) + " < " +
+                    config_detail::float_text(ssm.human_speed_mps));
+  }
   r.number_in("safety.controller_latency_s", ssm.controller_latency_s, 0.0, 10.0, " s");
   r.number_in("safety.robot_stop_time_s", ssm.robot_stop_time_s, 0.0, 10.0, " s");
   r.number("safety.robot_decel_mps2", ssm.robot_decel_mps2, Bound::non_negative, 1000.0F);
@@ -193,9 +199,11 @@ void read_safety_behaviour(KeyReader& r, Config& c) {
       policy == "stop_within_m" ? SafetyParams::UnknownPolicy::stop_within_m : SafetyParams::UnknownPolicy::report;
   r.number("safety.unknown_stop_within_m", safety.unknown_stop_within_m, Bound::non_negative, 10.0F);
   CellCheckParams& checks = c.pipeline.checks;
-  r.number("safety.blocked_depth_m", checks.blocked_depth_m, Bound::non_negative, 10.0F);
+  // None of the image watchdogs can be switched off by a value: 0 m would never block, a
+  // share of 1 would never be exceeded.
+  r.number("safety.blocked_depth_m", checks.blocked_depth_m, Bound::positive, 10.0F);
   r.number("safety.blocked_share", checks.blocked_share, Bound::positive, 1.0F);
-  r.number("safety.max_envelope_invalid_share", checks.max_envelope_invalid_share, Bound::non_negative, 1.0F);
+  r.number("safety.max_envelope_invalid_share", checks.max_envelope_invalid_share, Bound::non_negative, 0.99F);
   r.number("safety.moved_share", checks.moved_share, Bound::positive, 1.0F);
   // At least one period (a gap below one period fires between any two frames), at most 100.
   r.number_in("safety.max_frame_gap_periods", safety.max_frame_gap_periods, 1.0, 100.0, " periods");

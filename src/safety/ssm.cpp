@@ -12,6 +12,14 @@ namespace {
 // NaN stays NaN (std::max would turn a NaN first argument into the second).
 double non_negative(double v) { return v < 0.0 ? 0.0 : v; }
 
+// C of ISO 13855 for detection capability d: 8·(d − 14) mm up to d = 40 mm (a hand or finger
+// reaching through), not below 0; beyond 40 mm an arm reaches through, C = 850 mm.
+double intrusion_distance_m(const SsmParams& params) {
+  const double d = params.detection_mm;
+  if (d > 40.0) return 0.85;
+  return std::max(0.0, 8.0 * (d - 14.0)) * 1e-3;
+}
+
 double human_speed(const SsmParams& params, double distance_m) {
   return distance_m <= params.human_near_m ? params.human_speed_near_mps : params.human_speed_mps;
 }
@@ -26,7 +34,7 @@ Quadratic protective_polynomial(const SsmParams& params, const SsmInput& input) 
   const double v_h = human_speed(params, input.distance_m);
   const double t_r = non_negative(input.frame_age_s) + params.controller_latency_s;
   const double t_0 = params.robot_stop_time_s;
-  const double c_m = std::max(0.0, 8.0 * (static_cast<double>(params.detection_mm) - 14.0)) * 1e-3;
+  const double c_m = intrusion_distance_m(params);
   Quadratic q;
   q.a = v_h * (t_r + t_0) + c_m + non_negative(input.distance_uncertainty_m) + params.robot_uncertainty_m;
   if (params.robot_decel_mps2 > 0.0F) {
@@ -60,7 +68,7 @@ SsmTerms protective_distance(const SsmParams& params, const SsmInput& input, flo
   t.s_h_m = static_cast<float>(v_h * (t.reaction_time_s + t.stop_time_s));
   t.s_r_m = static_cast<float>(v_r * t.reaction_time_s);
   t.s_s_m = static_cast<float>(s_s);
-  t.c_m = static_cast<float>(std::max(0.0, 8.0 * (static_cast<double>(params.detection_mm) - 14.0)) * 1e-3);
+  t.c_m = static_cast<float>(intrusion_distance_m(params));
   t.z_d_m = static_cast<float>(non_negative(input.distance_uncertainty_m));
   t.z_r_m = params.robot_uncertainty_m;
   t.protective_distance_m = t.s_h_m + t.s_r_m + t.s_s_m + t.c_m + t.z_d_m + t.z_r_m;

@@ -90,7 +90,16 @@ Verdict ssm_verdict(const SafetyParams& params, const VerdictInput& input, float
                         bad ? ReasonCode::non_finite_input : ReasonCode::below_protective_distance,
                         bad ? "invalid ssm input" : "below S_p");
   }
-  const float scale = ssm_speed_scale(params.ssm, ssm);
+  float scale = ssm_speed_scale(params.ssm, ssm);
+  // The scale is of the programmed speed: the robot runs at robot_speed_scaling of it now (a
+  // slider we set earlier, the controller's own reduction). Below 1 % the present speed says
+  // too little about the programmed one, and the present speed counts as programmed.
+  const double running = input.robot_speed_scaling;
+  if (running > 0.01 && running < 1.0 && input.robot_speed_towards_mps > 0.0F) {
+    const double allowed = allowed_robot_speed_mps(params.ssm, ssm);
+    const double programmed_mps = input.robot_speed_towards_mps / running;
+    scale = static_cast<float>(std::clamp(allowed / programmed_mps, 0.0, 1.0));
+  }
   if (scale >= 1.0F) {
     return make_verdict(VerdictState::run, 1.0F, terms->protective_distance_m, ReasonCode::clear, "clear");
   }
@@ -108,6 +117,10 @@ VerdictInput verdict_input(const FrameResult& result, double frame_age_s) {
   input.robot_speed_towards_mps = result.robot_speed_towards_mps;
   input.unknown_distance_m = result.unknown_distance_m;
   input.frame_age_s = frame_age_s;
+  const RobotStatus& status = result.robot_state.status;
+  if (status.known && status.speed_scaling > 0.0 && status.speed_scaling <= 1.0) {
+    input.robot_speed_scaling = status.speed_scaling;
+  }
   return input;
 }
 

@@ -77,6 +77,21 @@ TEST(DecideVerdict, SsmMovingRobotSlowsToTheScaleThatKeepsTheDistance) {
   EXPECT_EQ(decide_verdict(ssm_params(), frame(1.2F, -1.0F)).verdict.state, VerdictState::run);
 }
 
+TEST(DecideVerdict, SsmScaleIsOfTheProgrammedSpeed) {
+  // At 1.373 m the robot may approach at 0.5 m/s. It moves at 0.5 m/s now, but at half its
+  // programmed speed (speed_scaling 0.5: a slider set earlier): programmed 1 m/s, so the scale
+  // is 0.5 of the programmed speed, not the 1.0 the present speed alone would give.
+  VerdictInput in = frame(1.373F, 0.5F);
+  EXPECT_EQ(decide_verdict(ssm_params(), in).verdict.state, VerdictState::run);  // scaling unknown
+  in.robot_speed_scaling = 0.5;
+  const Decision d = decide_verdict(ssm_params(), in);
+  EXPECT_EQ(d.verdict.state, VerdictState::slow);
+  EXPECT_NEAR(d.verdict.speed_scale, 0.5, 1e-4);
+  // Far enough for the programmed speed too (1.198 + 0.35·1.0 = 1.548 m): run.
+  in.contact.distance_m = 1.56F;
+  EXPECT_EQ(decide_verdict(ssm_params(), in).verdict.state, VerdictState::run);
+}
+
 TEST(DecideVerdict, SsmUnknownSpeedOrUncertaintyStops) {
   EXPECT_EQ(decide_verdict(ssm_params(), frame(3.0F, kNaN)).verdict.code, ReasonCode::non_finite_input);
   VerdictInput in = frame(3.0F, 0.0F);

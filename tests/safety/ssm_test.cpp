@@ -93,8 +93,10 @@ TEST(Ssm, DetectionCapabilityBelow14mmGivesNoIntrusionDistance) {
   SsmParams params;
   params.detection_mm = 10.0F;
   EXPECT_EQ(protective_distance(params, input(2.0F, 0.0F), 0.0F).c_m, 0.0F);
-  params.detection_mm = 70.0F;  // 8·56 mm
-  EXPECT_NEAR(protective_distance(params, input(2.0F, 0.0F), 0.0F).c_m, 0.448, 1e-6);
+  params.detection_mm = 40.0F;  // the formula's last value: 8·26 mm
+  EXPECT_NEAR(protective_distance(params, input(2.0F, 0.0F), 0.0F).c_m, 0.208, 1e-6);
+  params.detection_mm = 70.0F;  // coarser than 40 mm: an arm reaches through, ISO 13855's 850 mm
+  EXPECT_NEAR(protective_distance(params, input(2.0F, 0.0F), 0.0F).c_m, 0.85, 1e-6);
 }
 
 TEST(Ssm, MovingAwayCountsAsStandingStill) {
