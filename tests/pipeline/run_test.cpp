@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <string>
 #include <thread>
 
@@ -138,6 +139,20 @@ bool has_results(CollectingSink& sink, size_t count) {
   return sink.wait_until([&](const std::vector<FrameResult>& results) { return results.size() >= count; });
 }
 
+// The source's before_step for a stall before frame 4: once frame 3 is written and the output
+// has looked at the clock since, the fake clock jumps by `stall_ns`; the stall ends once the
+// watchdog has written its no_frame stop (false if it never does).
+std::function<bool(size_t)> stall_before_frame_4(test::WatchedClock& clock, CollectingSink& sink, int64_t stall_ns) {
+  return [&clock, &sink, stall_ns](size_t step) {
+    if (step != 4) return true;
+    if (!has_results(sink, 4) || !clock.wait_output_reads_above(clock.output_reads())) return false;
+    clock.fake.advance(stall_ns);
+    return sink.wait_until([](const std::vector<FrameResult>& results) {
+      return !results.empty() && results.back().verdict.code == ReasonCode::no_frame;
+    });
+  };
+}
+
 // On a fake clock the source stalls before frame 4 for 0.25 s (max_frame_age_s 0.1 s). It
 // starts the stall once frame 3 is written and the output has looked at the clock since, and
 // ends it once the watchdog has written its stop; the clock does not move while it waits, so
@@ -146,14 +161,7 @@ TEST(RunPipeline, WatchdogStopsWhenTheSourceStalls) {
   test::WatchedClock clock;
   FakeSource source(after_learning({{1.5F}, {1.5F}, {1.5F}}));
   CollectingSink sink;
-  source.before_step = [&](size_t step) {
-    if (step != 4) return true;
-    if (!has_results(sink, 4) || !clock.wait_output_reads_above(clock.output_reads())) return false;
-    clock.fake.advance(250'000'000);
-    return sink.wait_until([](const std::vector<FrameResult>& results) {
-      return !results.empty() && results.back().verdict.code == ReasonCode::no_frame;
-    });
-  };
+  source.before_step = stall_before_frame_4(clock, sink, 250'000'000);
   RunOptions options;
   options.clock = &clock;
   const RunSummary summary = run(source, sink, fake_params(0.1), options);
@@ -197,14 +205,7 @@ TEST(RunPipeline, WatchdogStopsALiveSourceAfterTwoFramePeriods) {
   test::WatchedClock clock;
   LiveFakeSource source(after_learning({{1.5F}, {1.5F}, {1.5F}}));
   CollectingSink sink;
-  source.before_step = [&](size_t step) {
-    if (step != 4) return true;
-    if (!has_results(sink, 4) || !clock.wait_output_reads_above(clock.output_reads())) return false;
-    clock.fake.advance(70'000'000);
-    return sink.wait_until([](const std::vector<FrameResult>& results) {
-      return !results.empty() && results.back().verdict.code == ReasonCode::no_frame;
-    });
-  };
+  source.before_step = stall_before_frame_4(clock, sink, 70'000'000);
   RunOptions options;
   options.clock = &clock;
   run(source, sink, fake_params(0.5), options);
