@@ -220,6 +220,7 @@ std::unique_ptr<UdpLinkSink> make_udp_link_sink(const Config& config, const RunC
   params.address = link.udp_address;
   params.format = link.udp_format == "json" ? UdpLinkParams::Format::json : UdpLinkParams::Format::binary;
   params.heartbeat_hz = link.heartbeat_hz;
+  params.backend = config.pipeline.backend;
   try {
     return std::make_unique<UdpLinkSink>(params, clock != nullptr ? *clock : steady_clock);
   } catch (const std::invalid_argument& e) {

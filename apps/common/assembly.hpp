@@ -69,7 +69,7 @@ bool load_background_file(const Config& config, const SourceInfo& info, Pipeline
 /// when learning did not finish. Nothing without background.path.
 void save_learnt_background(const Config& config, const Pipeline& pipeline);
 
-/// The link to the robot controller (`link.udp.*`, docs/LINK.md): a UdpLinkSink sending to
+/// The link to the robot controller (`link.udp.*`, docs/SAFETY.md): a UdpLinkSink sending to
 /// link.udp.address, on `clock` (null: the steady clock, run_pipeline's default; it must
 /// outlive the sink); null when link.udp.address is empty. Throws ConfigError naming the file
 /// and link.udp.address for an address that is not numeric host:port.

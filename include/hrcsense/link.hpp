@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — the verdict sent to the robot controller over UDP (`link.udp.*`, docs/LINK.md):
+// hrcsense — the verdict sent to the robot controller over UDP (`link.udp.*`, docs/SAFETY.md):
 // a fixed 41-byte little-endian datagram with a CRC-32, or the frame's JSON line.
 #pragma once
 
@@ -22,7 +22,7 @@ struct sockaddr_storage;  // <sys/socket.h>, kept out of this header
 
 namespace hrcsense {
 
-/// The datagram's total size in bytes, CRC included (docs/LINK.md has the byte offsets).
+/// The datagram's total size in bytes, CRC included (docs/SAFETY.md has the byte offsets).
 inline constexpr size_t kLinkDatagramSize = 41;
 /// `version` of the layout below; a receiver rejects any other.
 inline constexpr uint16_t kLinkVersion = 1;
@@ -89,6 +89,8 @@ struct UdpLinkParams {
   std::string address;  ///< `link.udp.address`, see parse_link_address
   enum class Format { binary, json } format = Format::binary;  ///< `link.udp.format`
   double heartbeat_hz = 20.0;  ///< `link.heartbeat_hz`, > 0
+  /// json format: the proximity backend its lines name when no search ran (`proximity.backend`)
+  std::string backend = "brute";
   /// How long, in real time, the sender thread waits at most before it reads the clock again:
   /// bounds how late a heartbeat is on a clock that jumps (a FakeClock in tests), ns.
   int64_t max_wait_ns = 2'000'000;
@@ -107,7 +109,7 @@ struct UdpLinkCounters {
 /// for one heartbeat period (on `clock`), and a final stop from summary() or, when no summary
 /// came, from the destructor. Sending never blocks frame(): the socket is non-blocking and a
 /// failed send is counted (counters()), never thrown; a sink whose link fails does not end
-/// the run (the controller stops on its own when datagrams stop arriving, docs/LINK.md).
+/// the run (the controller stops on its own when datagrams stop arriving, docs/SAFETY.md).
 /// frame() and summary() come from the run's output thread; a sender thread writes the
 /// heartbeats; one mutex keeps the sequence in the order the datagrams leave.
 class UdpLinkSink final : public Sink {

@@ -251,7 +251,7 @@ class RtdeRobotState final : public RobotStateSource {
   std::thread thread_;  // last: started once everything above exists
 };
 
-/// RtdeLinkSink's parameters (`link.rtde.*`, robot.state.host/port; docs/LINK.md).
+/// RtdeLinkSink's parameters (`link.rtde.*`, robot.state.host/port; docs/SAFETY.md).
 struct RtdeLinkParams {
   std::string host;  ///< `robot.state.host`
   int port = 30004;  ///< `robot.state.port`

@@ -85,6 +85,15 @@ class VerdictHold {
   /// Replaces `decision` (the frame's own, from decide_verdict(params, input)) with the held
   /// one for a frame of host time `time_ns` (frames in time order).
   void apply(const SafetyParams& params, const VerdictInput& input, int64_t time_ns, Decision& decision);
+  /// A stop that no frame's verdict shows (the output's watchdog stop while no result came):
+  /// held as if a frame of host time `time_ns` had asked for it, so that the frames after a
+  /// silence relax no faster than after any other stop.
+  void stop_at(int64_t time_ns) {
+    have_ = true;
+    held_ = VerdictState::stop;
+    since_ns_ = time_ns;
+    held_scale_ = 0.0F;
+  }
   /// Forgets the past (a new run).
   void reset() { have_ = false; }
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — `link.rtde.write`: the verdict's speed scale written to a UR controller's RTDE
 // inputs (the speed slider, or a double register for a URScript) by a writer thread with its
-// own connection; frame() never touches the network (../shared/specs/ur-rtde.md, docs/LINK.md).
+// own connection; frame() never touches the network (../shared/specs/ur-rtde.md, docs/SAFETY.md).
 #include "hrcsense/rtde.hpp"
 
 #include <algorithm>
@@ -68,17 +68,8 @@ struct RtdeLinkSink::Connection {
   // Reads what is there (waiting at most `wait_ms`) and takes the next package into `frame`.
   // 1: a package; 0: none yet; -1: the connection ended (error, malformed set).
   int next(rtde::Frame& frame, int wait_ms) {
-    const rtde::FrameSplit split = rtde::split_frame(buffer.data() + begin, end - begin);
-    if (split.status == rtde::SplitStatus::frame) {
-      frame = split.frame;
-      begin += split.consumed;
-      return 1;
-    }
-    if (split.status == rtde::SplitStatus::malformed) {
-      error = split.error;
-      malformed = true;
-      return -1;
-    }
+    const int buffered = next_buffered(frame);
+    if (buffered != 0) return buffered;
     if (begin > 0) {  // keep room for a read
       std::memmove(buffer.data(), buffer.data() + begin, end - begin);
       end -= begin;
@@ -106,6 +97,7 @@ struct RtdeLinkSink::Connection {
   }
 
  private:
+  // The next package already in the buffer: 1 taken, 0 none complete yet, -1 malformed.
   int next_buffered(rtde::Frame& frame) {
     const rtde::FrameSplit split = rtde::split_frame(buffer.data() + begin, end - begin);
     if (split.status == rtde::SplitStatus::frame) {

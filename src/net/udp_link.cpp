@@ -30,7 +30,7 @@
 namespace hrcsense {
 namespace {
 
-// Byte offsets (docs/LINK.md's table).
+// Byte offsets (docs/SAFETY.md's table).
 constexpr size_t kMagicAt = 0, kVersionAt = 4, kKindAt = 6, kSequenceAt = 8, kTimestampAt = 12, kVerdictAt = 20,
                  kReasonAt = 21, kSpeedScaleAt = 23, kDistanceAt = 27, kProtectiveAt = 31, kAgeAt = 35, kCrcAt = 37;
 static_assert(kCrcAt + 4 == kLinkDatagramSize, "the CRC closes the datagram");
@@ -234,7 +234,7 @@ sockaddr_storage parse_link_address(const std::string& address, unsigned& length
 // so a frame allocates nothing once the longest line has been seen).
 class UdpLinkSink::JsonFrames {
  public:
-  JsonFrames() : stream_(&buffer_), sink_(stream_) {}
+  explicit JsonFrames(const std::string& backend) : stream_(&buffer_), sink_(stream_, backend) {}
   void header(const RunHeader& header) {
     sink_.header(header);  // the sink learns what frames carry (robot_status); the line is not sent
     buffer_.text.clear();
@@ -277,7 +277,7 @@ UdpLinkSink::UdpLinkSink(const UdpLinkParams& params, const RunClock& clock)
   }
   unsigned length = 0;
   const sockaddr_storage destination = parse_link_address(address_, length);
-  if (format_ == UdpLinkParams::Format::json) json_ = std::make_unique<JsonFrames>();
+  if (format_ == UdpLinkParams::Format::json) json_ = std::make_unique<JsonFrames>(params.backend);
   fd_ = ::socket(destination.ss_family, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   if (fd_ < 0) {
     throw std::runtime_error("link.udp.address '" + address_ + "': socket: " + std::system_category().message(errno));

@@ -6,6 +6,7 @@
 #include "hrcsense/pipeline.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -188,10 +189,12 @@ struct ProcessingStats {
 
 // Processes every frame it takes; a frame older than max_frame_age_s at the end of its
 // processing becomes a stop. Reads the clock once per frame, there (tests rely on it). Closes
-// `results` when `frames` is closed and drained.
+// `results` when `frames` is closed and drained. `watchdog_stopped` is set by the output loop
+// when it wrote a watchdog stop: the next frame's verdict holds that stop (VerdictHold::stop_at
+// at the frame's own time, later than the silence began: the cautious side).
 void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const RunOptions& options,
                      const RunClock& clock, double max_frame_age_s, Mailbox<Captured>& frames,
-                     Mailbox<FrameResult>& results, ProcessingStats& stats) {
+                     Mailbox<FrameResult>& results, std::atomic<bool>& watchdog_stopped, ProcessingStats& stats) {
   const int64_t max_frame_age_ns = seconds_to_ns(max_frame_age_s);
   const int64_t camera_latency_ns = robot_state_lookup_offset_ns(robot_states.origin(), options.camera_latency_s);
   Captured in;
@@ -216,6 +219,7 @@ void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const R
       if (age_ns > max_frame_age_ns) decision.verdict = stop_verdict(ReasonCode::stale_frame, "stale frame");
       // Held on the frames' own times: a replay faster than real time holds as many frames
       // as the live cell would.
+      if (watchdog_stopped.exchange(false)) hold.stop_at(result.host_time_ns);
       hold.apply(safety, input, result.host_time_ns, decision);
       result.verdict = std::move(decision.verdict);
       result.ssm = decision.ssm;
@@ -313,7 +317,8 @@ Watchdog watchdog_for(const SafetyParams& safety, const SourceInfo& info, bool p
 // processing and capture end too, and says why in `error`. Returns the last result written
 // (for the final stop's frame index).
 FrameResult output_loop(Sink& sink, const Source& source, const RunClock& clock, const Watchdog& watchdog_limit,
-                        Mailbox<FrameResult>& results, RunSummary& summary, std::string& error) {
+                        Mailbox<FrameResult>& results, std::atomic<bool>& watchdog_stopped, RunSummary& summary,
+                        std::string& error) {
   const int64_t max_frame_age_ns = watchdog_limit.after_ns;
   FrameResult result, last, watchdog;
   int64_t last_arrival_ns = clock.now_ns();
@@ -338,6 +343,7 @@ FrameResult output_loop(Sink& sink, const Source& source, const RunClock& clock,
                     silence == ReasonCode::camera_disconnected ? "camera disconnected: " : "",
                     ns_to_seconds(clock.now_ns() - last_arrival_ns), watchdog_limit.rule);
       write_stop(sink, watchdog, last, silence, reason);
+      watchdog_stopped = true;
       waiting_since_ns = clock.now_ns();
     }
   } catch (const std::exception& e) {
@@ -377,14 +383,16 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
   CaptureOutcome outcome;
   RunSummary summary;
   std::string output_error;
+  std::atomic<bool> watchdog_stopped{false};
 
   sink.header(header);
   const bool source_time = host_time_is_source_time(robot_states.origin(), options.pace);
   std::thread capture([&] { capture_loop(source, options, clock, max_frame_age_s, source_time, frames, outcome); });
-  std::thread processing(
-      [&] { processing_loop(pipeline, robot_states, options, clock, max_frame_age_s, frames, results, stats); });
+  std::thread processing([&] {
+    processing_loop(pipeline, robot_states, options, clock, max_frame_age_s, frames, results, watchdog_stopped, stats);
+  });
   const Watchdog watchdog = watchdog_for(pipeline.params().safety, source.info(), options.pace);
-  const FrameResult last = output_loop(sink, source, clock, watchdog, results, summary, output_error);
+  const FrameResult last = output_loop(sink, source, clock, watchdog, results, watchdog_stopped, summary, output_error);
   processing.join();
   capture.join();
 

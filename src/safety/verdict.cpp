@@ -134,6 +134,9 @@ Decision decide_verdict(const SafetyParams& params, const VerdictInput& input, f
                         decision.verdict.code != ReasonCode::inside_robot;
   if (params.mode == SafetyParams::Mode::ssm && measured) {
     decision.verdict = ssm_verdict(params, input, contact.distance_m, decision.ssm);
+  } else if (params.mode == SafetyParams::Mode::ssm && decision.verdict.code == ReasonCode::inside_robot) {
+    // A stop either way; it reports S_p of a person at 0 m, not the zones' stop distance.
+    decision.verdict.protective_distance_m = ssm_verdict(params, input, 0.0F, decision.ssm).protective_distance_m;
   } else if (params.mode == SafetyParams::Mode::ssm && !contact.valid) {
     // Nobody there: S_p at rest for a person at walking speed, where one who appears stops the robot.
     SsmInput far;

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -121,28 +122,51 @@ TEST(SsmAcceptance, MovingArmsOwnShadowAndPixelsDoNotFreezeTheCell) {
   EXPECT_GT(reported_person, 300);
 }
 
+// The side, in mm, of a square of the same area as the person's visible pixels at their mean
+// true depth (sqrt(count) · mean z / fx): how large the camera sees the person, from the
+// simulator's noise-free depth and labels. 0: nothing of the person is visible.
+double visible_size_mm(const Frame& frame) {
+  int64_t count = 0;
+  double z_sum = 0.0;
+  for (size_t i = 0; i < frame.truth->labels.size(); ++i) {
+    const uint16_t label = frame.truth->labels[i];
+    if (label == kStaticLabel || label == kRobotLabel || frame.truth->depth_m[i] <= 0.0F) continue;
+    ++count;
+    z_sum += frame.truth->depth_m[i];
+  }
+  if (count == 0) return 0.0;
+  return std::sqrt(static_cast<double>(count)) * (z_sum / static_cast<double>(count)) * 1000.0 / frame.intrinsics.fx;
+}
+
 // Z_d covers the measurement: measured distance − Z_d ≤ true distance in ≥ 99.9 % of the frames
-// with a person and a measured contact, and the median Z_d of contacts within 2.5 m of the
-// camera is at most 50 mm. Frames whose person is not measured at all (a detection miss, not
-// a measurement error: a person entering at the image's edge) are counted and reported apart;
-// they stay below 0.5 %.
+// with a detectable person (a frame whose person is not measured at all counts against it), and
+// the median Z_d of contacts within 2.5 m of the camera is at most 50 mm. A person the camera
+// sees smaller than the detection capability d (safety.detection_mm: a few pixels of a person
+// entering at the image's edge) is beyond what the system claims to detect: those frames are
+// counted and reported apart.
 TEST(SsmAcceptance, DistanceUncertaintyCoversTheTruthPooledOverTheScenes) {
   const std::vector<std::string> scenes = {"cell-ur5-moving.yaml", "cell-ur5.yaml", "walk.yaml",
                                            "thesis-box-human.yaml", "clutter.yaml"};
-  int frames = 0, covered = 0, measured = 0;
+  int frames = 0, covered = 0, measured = 0, below_d = 0, below_d_measured = 0;
   std::vector<float> z_d_near;
   std::vector<float> excess;  // measured − Z_d − truth where positive
   for (const std::string& scene : scenes) {
     for (const char* seed : {"source.seed=1", "source.seed=2"}) {
       SimRun run(load_config(config_path(scene), {seed}));
+      const double detection_mm = run.config.pipeline.safety.ssm.detection_mm;
       Frame frame;
       RobotState state;
       FrameResult result;
       for (int64_t i = 0; i < run.config.sim.frames; ++i) {
         run.step(i, frame, state, result);
         if (!result.valid || !result.truth || !result.truth->valid) continue;
-        ++frames;
         const Contact& c = result.contact;
+        if (visible_size_mm(frame) < detection_mm) {
+          ++below_d;
+          below_d_measured += c.valid ? 1 : 0;
+          continue;
+        }
+        ++frames;
         if (!c.valid) continue;
         ++measured;
         const float low = c.distance_m - result.distance_uncertainty_m;
@@ -160,13 +184,13 @@ TEST(SsmAcceptance, DistanceUncertaintyCoversTheTruthPooledOverTheScenes) {
   std::sort(z_d_near.begin(), z_d_near.end());
   std::sort(excess.begin(), excess.end());
   const auto at = [&](double q) { return z_d_near[static_cast<size_t>(q * static_cast<double>(z_d_near.size() - 1))]; };
-  const double share = static_cast<double>(covered) / measured;
-  std::printf("Z_d: %d frames with a person, %d measured, covered %.4f; Z_d within 2.5 m (%zu): p5 %.4f, p50 %.4f, p95 %.4f, max "
-              "%.4f m; %zu uncovered, largest excess %.4f m\n",
+  const double share = static_cast<double>(covered) / frames;
+  std::printf("Z_d: %d frames with a person seen at least d across, %d measured, covered %.4f; Z_d within 2.5 m (%zu): "
+              "p5 %.4f, p50 %.4f, p95 %.4f, max %.4f m; %zu uncovered, largest excess %.4f m; %d frames with a "
+              "person seen smaller than d (%d of them measured)\n",
               frames, measured, share, z_d_near.size(), at(0.05), at(0.5), at(0.95), z_d_near.back(), excess.size(),
-              excess.empty() ? 0.0 : static_cast<double>(excess.back()));
+              excess.empty() ? 0.0 : static_cast<double>(excess.back()), below_d, below_d_measured);
   EXPECT_GE(share, 0.999);
-  EXPECT_LE(frames - measured, frames / 200);
   EXPECT_LE(at(0.5), 0.050F);
 }
 

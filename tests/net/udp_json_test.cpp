@@ -3,6 +3,7 @@
 // the robot state source fed by a sender socket in this process over loopback, on a fake clock.
 #include "hrcsense/udp_json.hpp"
 
+#include "../support/loopback.hpp"
 #include "cli_cell.hpp"
 
 #include "common/assembly.hpp"
@@ -184,32 +185,19 @@ bool wait_until(Predicate done) {
 class Sender {
  public:
   explicit Sender(uint16_t to_port) {
-    fd_ = ::socket(AF_INET, SOCK_DGRAM, 0);
-    if (fd_ < 0) throw std::runtime_error("sender socket");
-    sockaddr_in self{};
-    self.sin_family = AF_INET;
-    self.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::bind(fd_, reinterpret_cast<const sockaddr*>(&self), sizeof self) != 0) throw std::runtime_error("bind");
-    socklen_t length = sizeof self;
-    ::getsockname(fd_, reinterpret_cast<sockaddr*>(&self), &length);
-    port_ = ntohs(self.sin_port);
     to_.sin_family = AF_INET;
     to_.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
     to_.sin_port = htons(to_port);
   }
-  ~Sender() { ::close(fd_); }
-  Sender(const Sender&) = delete;
-  Sender& operator=(const Sender&) = delete;
   void send(const std::string& bytes) const {
     const ssize_t sent =
-        ::sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&to_), sizeof to_);
+        ::sendto(socket_.fd, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&to_), sizeof to_);
     ASSERT_EQ(sent, static_cast<ssize_t>(bytes.size()));
   }
-  uint16_t port() const { return port_; }
+  uint16_t port() const { return socket_.port; }
 
  private:
-  int fd_ = -1;
-  uint16_t port_ = 0;
+  test::LoopbackUdpSocket socket_;
   sockaddr_in to_{};
 };
 
@@ -388,20 +376,7 @@ TEST(UdpJsonRobotState, ReorderedDatagramIsBackwardsAndLeavesTheClockMap) {
 }
 
 // A socket bound to 127.0.0.1 on an ephemeral port, held by the test.
-struct HeldPort {
-  int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  uint16_t port = 0;
-  HeldPort() {
-    sockaddr_in self{};
-    self.sin_family = AF_INET;
-    self.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::bind(fd, reinterpret_cast<const sockaddr*>(&self), sizeof self) != 0) throw std::runtime_error("bind");
-    socklen_t length = sizeof self;
-    ::getsockname(fd, reinterpret_cast<sockaddr*>(&self), &length);
-    port = ntohs(self.sin_port);
-  }
-  ~HeldPort() { ::close(fd); }
-};
+using HeldPort = test::LoopbackUdpSocket;
 
 void expect_runtime_error(const UdpJsonParams& params, const std::string& message) {
   FakeClock clock;

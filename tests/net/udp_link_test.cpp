@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The link to the controller: the HRCS datagram against bytes laid out by hand from the layout
-// in docs/LINK.md (CRC values from zlib's crc32), its decoder against every kind of damage, and
+// in docs/SAFETY.md (CRC values from zlib's crc32), its decoder against every kind of damage, and
 // UdpLinkSink against a receiver socket in this process on 127.0.0.1 (ephemeral ports, every
 // wait bounded), on a fake clock; then `hrcsense run` with the link on.
 #include "hrcsense/link.hpp"
@@ -8,6 +8,8 @@
 #include "hrcsense/clock.hpp"
 #include "hrcsense/safety.hpp"
 #include "hrcsense/sinks.hpp"
+
+#include "../support/loopback.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -284,30 +286,15 @@ TEST(UdpLinkAddress, NumericAddressesOnlyAndTheKeyIsNamed) {
 // A UDP socket bound to 127.0.0.1 on an ephemeral port.
 class Receiver {
  public:
-  Receiver() {
-    fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-    if (fd_ < 0) throw std::runtime_error("receiver socket");
-    sockaddr_in self{};
-    self.sin_family = AF_INET;
-    self.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::bind(fd_, reinterpret_cast<const sockaddr*>(&self), sizeof self) != 0) throw std::runtime_error("bind");
-    socklen_t length = sizeof self;
-    ::getsockname(fd_, reinterpret_cast<sockaddr*>(&self), &length);
-    port_ = ntohs(self.sin_port);
-  }
-  ~Receiver() { ::close(fd_); }
-  Receiver(const Receiver&) = delete;
-  Receiver& operator=(const Receiver&) = delete;
-
-  std::string address() const { return "127.0.0.1:" + std::to_string(port_); }
-  uint16_t port() const { return port_; }
+  std::string address() const { return "127.0.0.1:" + std::to_string(socket_.port); }
+  uint16_t port() const { return socket_.port; }
 
   /// The next datagram, waiting at most `timeout_ms`; none when nothing came.
   std::optional<std::string> next(int timeout_ms = 2000) const {
-    pollfd fds{fd_, POLLIN, 0};
+    pollfd fds{socket_.fd, POLLIN, 0};
     if (::poll(&fds, 1, timeout_ms) <= 0) return std::nullopt;
     char buffer[65536];
-    const ssize_t got = ::recv(fd_, buffer, sizeof buffer, MSG_DONTWAIT);
+    const ssize_t got = ::recv(socket_.fd, buffer, sizeof buffer, MSG_DONTWAIT);
     if (got < 0) return std::nullopt;
     return std::string(buffer, static_cast<size_t>(got));
   }
@@ -325,8 +312,7 @@ class Receiver {
   }
 
  private:
-  int fd_ = -1;
-  uint16_t port_ = 0;
+  test::LoopbackUdpSocket socket_;
 };
 
 FrameResult frame_at(int64_t index, int64_t host_time_ns, bool contact) {
@@ -506,13 +492,15 @@ TEST(UdpLinkSink, JsonFormatSendsTheFramesLine) {
   FakeClock clock(0);
   UdpLinkParams params = params_for(receiver);
   params.format = UdpLinkParams::Format::json;
+  params.backend = "octree";  // proximity.backend, named when no search ran
   UdpLinkSink sink(params, clock);
   sink.header(RunHeader{});
-  const FrameResult frame = frame_at(3, 42 * kMs, true);
+  FrameResult frame = frame_at(3, 42 * kMs, true);
+  frame.backend = nullptr;
   sink.frame(frame);
   // The line JSON Lines output writes for the same result.
   std::ostringstream expected_out;
-  JsonLinesSink jsonl(expected_out);
+  JsonLinesSink jsonl(expected_out, "octree");
   jsonl.frame(frame);
   std::string expected = expected_out.str();
   ASSERT_FALSE(expected.empty());
@@ -521,6 +509,7 @@ TEST(UdpLinkSink, JsonFormatSendsTheFramesLine) {
   ASSERT_TRUE(line);
   EXPECT_EQ(*line, expected);
   EXPECT_EQ(nlohmann::json::parse(*line).at("type"), "frame");
+  EXPECT_EQ(nlohmann::json::parse(*line).at("backend"), "octree");
 
   clock.advance(100 * kMs);
   const std::optional<std::string> heartbeat = receiver.next();

@@ -187,6 +187,31 @@ TEST(RunPipeline, WatchdogStopsWhenTheSourceStalls) {
   EXPECT_EQ(sink.results.back().verdict.reason, "source ended");
 }
 
+// The watchdog's stop is held like any other (safety.min_hold_s 20 ms on the frames' own
+// times, 30 frames/s): frame 4, the first after the silence, says `holding` stop, frame 5
+// (33 ms later) runs again. Without the stall frame 4 runs.
+TEST(RunPipeline, FramesAfterAWatchdogStopHoldIt) {
+  for (const bool stall : {true, false}) {
+    SCOPED_TRACE(stall ? "with the stall" : "without it");
+    test::WatchedClock clock;
+    FakeSource source(after_learning({{1.5F}, {1.5F}, {1.5F}}));
+    CollectingSink sink;
+    if (stall) source.before_step = stall_before_frame_4(clock, sink, 250'000'000);
+    RunOptions options;
+    options.clock = &clock;
+    PipelineParams params = fake_params(0.1);
+    params.safety.min_hold_s = 0.02;
+    run(source, sink, params, options);
+
+    const std::vector<FrameResult> frames = sink.frame_results();
+    ASSERT_EQ(frames.size(), 6U);
+    EXPECT_EQ(frames[3].verdict.state, VerdictState::run);  // before the stall
+    EXPECT_EQ(frames[4].verdict.state, stall ? VerdictState::stop : VerdictState::run);
+    EXPECT_EQ(frames[4].verdict.code == ReasonCode::holding, stall);
+    EXPECT_EQ(frames[5].verdict.state, VerdictState::run);
+  }
+}
+
 // A live source (frames at the camera's rate) at 30 frames/s: no frame for 2 periods
 // (safety.max_frame_gap_periods, 66.7 ms) is a stop although max_frame_age_s is 0.5 s. The
 // source stalls 70 ms of fake time before frame 4, as above: exactly one watchdog stop.

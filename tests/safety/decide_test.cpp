@@ -109,7 +109,13 @@ TEST(DecideVerdict, SsmKeepsTheContactChecks) {
   EXPECT_FALSE(empty.ssm.has_value());
   VerdictInput inside = frame(0.0F, 0.0F);
   inside.contact.inside = true;
-  EXPECT_EQ(decide_verdict(ssm_params(), inside).verdict.code, ReasonCode::inside_robot);
+  const Decision in = decide_verdict(ssm_params(), inside);
+  EXPECT_EQ(in.verdict.state, VerdictState::stop);
+  EXPECT_EQ(in.verdict.code, ReasonCode::inside_robot);
+  // Compared against S_p of a person at 0 m (2.0·0.6 + 0.238 = 1.438 m), not a zone's distance.
+  EXPECT_NEAR(in.verdict.protective_distance_m, 1.438, 1e-5);
+  ASSERT_TRUE(in.ssm.has_value());
+  EXPECT_NEAR(in.ssm->protective_distance_m, 1.438, 1e-5);
 }
 
 TEST(DecideVerdict, ZonesModeIsTheThesisRule) {
