@@ -24,7 +24,21 @@ struct CommandArgs {
   double duration_s = -1.0;         ///< record --duration-s S; < 0: until --frames or the source's end
 };
 
+/// `hrcsense eval`'s flags (docs/EVALUATION.md).
+struct EvalArgs {
+  std::string config_path;          ///< --config FILE: the scene when no --scene is given
+  std::vector<std::string> sets;    ///< --set KEY=VALUE, for every row
+  std::vector<std::string> sweeps;  ///< --sweep KEY=LIST | KEY=A:B[:STEP], a grid
+  std::vector<std::string> scenes;  ///< --scene FILE (configuration files)
+  int64_t seeds = 0;                ///< --seeds N: source.seed 1..N; 0: each scene's own seed
+  int64_t frames = -1;              ///< --frames N per row; -1: the source's length
+  int jobs = 1;                     ///< --jobs N rows at once
+  std::string out;                  ///< --out DIR
+};
+
 int run_command(const CommandArgs& args);
+/// eval: the thesis's measures over a sweep (results.csv in --out, resumable).
+int eval_command(const EvalArgs& args);
 /// record --out FILE.bag [--frames N | --duration-s S]: the source's frames, unfiltered, to a bag.
 int record_command(const CommandArgs& args);
 /// publish: the configured source as realsense-ros topics over Cyclone DDS (publish.*).

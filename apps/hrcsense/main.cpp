@@ -64,6 +64,19 @@ int main(int argc, char** argv) {
   CLI::App* bench = app.add_subcommand("bench", "time the processing path on pre-rendered frames");
   add_common_flags(*bench, args);
 
+  hrcsense::app::EvalArgs eval_args;
+  CLI::App* eval = app.add_subcommand("eval", "the thesis's measures over sweeps, scenes and seeds (docs/EVALUATION.md)");
+  eval->add_option("--config", eval_args.config_path, "the scene's configuration file when no --scene is given");
+  eval->add_option("--set", eval_args.sets, "override a key in every row, KEY=VALUE (repeatable)")->allow_extra_args(false);
+  eval->add_option("--sweep", eval_args.sweeps, "KEY=V1,V2,... or KEY=A:B[:STEP]; several span a grid (repeatable)")
+      ->allow_extra_args(false);
+  eval->add_option("--scene", eval_args.scenes, "a scene's configuration file (repeatable)")->allow_extra_args(false);
+  eval->add_option("--seeds", eval_args.seeds, "run each row with source.seed 1..N, 1 to 1000")->check(CLI::Range(1, 1000));
+  eval->add_option("--frames", eval_args.frames, "source frames per row, 1 to 10^10 (default: the source's length)")
+      ->check(CLI::Range(int64_t{1}, kMaxFrames));
+  eval->add_option("--jobs", eval_args.jobs, "rows at once, 1 to 64 (rates then say parallel)")->check(CLI::Range(1, 64));
+  eval->add_option("--out", eval_args.out, "folder for results.csv")->required();
+
   CLI::App* verify_filters =
       app.add_subcommand("verify-filters", "compare hrcsense's depth filters with RealSense SDK goldens");
   verify_filters->add_option("cases", args.input, "cases.json of an SDK golden set")->required();
@@ -72,9 +85,9 @@ int main(int argc, char** argv) {
   // CLI11 would only say "a subcommand is required" for a misspelt one; name it instead.
   const std::string first = argc > 1 ? argv[1] : "";
   if (!first.empty() && first[0] != '-' && first != "run" && first != "record" && first != "publish" && first != "info" &&
-      first != "devices" && first != "bench" && first != "verify-filters") {
+      first != "devices" && first != "bench" && first != "verify-filters" && first != "eval") {
     return hrcsense::app::report_error(std::string("unknown command '") + argv[1] +
-                                           "'; expected run, record, publish, info, devices, bench or verify-filters",
+                                           "'; expected run, record, publish, info, devices, bench, eval or verify-filters",
                                        hrcsense::app::kExitUsage);
   }
   try {
@@ -91,6 +104,7 @@ int main(int argc, char** argv) {
     if (info->parsed()) return hrcsense::app::info_command(args);
     if (devices->parsed()) return hrcsense::app::devices_command();
     if (verify_filters->parsed()) return hrcsense::app::verify_filters_command(args);
+    if (eval->parsed()) return hrcsense::app::eval_command(eval_args);
     return hrcsense::app::bench_command(args);
   } catch (const std::exception& e) {
     return hrcsense::app::report_error(e);

@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — one evaluation run (eval_run.hpp).
+#include "common/eval_run.hpp"
+
+#include "common/assembly.hpp"
+#include "hrcsense/pipeline.hpp"
+#include "hrcsense/sink.hpp"
+
+namespace hrcsense::app {
+namespace {
+
+std::array<double, 3> point_of(const Eigen::Vector3f& p) { return {p.x(), p.y(), p.z()}; }
+
+// Keeps what the metrics read of every processed frame after learning.
+class SampleSink : public Sink {
+ public:
+  SampleSink(EvalRun& run, std::atomic<int64_t>* frames_done) : run_(run), frames_done_(frames_done) {}
+  void header(const RunHeader&) override {}
+  void frame(const FrameResult& result) override {
+    if (!result.source_frame) return;  // a watchdog's or the final stop
+    ++run_.source_frames;
+    if (frames_done_ != nullptr) ++*frames_done_;
+    if (!result.valid) return;  // learning the background, or a frame the pipeline refused
+    eval::EvalSample s;
+    s.measured = result.contact.valid;
+    if (s.measured) {
+      s.closest_base = point_of(result.contact.closest_base);
+      s.distance_m = result.contact.distance_m;
+    }
+    s.has_truth = result.truth.has_value() && result.truth->valid;
+    if (s.has_truth) {
+      s.truth_closest_base = point_of(result.truth->closest_base);
+      s.truth_distance_m = result.truth->distance_m;
+    }
+    s.distance_uncertainty_m = result.distance_uncertainty_m;
+    s.protective_distance_m = result.verdict.protective_distance_m;
+    s.latency_us = result.latency_us;
+    run_.samples.push_back(s);
+  }
+  void summary(const RunSummary& summary) override { run_.error = summary.error; }
+
+ private:
+  EvalRun& run_;
+  std::atomic<int64_t>* frames_done_;
+};
+
+}  // namespace
+
+EvalRun run_eval(const Config& config, int64_t max_frames, std::atomic<int64_t>* frames_done) {
+  EvalRun run;
+  std::unique_ptr<Source> source = make_source(config);
+  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config, *source);
+  Pipeline pipeline(config.pipeline);
+  const SourceInfo info = source->info();
+  if (info.frame_count > 0) run.samples.reserve(static_cast<size_t>(info.frame_count));
+  SampleSink sink(run, frames_done);
+  RunOptions options;
+  options.max_frames = max_frames;
+  options.camera_latency_s = config.robot_state.camera_latency_s;
+  run_pipeline(*source, *robot_states, pipeline, sink, options, make_run_header(config, info));
+  return run;
+}
+
+}  // namespace hrcsense::app
