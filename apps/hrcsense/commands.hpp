@@ -34,11 +34,16 @@ struct EvalArgs {
   int64_t frames = -1;              ///< --frames N per row; -1: the source's length
   int jobs = 1;                     ///< --jobs N rows at once
   std::string out;                  ///< --out DIR
+  std::string study;                ///< --study NAME: a ready-made study (docs/EVALUATION.md)
+  std::string config_dir = "config";  ///< --config-dir DIR: where a study finds its scenes
+  std::string report;               ///< --report FILE: the thesis study's report also here
 };
 
 int run_command(const CommandArgs& args);
 /// eval: the thesis's measures over a sweep (results.csv in --out, resumable).
 int eval_command(const EvalArgs& args);
+/// eval --study NAME: table-4.1 … table-4.4, moving-cell, or thesis (all, with the report).
+int eval_study_command(const EvalArgs& args);
 /// record --out FILE.bag [--frames N | --duration-s S]: the source's frames, unfiltered, to a bag.
 int record_command(const CommandArgs& args);
 /// publish: the configured source as realsense-ros topics over Cyclone DDS (publish.*).

@@ -75,7 +75,11 @@ int main(int argc, char** argv) {
   eval->add_option("--frames", eval_args.frames, "source frames per row, 1 to 10^10 (default: the source's length)")
       ->check(CLI::Range(int64_t{1}, kMaxFrames));
   eval->add_option("--jobs", eval_args.jobs, "rows at once, 1 to 64 (rates then say parallel)")->check(CLI::Range(1, 64));
-  eval->add_option("--out", eval_args.out, "folder for results.csv")->required();
+  eval->add_option("--out", eval_args.out, "folder for results.csv, results.md and the figures")->required();
+  eval->add_option("--study", eval_args.study,
+                   "a ready-made study: table-4.1, table-4.2, table-4.3, table-4.4, moving-cell or thesis (all)");
+  eval->add_option("--config-dir", eval_args.config_dir, "where a study finds its scenes (default: config)");
+  eval->add_option("--report", eval_args.report, "with --study thesis: write the report here too (its figures beside it)");
 
   CLI::App* verify_filters =
       app.add_subcommand("verify-filters", "compare hrcsense's depth filters with RealSense SDK goldens");

@@ -4,7 +4,7 @@
 // nearest-point query from the robot point. The copy into PCL's cloud type is left out of the
 // timing (users of PCL would already hold one), which favours PCL.
 
-#include "person_cloud.hpp"
+#include "hrcsense/person_cloud.hpp"
 
 #include <benchmark/benchmark.h>
 #include <pcl/kdtree/kdtree_flann.h>
@@ -35,7 +35,7 @@ pcl::PointCloud<pcl::PointXYZ>::Ptr to_pcl(const PointCloud& cloud) {
 }
 
 pcl::PointXYZ robot_query() {
-  const Capsule c = robot_point().capsules[0];
+  const Capsule c = person_cloud_robot_point().capsules[0];
   return {c.a.x(), c.a.y(), c.a.z()};
 }
 

@@ -3,7 +3,7 @@
 // cloud of N points; Peer/nanoflann/point/N: nanoflann used directly; and the build and query
 // halves of the trees, for the crossover against brute force (docs/PROXIMITY.md).
 
-#include "person_cloud.hpp"
+#include "hrcsense/person_cloud.hpp"
 
 #include "../../src/proximity/brute.hpp"
 #include "../../src/proximity/kdtree.hpp"
@@ -24,7 +24,9 @@ std::string size_name(size_t n) {
   return n >= 1000000 ? std::to_string(n / 1000000) + "M" : n >= 1000 ? std::to_string(n / 1000) + "k" : std::to_string(n);
 }
 
-RobotModel robot_named(const std::string& robot) { return robot == "point" ? robot_point() : robot_arm8(); }
+RobotModel robot_named(const std::string& robot) {
+  return robot == "point" ? person_cloud_robot_point() : person_cloud_robot_arm8();
+}
 
 void BM_Search(benchmark::State& state, ProximityBackend backend, ProximityParams params, std::string robot_name,
                size_t n) {
@@ -53,7 +55,7 @@ struct Adaptor {
 
 void BM_PeerNanoflann(benchmark::State& state, size_t n) {
   const PointCloud cloud = person_cloud(n);
-  const Capsule robot = robot_point().capsules[0];
+  const Capsule robot = person_cloud_robot_point().capsules[0];
   const float query[3] = {robot.a.x(), robot.a.y(), robot.a.z()};
   Adaptor adaptor{&cloud};
   using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Adaptor>, Adaptor, 3, uint32_t>;

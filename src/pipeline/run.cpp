@@ -342,8 +342,10 @@ FrameResult output_loop(Sink& sink, const Source& source, const RunClock& clock,
       std::snprintf(reason, sizeof reason, "%sno frame for %.3f s (%s)",
                     silence == ReasonCode::camera_disconnected ? "camera disconnected: " : "",
                     ns_to_seconds(clock.now_ns() - last_arrival_ns), watchdog_limit.rule);
-      write_stop(sink, watchdog, last, silence, reason);
+      // Raised before the stop is written: a frame that anyone saw arrive after the stop
+      // (the sink, a controller) is processed with the flag already set, so it holds the stop.
       watchdog_stopped = true;
+      write_stop(sink, watchdog, last, silence, reason);
       waiting_since_ns = clock.now_ns();
     }
   } catch (const std::exception& e) {

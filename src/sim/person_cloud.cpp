@@ -1,14 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
-// The person-shaped benchmark cloud and the robots beside it.
+// hrcsense — the synthetic person-shaped cloud and the robots beside it (person_cloud.hpp).
 
-#include "person_cloud.hpp"
+#include "hrcsense/person_cloud.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
 
-namespace hrcsense::bench {
+namespace hrcsense {
 namespace {
 
 struct Part {
@@ -63,13 +63,13 @@ PointCloud person_cloud(size_t n) {
   return cloud;
 }
 
-RobotModel robot_point() {
+RobotModel person_cloud_robot_point() {
   RobotModel robot;
   robot.capsules.push_back({{-0.3F, 0.3F, 1.6F}, {-0.3F, 0.3F, 1.6F}, 0.0F, 0});
   return robot;
 }
 
-RobotModel robot_arm8() {
+RobotModel person_cloud_robot_arm8() {
   // A chain from a base on the floor left of the person up and toward them.
   const Eigen::Vector3f joints[] = {{-1.0F, 1.0F, 1.5F},  {-1.0F, 0.9F, 1.5F},  {-1.0F, 0.8F, 1.5F},
                                     {-0.9F, 0.4F, 1.55F}, {-0.85F, 0.0F, 1.6F}, {-0.7F, -0.1F, 1.6F},
@@ -80,4 +80,4 @@ RobotModel robot_arm8() {
   return robot;
 }
 
-}  // namespace hrcsense::bench
+}  // namespace hrcsense

@@ -1,0 +1,328 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense CLI — the sweep runner (eval_runner.hpp): rows on --jobs threads, one complete CSV
+// line per finished row, the deterministic columns independent of the thread count and the
+// rate column saying whether it was measured alone (`serial`).
+#include "eval_runner.hpp"
+
+#include "common/eval_run.hpp"
+#include "hrcsense/config.hpp"
+#include "hrcsense/eval_metrics.hpp"
+
+#include <unistd.h>
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+namespace hrcsense::app {
+namespace {
+
+using eval::EvalSample;
+
+// One row to run: a sweep point on one scene with one seed (0: the scene's own seed).
+struct Row {
+  int64_t index = 0;
+  const eval::SweepPoint* point = nullptr;
+  std::string scene;
+  int64_t seed = 0;
+  std::vector<std::string> key_fields() const {
+    return {std::to_string(index), eval::settings_text(*point), scene, seed > 0 ? std::to_string(seed) : "config"};
+  }
+};
+
+constexpr size_t kKeyColumns = 4;
+const char* const kColumns[] = {"row",
+                                "settings",
+                                "scene",
+                                "seed",
+                                "frames",
+                                "truth_frames",
+                                "measured_frames",
+                                "misrecognised_1m",
+                                "misrecognised_1m_per_thesis_minute",
+                                "misrecognised_0.1m",
+                                "misrecognised_0.1m_per_1000",
+                                "mse_run_m2",
+                                "mse_thesis_m2",
+                                "distance_error_mean_m",
+                                "distance_error_median_m",
+                                "distance_error_p95_m",
+                                "distance_error_max_m",
+                                "unsafe_share",
+                                "z_d_coverage",
+                                "latency_p50_us",
+                                "latency_p99_us",
+                                "processing_fps",
+                                "timing"};
+
+std::string header_line() {
+  std::string line;
+  for (const char* column : kColumns) line += (line.empty() ? "" : ",") + std::string(column);
+  return line;
+}
+
+// A number as the table writes it: enough digits to compare runs exactly; empty for NaN.
+std::string number(double value) {
+  if (!std::isfinite(value)) return "";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", value);
+  return text;
+}
+
+// The processing path's rate: frames per second of processing time (latency_us summed), the
+// median over five equal blocks of the run's frames, so that one slow stretch does not decide.
+double processing_fps(const std::vector<EvalSample>& samples) {
+  constexpr size_t kBlocks = 5;
+  if (samples.size() < kBlocks) return std::nan("");
+  std::vector<double> rates;
+  const size_t per_block = samples.size() / kBlocks;
+  for (size_t b = 0; b < kBlocks; ++b) {
+    double total_us = 0.0;
+    for (size_t i = b * per_block; i < (b + 1) * per_block; ++i) total_us += samples[i].latency_us;
+    rates.push_back(static_cast<double>(per_block) / (total_us * 1e-6));
+  }
+  std::sort(rates.begin(), rates.end());
+  return rates[kBlocks / 2];
+}
+
+// The CSV line of a finished row. Ground-truth measures when the run has truth, else the
+// stability measures against the run's median point (recordings).
+std::string row_line(const Row& row, const EvalRun& run, bool serial) {
+  const std::vector<EvalSample>& s = run.samples;
+  const bool truth = std::any_of(s.begin(), s.end(), [](const EvalSample& e) { return e.has_truth; });
+  const eval::InstabilityCount thesis = truth ? eval::instability_vs_truth(s, eval::kThesisMisrecognitionM)
+                                              : eval::instability_vs_median(s, eval::kThesisMisrecognitionM);
+  const eval::InstabilityCount strict = truth ? eval::instability_vs_truth(s, eval::kStrictMisrecognitionM)
+                                              : eval::instability_vs_median(s, eval::kStrictMisrecognitionM);
+  const std::vector<std::array<double, 3>> stable =
+      truth ? eval::stable_points_vs_truth(s, eval::kThesisMisrecognitionM)
+            : eval::stable_points_vs_median(s, eval::kThesisMisrecognitionM);
+  const eval::DistanceError error = eval::distance_error(s);
+  const eval::Percentiles latency = eval::latency_percentiles(s);
+  const int64_t truth_frames = std::count_if(s.begin(), s.end(), [](const EvalSample& e) { return e.has_truth; });
+  const int64_t measured = std::count_if(s.begin(), s.end(), [](const EvalSample& e) { return e.measured; });
+  std::vector<std::string> fields = row.key_fields();
+  for (std::string& field : fields) field = eval::csv_field(field);
+  const std::vector<std::string> values = {std::to_string(s.size()),
+                                           std::to_string(truth_frames),
+                                           std::to_string(measured),
+                                           std::to_string(thesis.mis_recognised),
+                                           number(thesis.per_thesis_minute()),
+                                           std::to_string(strict.mis_recognised),
+                                           number(strict.per_1000_frames()),
+                                           number(eval::mse_whole_run(stable)),
+                                           number(eval::mse_thesis_windows(stable)),
+                                           number(error.mean_abs_m),
+                                           number(error.median_abs_m),
+                                           number(error.p95_abs_m),
+                                           number(error.max_abs_m),
+                                           number(error.unsafe_share),
+                                           number(eval::uncertainty_coverage(s).share()),
+                                           number(latency.p50),
+                                           number(latency.p99),
+                                           number(processing_fps(s)),
+                                           serial ? "serial" : "parallel"};
+  fields.insert(fields.end(), values.begin(), values.end());
+  std::string line;
+  for (const std::string& field : fields) line += (line.empty() ? "" : ",") + field;
+  return line;
+}
+
+// What the progress bar shows, updated by the workers.
+struct Progress {
+  std::atomic<int64_t> frames{0};
+  std::atomic<int64_t> rows_done{0};
+  int64_t rows_total = 0;
+  int64_t frames_per_row = 0;  ///< for the estimate; 0: unknown
+};
+
+void draw(const Progress& p, double elapsed_s, const std::string& current) {
+  const int64_t done = p.rows_done.load();
+  const double fps = elapsed_s > 0.0 ? static_cast<double>(p.frames.load()) / elapsed_s : 0.0;
+  const double left_frames =
+      static_cast<double>(p.rows_total * p.frames_per_row) - static_cast<double>(p.frames.load());
+  constexpr int kWidth = 24;
+  const int filled = p.rows_total > 0 ? static_cast<int>(kWidth * done / p.rows_total) : kWidth;
+  std::string bar(static_cast<size_t>(filled), '#');
+  bar.resize(kWidth, '.');
+  std::fprintf(stderr, "\r[%s] %lld/%lld rows  %s  %.0f frames/s  %s left   ", bar.c_str(),
+               static_cast<long long>(done), static_cast<long long>(p.rows_total), current.c_str(), fps,
+               fps > 0.0 && p.frames_per_row > 0
+                   ? (std::to_string(static_cast<int64_t>(left_frames / fps)) + " s").c_str()
+                   : "?");
+  std::fflush(stderr);
+}
+
+// DIR/results.md: every row of results.csv in row order, with the columns a reader compares
+// (the rest are in the CSV).
+void write_results_md(const std::string& csv, const std::string& md) {
+  std::ifstream in(csv, std::ios::binary);
+  std::string line;
+  std::getline(in, line);
+  const std::vector<std::string> header = eval::split_csv_line(line);
+  std::vector<std::vector<std::string>> rows;
+  while (std::getline(in, line)) rows.push_back(eval::split_csv_line(line));
+  std::sort(rows.begin(), rows.end(),
+            [](const auto& a, const auto& b) { return std::stoll(a.at(0)) < std::stoll(b.at(0)); });
+  const std::vector<std::string> shown = {
+      "row", "settings", "scene", "seed", "frames", "misrecognised_1m_per_thesis_minute",
+      "misrecognised_0.1m_per_1000", "mse_thesis_m2", "mse_run_m2", "distance_error_mean_m", "distance_error_p95_m",
+      "unsafe_share", "z_d_coverage", "processing_fps", "timing"};
+  std::vector<size_t> columns;
+  for (const std::string& name : shown) {
+    columns.push_back(static_cast<size_t>(std::find(header.begin(), header.end(), name) - header.begin()));
+  }
+  std::ofstream out(md, std::ios::binary);
+  out << "# hrcsense eval\n\nThe measures are defined in docs/EVALUATION.md: misrecognised frames per thesis minute "
+         "(1 m rule) and per 1000 frames (0.1 m rule); MSE the thesis's way (5 windows of 10 results) and over the "
+         "whole run, m²; the mean and p95 distance error, m; the share measured farther than true; the share where "
+         "Z_d covers the truth; the processing rate, frames/s (`serial`: measured alone).\n\n";
+  for (const std::string& name : shown) out << "| " << name << " ";
+  out << "|\n";
+  for (size_t i = 0; i < shown.size(); ++i) out << "| --- ";
+  out << "|\n";
+  for (const std::vector<std::string>& row : rows) {
+    for (size_t c = 0; c < columns.size(); ++c) {
+      std::string cell = columns[c] < row.size() ? row[columns[c]] : "";
+      if (shown[c] == "scene") cell = std::filesystem::path(cell).filename().string();
+      for (size_t k = cell.find('|'); k != std::string::npos; k = cell.find('|', k + 2)) cell.replace(k, 1, "\\|");
+      out << "| " << cell << " ";
+    }
+    out << "|\n";
+  }
+  if (!out.flush()) throw std::runtime_error(md + ": cannot write");
+}
+
+}  // namespace
+
+size_t ResultTable::column(const std::string& name) const {
+  const auto it = std::find(header.begin(), header.end(), name);
+  if (it == header.end()) throw std::out_of_range("results.csv has no column '" + name + "'");
+  return static_cast<size_t>(it - header.begin());
+}
+
+const std::string& ResultTable::text(size_t row, const std::string& name) const {
+  return rows.at(row).at(column(name));
+}
+
+double ResultTable::number(size_t row, const std::string& name) const {
+  const std::string& cell = text(row, name);
+  return cell.empty() ? std::nan("") : std::stod(cell);
+}
+
+ResultTable read_results(const std::string& csv_path) {
+  std::ifstream in(csv_path, std::ios::binary);
+  if (!in) throw std::runtime_error(csv_path + ": cannot read");
+  ResultTable table;
+  std::string line;
+  std::getline(in, line);
+  table.header = eval::split_csv_line(line);
+  while (std::getline(in, line)) {
+    table.rows.push_back(eval::split_csv_line(line));
+    if (table.rows.back().size() != table.header.size()) {
+      throw std::runtime_error(csv_path + ": line " + std::to_string(table.rows.size() + 1) + " has " +
+                               std::to_string(table.rows.back().size()) + " fields, the header " +
+                               std::to_string(table.header.size()));
+    }
+  }
+  std::sort(table.rows.begin(), table.rows.end(),
+            [](const auto& a, const auto& b) { return std::stoll(a.at(0)) < std::stoll(b.at(0)); });
+  return table;
+}
+
+ResultTable run_sweep(const SweepRequest& request) {
+  if (request.points.empty() || request.scenes.empty()) {
+    throw std::invalid_argument("eval: a sweep needs at least one point and one scene");
+  }
+  std::vector<Row> rows;
+  for (const eval::SweepPoint& point : request.points) {
+    for (const std::string& scene : request.scenes) {
+      for (int64_t seed = request.seeds > 0 ? 1 : 0; seed <= std::max<int64_t>(0, request.seeds); ++seed) {
+        rows.push_back({static_cast<int64_t>(rows.size()), &point, scene, seed});
+      }
+    }
+  }
+  // Every row's configuration is loaded before any runs: a bad key fails now, naming it.
+  std::vector<Config> configs;
+  for (const Row& row : rows) {
+    std::vector<std::string> sets = request.sets;
+    sets.insert(sets.end(), row.point->settings.begin(), row.point->settings.end());
+    if (row.seed > 0) sets.push_back("source.seed=" + std::to_string(row.seed));
+    configs.push_back(load_config(row.scene, sets));
+  }
+
+  std::filesystem::create_directories(request.out_dir);
+  const std::string csv = (std::filesystem::path(request.out_dir) / "results.csv").string();
+  const eval::ResumeState resumed = eval::resume_results(csv, header_line(), kKeyColumns);
+  std::vector<size_t> pending;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (resumed.done.count(eval::row_key(rows[i].key_fields())) == 0) pending.push_back(i);
+  }
+  if (resumed.existed) {
+    spdlog::info("eval: resuming {}: {} of {} rows already there{}", csv, rows.size() - pending.size(), rows.size(),
+                 resumed.dropped_partial ? " (a row cut off by the interruption was removed)" : "");
+  }
+
+  const int jobs = std::max(1, std::min<int>(request.jobs, static_cast<int>(pending.size())));
+  Progress progress;
+  progress.rows_total = static_cast<int64_t>(pending.size());
+  progress.frames_per_row = request.frames > 0 ? request.frames : (configs.empty() ? 0 : configs[0].sim.frames);
+  std::ofstream out(csv, std::ios::app | std::ios::binary);
+  std::mutex mutex;  // the table, the error, the next row
+  size_t next = 0;
+  std::string first_error;
+  std::string current;
+  const auto start = std::chrono::steady_clock::now();
+  const auto worker = [&] {
+    for (;;) {
+      size_t i = 0;
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (next >= pending.size() || !first_error.empty()) return;
+        i = pending[next++];
+        current = request.label + (request.label.empty() ? "" : ": ") + rows[i].key_fields()[1] + " " +
+                  std::filesystem::path(rows[i].scene).filename().string();
+      }
+      const EvalRun run = run_eval(configs[i], request.frames, &progress.frames);
+      std::lock_guard<std::mutex> lock(mutex);
+      if (!run.error.empty()) {
+        first_error = rows[i].scene + " (" + rows[i].key_fields()[1] + "): " + run.error;
+        return;
+      }
+      out << row_line(rows[i], run, jobs == 1) << '\n';
+      out.flush();
+      ++progress.rows_done;
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int j = 0; j < jobs; ++j) threads.emplace_back(worker);
+  const bool tty = ::isatty(STDERR_FILENO) != 0;
+  while (progress.rows_done.load() < progress.rows_total) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (!first_error.empty()) break;
+      if (tty) draw(progress, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), current);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  for (std::thread& t : threads) t.join();
+  if (tty) std::fprintf(stderr, "\n");
+  if (!first_error.empty()) throw std::runtime_error("eval: " + first_error);
+  if (!out) throw std::runtime_error("eval: cannot write " + csv);
+  out.close();
+  const std::string md = (std::filesystem::path(request.out_dir) / "results.md").string();
+  write_results_md(csv, md);
+  spdlog::info("eval: {} rows in {} and {} ({} run now)", rows.size(), csv, md, pending.size());
+  return read_results(csv);
+}
+
+}  // namespace hrcsense::app
