@@ -37,7 +37,11 @@ class SampleSink : public Sink {
     s.latency_us = result.latency_us;
     run_.samples.push_back(s);
   }
-  void summary(const RunSummary& summary) override { run_.error = summary.error; }
+  void summary(const RunSummary& summary) override {
+    run_.error = summary.error;
+    run_.wall_s = summary.wall_s;
+    run_.frames_dropped = summary.frames_dropped;
+  }
 
  private:
   EvalRun& run_;
@@ -56,6 +60,7 @@ EvalRun run_eval(const Config& config, int64_t max_frames, std::atomic<int64_t>*
   SampleSink sink(run, frames_done);
   RunOptions options;
   options.max_frames = max_frames;
+  options.pace = config.source.pace;
   options.camera_latency_s = config.robot_state.camera_latency_s;
   run_pipeline(*source, *robot_states, pipeline, sink, options, make_run_header(config, info));
   return run;

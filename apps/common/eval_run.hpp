@@ -20,9 +20,12 @@ struct EvalRun {
   std::vector<eval::EvalSample> samples;
   int64_t source_frames = 0;  ///< source frames processed, learning included
   std::string error;          ///< the run's error (a source that failed), empty when none
+  double wall_s = 0.0;        ///< the run's wall time (RunSummary::wall_s)
+  int64_t frames_dropped = 0; ///< frames a paced run dropped (RunSummary::frames_dropped)
 };
 
-/// Runs `config`'s source for at most `max_frames` frames (-1: to its end), unpaced, learning
+/// Runs `config`'s source for at most `max_frames` frames (-1: to its end), unpaced unless
+/// `source.pace` is set (then at the source's own rate, for an end-to-end rate), learning
 /// the background in the run (background.path is neither read nor written). `frames_done`,
 /// when given, counts processed frames as they come (for a progress bar on another thread).
 EvalRun run_eval(const Config& config, int64_t max_frames, std::atomic<int64_t>* frames_done = nullptr);

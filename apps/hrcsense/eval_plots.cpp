@@ -92,7 +92,7 @@ void draw_plot(const Plot& plot) {
      << "set title " << quoted(plot.title) << "\n"
      << "set xlabel " << quoted(plot.x_label) << "\n"
      << "set ylabel " << quoted(plot.y_label) << "\n"
-     << "set grid\nset key outside right top\nset datafile missing 'NaN'\n";
+     << "set grid\nset key below\nset datafile missing 'NaN'\n";
   if (plot.log_x) gp << "set logscale x\n";
   if (plot.log_y) gp << "set logscale y\n";
   const bool categories = !plot.series.empty() && !plot.series.front().x_labels.empty();

@@ -24,7 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Why our numbers differ from the thesis's, and what we recommend, per section.
+// Why our numbers differ from the thesis's, per section (what we recommend comes with each study).
 const std::map<std::string, std::string> kNotes = {
     {"Table 4.1",
      "**Why the numbers differ.** The thesis timed its whole system (capture, filters, search, its OpenGL view and "
@@ -33,33 +33,22 @@ const std::map<std::string, std::string> kNotes = {
      "measured the box's true corner by hand; ours is the simulator's exact closest point, so the distance error "
      "and the 0.1 m rule see errors that a 1 m rule never counts. Our holes come from the simulated dropouts "
      "(the shiny table top) and disparity noise, not from the thesis's room, so the instability counts are "
-     "smaller than the thesis's and compare only in their trend.\n\n"
-     "**What we recommend.** For a still object, persistence changes little once the box is learnt. For people "
-     "who move, persistence 0: filling a hole from history puts a walking person's old depth into the stereo "
-     "shadow they leave (docs/ACCURACY.md, the moving UR5 cell), which is why `config/cell-ur5-moving.yaml` uses "
-     "0. The `thesis` preset keeps the thesis's 3 and `sdk` the SDK's default 3."},
+     "smaller than the thesis's and compare only in their trend."},
     {"Table 4.2",
      "**Why the numbers differ.** As for Table 4.1; in addition the SDK, and hrcsense's filters which match it bit "
      "for bit, accept α only in 0.25–1 and δ only in 1–50, so the thesis's other values cannot be set on a "
      "RealSense camera today and are listed as refused. Our runs use the disparity domain for the spatial filter "
-     "(docs/FILTERS.md; the thesis does not say which it used).\n\n"
-     "**What we recommend.** The SDK's defaults (α 0.5, δ 20, two passes) or the thesis's α 0.4, δ 20: within "
-     "the accepted range the error changes by millimetres on a still box. On a moving person one pass "
-     "(`filters.spatial.magnitude: 1`) avoids smoothing a hand towards the arm (docs/ACCURACY.md)."},
+     "(docs/FILTERS.md; the thesis does not say which it used)."},
     {"Table 4.3",
      "**Why the numbers differ.** Every hrcsense backend is exact (docs/PROXIMITY.md), so each finds the same "
      "closest point as brute force and the same distance error, where the thesis's octree lost up to 0.43 m at "
      "small heights (0.54 m against brute force's 0.11 m) and its kd-tree could not keep up (0.08 Hz). The "
      "octree's height now only changes its speed. Our distance error is the measurement's own (filters, noise, "
-     "the pixel grid), the same for every backend.\n\n"
-     "**What we recommend.** `proximity.backend: brute` (or `auto`, which picks it): one query per frame never "
-     "repays building a tree, at any cloud size the camera can give (Table 4.4)."},
+     "the pixel grid), the same for every backend."},
     {"Table 4.4",
      "**Why the numbers differ.** The thesis's rates are of its whole system; ours of the search stage alone, so "
      "they are hundreds to thousands of times higher at every size. The kd-tree is rebuilt for every frame in "
-     "both, and its build dominates at 10⁶ points; the octree's build likewise.\n\n"
-     "**What we recommend.** Brute force at every size (the vectorised scan prunes whole blocks by their boxes); "
-     "`proximity.threads: 2` halves it for clouds of 10⁵ points and more (docs/PROXIMITY.md)."},
+     "both, and its build dominates at 10⁶ points; the octree's build likewise."},
     {"The moving cell and SSM",
      "The thesis had a fixed robot point and no speed and separation monitoring. Here the arm moves and is "
      "removed from its own image by the self-filter, and every frame's closest distance carries its measurement "
@@ -110,9 +99,10 @@ void write_report(const std::string& path, const EvalArgs& args, const std::vect
       << "hrcsense is not a safety-rated device (docs/SAFETY.md).\n";
   for (const StudySection& section : sections) {
     out << "\n## " << section.title << "\n\n" << section.markdown << "\n";
-    for (const std::string& figure : section.figures) out << "![" << figure << "](" << figure_link(figure) << ")\n\n";
     const auto note = kNotes.find(section.title);
-    if (note != kNotes.end()) out << note->second << "\n";
+    if (note != kNotes.end()) out << note->second << "\n\n";
+    if (!section.recommendation.empty()) out << "**What we recommend.** " << section.recommendation << "\n\n";
+    for (const std::string& figure : section.figures) out << "![" << figure << "](" << figure_link(figure) << ")\n\n";
   }
   if (!out.flush()) throw std::runtime_error(path + ": cannot write");
 }

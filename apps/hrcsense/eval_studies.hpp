@@ -18,6 +18,7 @@ struct StudySection {
   std::string title;                 ///< "Table 4.1", …
   std::string markdown;              ///< the table and its notes
   std::vector<std::string> figures;  ///< PNGs, relative to the study folder's parent (DIR)
+  std::string recommendation;        ///< what we recommend, from this run's numbers
 };
 
 /// What the studies share: where they write and how long they run.

@@ -3,19 +3,26 @@
 // draws its three figures (valid PNGs with lines on them, their data equal to results.csv), the
 // search-backend study (Table 4.3) finds every backend's error equal to brute force's through
 // the whole pipeline, and the smoothing study (Table 4.2) lists the thesis's values that the
-// SDK's ranges refuse, as the configuration refuses them.
+// SDK's ranges refuse, as the configuration refuses them; a sweep killed mid-way and started
+// again ends with the same deterministic columns as one never interrupted. Release builds only,
+// under the ctest label `long` (the CI's short sweep; not under the sanitizers).
 
 #include "../support/run_cli.hpp"
 
 #include <gtest/gtest.h>
 #include <png.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace hrcsense {
@@ -146,6 +153,60 @@ TEST(EvalFigures, TheSmoothingStudyListsTheValuesTheSdkRefuses) {
   size_t rows = 0;
   while (std::getline(csv, line)) ++rows;
   EXPECT_EQ(rows, 1U + 8U + 6U + 1U);
+}
+
+// The lines of a results.csv, the timing columns (latency, rate, `timing`) cut off.
+std::vector<std::string> deterministic_lines(const std::string& csv_path) {
+  std::istringstream in(read(csv_path));
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) {
+    size_t cut = line.size();
+    for (int k = 0; k < 4; ++k) cut = line.rfind(',', cut - 1);
+    lines.push_back(line.substr(0, cut));
+  }
+  std::sort(lines.begin() + 1, lines.end());  // rows in row order (their first field)
+  return lines;
+}
+
+size_t line_count(const std::string& path) {
+  const std::string text = read(path);
+  return static_cast<size_t>(std::count(text.begin(), text.end(), '\n'));
+}
+
+// A real interruption: the sweep is killed (SIGKILL, no chance to tidy up) once its first row
+// is written, then the same command runs again and finishes the rest.
+TEST(EvalFigures, AKilledSweepResumedEqualsAnUninterruptedOne) {
+  const std::string arguments = "eval --config " + scene("thesis-box.yaml") +
+                                " --set filters.preset=thesis --set sim.width=424 --set sim.height=240"
+                                " --sweep filters.temporal.persistence=0:3"
+                                " --frames 160 --out ";
+  const std::string whole = fresh_dir("whole");
+  ASSERT_EQ(test::cli(arguments + whole).exit_code, 0);
+
+  const std::string killed = fresh_dir("killed");
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ::execl("/bin/sh", "sh", "-c", (std::string("exec ") + HRCSENSE_CLI + " " + arguments + killed + " 2>/dev/null").c_str(),
+            static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // Bounded: at most 60 s for the first row to appear.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (line_count(killed + "/results.csv") < 2 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  const size_t rows_before = line_count(killed + "/results.csv") - 1;
+  ASSERT_GE(rows_before, 1U);
+  ASSERT_LT(rows_before, 4U) << "the sweep finished before it was killed";
+
+  const test::CliResult resumed = test::cli(arguments + killed);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.out;
+  EXPECT_NE(resumed.out.find("resuming"), std::string::npos) << resumed.out;
+  EXPECT_EQ(deterministic_lines(killed + "/results.csv"), deterministic_lines(whole + "/results.csv"));
 }
 
 TEST(EvalFigures, AnUnknownStudyIsNamed) {
