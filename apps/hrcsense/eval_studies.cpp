@@ -168,14 +168,24 @@ StudySection study_table_41(const StudyContext& ctx) {
                                         {thesis_mse, ours_mse}}));
   const ErrorSpread spread = error_spread(table);
   section.markdown += "\n" + rate_note(table) + "\n";
-  section.recommendation = "On the still box the persistence hardly moves the "
-                      "closest point: the mean distance error spans " + mm(spread.low_m) + " to " + mm(spread.high_m) +
-                      " over persistence 0–8, and no frame is mis-recognised by either rule, because the box's corner "
-                      "nearest the robot point has no holes for the filter to fill (the thesis's counts came from holes "
-                      "and noise at its closest point in a real room). For people who move, persistence 0: filling a "
-                      "hole from history puts a walking person's old depth into the stereo shadow they leave, which the "
-                      "moving cell below measures (persistence 0 against 3) and why `config/cell-ur5-moving.yaml` uses "
-                      "0. The `thesis` preset keeps the thesis's 3 and `sdk` the SDK's default 3.";
+  const std::string spread_text =
+      spread.high_m - spread.low_m < 1e-4
+          ? "the mean distance error is " + mm(spread.low_m) + " at every persistence (the rows differ by less "
+            "than 0.1 mm)"
+          : "the mean distance error spans " + mm(spread.low_m) + " to " + mm(spread.high_m);
+  bool none_misrecognised = true;
+  for (size_t r = 0; r < table.rows.size(); ++r) {
+    none_misrecognised = none_misrecognised && table.text(r, "misrecognised_1m") == "0" &&
+                         table.text(r, "misrecognised_0.1m") == "0";
+  }
+  section.recommendation =
+      "On the still box the persistence hardly moves the closest point: " + spread_text + " over persistence 0–8" +
+      (none_misrecognised ? ", and no frame is mis-recognised by either rule" : "") +
+      ": the box's corner nearest the robot point has no holes for the filter to fill (the thesis's counts came "
+      "from holes and noise at its closest point in a real room). For people who move, persistence 0: filling a "
+      "hole from history puts a walking person's old depth into the stereo shadow they leave, which the moving cell "
+      "below measures (persistence 0 against 3) and why `config/cell-ur5-moving.yaml` uses 0. The `thesis` preset "
+      "keeps the thesis's 3 and `sdk` the SDK's default 3.";
   return section;
 }
 
@@ -255,15 +265,22 @@ StudySection study_table_42(const StudyContext& ctx) {
                  "blends box and background into points in front of the edge, the measured closest point is more "
                  "than 0.1 m from the true one in " + fixed(table.number(r, "misrecognised_0.1m_per_1000") / 10.0, 1) +
                  " % of the frames and the distance error is " + mm(table.number(r, "distance_error_mean_m")) +
-                 " (on the near, safe side: the thesis's 1 m rule does not see it).";
+                 (table.number(r, "unsafe_share") == 0.0 ? " (on the near, safe side)" : "") +
+                 (table.text(r, "misrecognised_1m") == "0" ? "; the thesis's 1 m rule does not see it." : ".");
       }
     }
   }
   const ErrorSpread spread = error_spread(table);
   md << "\n" << rate_note(table) << "\n";
   std::ostringstream recommend;
-  recommend << "The lowest mean distance error, " << mm(spread.low_m) << ", is at `" << table.text(spread.best_row, "settings") << "`: on a still box every smoothing pass rounds the "
-     << "corner nearest the robot point a little (the error grows as α falls)." << breaks
+  recommend << "The lowest mean distance error, " << mm(spread.low_m) << ", is at `"
+            << table.text(spread.best_row, "settings") << "`"
+            << (alpha_error.y.size() >= 2 && alpha_error.y.front() > alpha_error.y.back()
+                    ? ": on a still box smoothing rounds the corner nearest the robot point a little, the more the "
+                      "lower α (" + mm(alpha_error.y.front()) + " at α " + value_text(alpha_error.x.front()) + ", " +
+                          mm(alpha_error.y.back()) + " at α " + value_text(alpha_error.x.back()) + ")."
+                    : ".")
+            << breaks
      << " Keep δ at 20 or below and α at 0.4–0.5 (the thesis's 0.4 and the SDK's default 0.5) where the smoothing "
         "is wanted against noise; on a moving person one pass (`filters.spatial.magnitude: 1`) avoids smoothing a "
         "hand towards the arm (docs/ACCURACY.md).";
