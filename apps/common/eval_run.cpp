@@ -35,6 +35,7 @@ class SampleSink : public Sink {
     s.distance_uncertainty_m = result.distance_uncertainty_m;
     s.protective_distance_m = result.verdict.protective_distance_m;
     s.latency_us = result.latency_us;
+    s.foreground_points = static_cast<int64_t>(result.foreground_points);
     run_.samples.push_back(s);
   }
   void summary(const RunSummary& summary) override {

@@ -59,6 +59,7 @@ const char* const kColumns[] = {"row",
                                 "distance_error_max_m",
                                 "unsafe_share",
                                 "z_d_coverage",
+                                "foreground_points_mean",
                                 "latency_p50_us",
                                 "latency_p99_us",
                                 "processing_fps",
@@ -94,6 +95,15 @@ double processing_fps(const std::vector<EvalSample>& samples) {
   return rates[kBlocks / 2];
 }
 
+// The mean size of the foreground cloud over the run's frames (the thesis's "number of points
+// of the target object"); NaN without frames.
+double mean_foreground_points(const std::vector<EvalSample>& samples) {
+  if (samples.empty()) return std::nan("");
+  double sum = 0.0;
+  for (const EvalSample& s : samples) sum += static_cast<double>(s.foreground_points);
+  return sum / static_cast<double>(samples.size());
+}
+
 // The CSV line of a finished row. Ground-truth measures when the run has truth, else the
 // stability measures against the run's median point (recordings).
 std::string row_line(const Row& row, const EvalRun& run, bool serial) {
@@ -127,6 +137,7 @@ std::string row_line(const Row& row, const EvalRun& run, bool serial) {
                                            number(error.max_abs_m),
                                            number(error.unsafe_share),
                                            number(eval::uncertainty_coverage(s).share()),
+                                           number(mean_foreground_points(s)),
                                            number(latency.p50),
                                            number(latency.p99),
                                            number(processing_fps(s)),
@@ -176,7 +187,7 @@ void write_results_md(const std::string& csv, const std::string& md) {
   const std::vector<std::string> shown = {
       "row", "settings", "scene", "seed", "frames", "misrecognised_1m_per_thesis_minute",
       "misrecognised_0.1m_per_1000", "mse_thesis_m2", "mse_run_m2", "distance_error_mean_m", "distance_error_p95_m",
-      "unsafe_share", "z_d_coverage", "processing_fps", "timing"};
+      "unsafe_share", "z_d_coverage", "foreground_points_mean", "processing_fps", "timing"};
   std::vector<size_t> columns;
   for (const std::string& name : shown) {
     columns.push_back(static_cast<size_t>(std::find(header.begin(), header.end(), name) - header.begin()));

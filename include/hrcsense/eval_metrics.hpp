@@ -36,6 +36,7 @@ struct EvalSample {
   /// S_p of the frame, m; NaN: none. Carried for the harness's tables; no metric here reads it.
   double protective_distance_m = std::numeric_limits<double>::quiet_NaN();
   double latency_us = std::numeric_limits<double>::quiet_NaN();  ///< processing latency, µs; NaN: unknown
+  int64_t foreground_points = 0;          ///< points of the foreground cloud the search ran on
 };
 
 /// The thesis's instability value: how many of the counted frames were mis-recognised.

@@ -22,14 +22,14 @@ namespace {
 
 using Table = std::vector<std::vector<std::string>>;
 
-// Columns up to z_d_coverage are deterministic; latency, rate and timing are measurements.
-constexpr size_t kDeterministicColumns = 19;
+// Columns up to foreground_points_mean are deterministic; latency, rate and timing are measurements.
+constexpr size_t kDeterministicColumns = 20;
 
 const std::string kHeader =
     "row,settings,scene,seed,frames,truth_frames,measured_frames,misrecognised_1m,"
     "misrecognised_1m_per_thesis_minute,misrecognised_0.1m,misrecognised_0.1m_per_1000,mse_run_m2,mse_thesis_m2,"
     "distance_error_mean_m,distance_error_median_m,distance_error_p95_m,distance_error_max_m,unsafe_share,"
-    "z_d_coverage,latency_p50_us,latency_p99_us,processing_fps,timing";
+    "z_d_coverage,foreground_points_mean,latency_p50_us,latency_p99_us,processing_fps,timing";
 
 std::string fresh_dir(const std::string& name) {
   const std::string dir = std::string(::testing::TempDir()) + "eval_cli_" + name;
@@ -61,7 +61,7 @@ Table deterministic_rows(const std::string& dir) {
   Table rows;
   while (std::getline(in, line)) {
     std::vector<std::string> fields = eval::split_csv_line(line);
-    EXPECT_EQ(fields.size(), 23U) << line;
+    EXPECT_EQ(fields.size(), 24U) << line;
     fields.resize(kDeterministicColumns);
     rows.push_back(fields);
   }
