@@ -182,6 +182,120 @@ bool write_snapshot(Renderer& renderer, const ViewFrame& frame, const PaneImages
   return true;
 }
 
+// Opens the window (hidden for snapshots) with an OpenGL 3.3 core context and the input
+// callbacks; without a display or such a context, says so in one line and returns nullptr.
+GLFWwindow* open_window(bool hidden) {
+  // No display: one line and a non-zero exit, never a crash (GLFW would only say "X11: ...").
+  const char* x_display = std::getenv("DISPLAY");
+  const char* wayland_display = std::getenv("WAYLAND_DISPLAY");
+  if ((x_display == nullptr || *x_display == '\0') && (wayland_display == nullptr || *wayland_display == '\0')) {
+    std::fprintf(stderr,
+                 "hrcsense-view: no display (DISPLAY is not set); run it under `xvfb-run -a` for snapshots, or use "
+                 "`hrcsense run`\n");
+    return nullptr;
+  }
+  glfwSetErrorCallback(nullptr);
+  if (glfwInit() != GLFW_TRUE) {
+    std::fprintf(stderr, "hrcsense-view: no display (%s); run it under `xvfb-run -a`, or use `hrcsense run`\n",
+                 glfw_error_text().c_str());
+    return nullptr;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_VISIBLE, hidden ? GLFW_FALSE : GLFW_TRUE);
+  GLFWwindow* window = glfwCreateWindow(kSnapshotWidth, kSnapshotHeight, "hrcsense-view", nullptr, nullptr);
+  if (window == nullptr) {
+    const std::string why = glfw_error_text();
+    glfwTerminate();
+    std::fprintf(stderr, "hrcsense-view: no OpenGL 3.3 core context (%s)\n", why.c_str());
+    return nullptr;
+  }
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(hidden ? 0 : 1);
+  // Before ImGui's init, which chains them.
+  glfwSetKeyCallback(window, on_key);
+  glfwSetCursorPosCallback(window, on_cursor);
+  glfwSetScrollCallback(window, on_scroll);
+  return window;
+}
+
+// What the draw loop keeps between turns: the newest frame, the panes' images and which frame
+// (the tap's take() count, `serial`) each one shows, the orbit camera and the figures.
+struct LoopState {
+  ViewFrame frame;
+  ColorImage image;     // the 2D pane
+  ColorImage cloud;     // the 3D pane
+  ColorImage snapshot;  // the offscreen picture
+  ComposeScratch scratch;
+  Cloud3dScratch cloud_scratch;
+  OrbitCamera orbit;
+  bool orbit_ready = false;
+  bool reset_orbit = false;
+  PaneMode mode = PaneMode::view_2d;
+  int64_t serial = 0, serial_2d = -1, serial_3d = -1;
+  ViewStats stats;
+  std::vector<double> frame_times_ms;    // compose + draw + swap of each new frame
+  std::vector<double> compose_times_ms;  // compose_2d alone (CPU)
+  int64_t drawn = 0;
+};
+
+// Composes again the panes the window shows whose frame, size or orbit changed.
+void compose_panes(LoopState& s, const PaneRects& rects, bool orbit_moved) {
+  if (rects.image_2d.width > 0 && s.serial_2d != s.serial) {
+    const auto c0 = std::chrono::steady_clock::now();
+    compose_2d(s.frame, kDepthAlpha, kMarkerRadiusPx, s.scratch, s.image);
+    s.compose_times_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - c0).count());
+    s.serial_2d = s.serial;
+  }
+  if (s.frame.frame >= 0 && (!s.orbit_ready || s.reset_orbit)) {
+    s.orbit = default_orbit(s.frame);
+    s.orbit_ready = true;
+    s.reset_orbit = false;
+    s.serial_3d = -1;
+  }
+  if (rects.cloud_3d.width > 0 && (s.serial_3d != s.serial || orbit_moved || s.cloud.width != rects.cloud_3d.width ||
+                                   s.cloud.height != rects.cloud_3d.height)) {
+    compose_3d(s.frame, s.orbit, rects.cloud_3d.width, rects.cloud_3d.height, s.cloud_scratch, s.cloud);
+    s.serial_3d = s.serial;
+  }
+}
+
+// The status strip's figures for this turn.
+void update_stats(LoopState& s, ViewTap& tap, const PlaybackControl* playback, int64_t start_ns, bool ended) {
+  s.stats.viewer_dropped = tap.dropped();
+  s.stats.pipeline_dropped = tap.index_gaps() - (playback != nullptr ? playback->skipped() : 0);
+  tap.timeline(s.stats.timeline);
+  s.stats.session_ended = ended;
+  s.stats.notice = playback != nullptr && playback->paused() ? paused_notice(*playback) : std::string();
+  const double elapsed_s = static_cast<double>(steady_ns() - start_ns) * 1e-9;
+  s.stats.display_fps = elapsed_s > 0.0 ? static_cast<double>(s.drawn) / elapsed_s : 0.0;
+}
+
+// The run's options: hrcsense run's, plus the view tap after each processed frame, the panels'
+// requests before each frame and, for a replay, the playback control around the recording.
+app::SessionOptions session_options(const ViewArgs& args, bool snapshots, ViewTap& tap, ControlInbox& inbox,
+                                    PlaybackControl* playback) {
+  app::SessionOptions options;
+  options.frames = args.frames;
+  options.out = args.out;
+  options.record = args.record;
+  options.unpaced = snapshots;  // snapshots wait for the renderer: a paced clock would drop
+  options.on_processed = [&tap](const Frame& frame, const Pipeline& pipeline, const FrameResult& result) {
+    tap.offer(frame, pipeline, result);
+  };
+  options.viewer_frames_dropped = [&tap] { return tap.dropped(); };
+  options.with_color = true;
+  options.before_process = [&inbox](Pipeline& pipeline, const FrameResult& previous) { inbox.apply(pipeline, previous); };
+  if (playback != nullptr) {
+    options.wrap_recording = [playback](std::unique_ptr<Source> opened, std::function<std::unique_ptr<Source>()> open) {
+      return std::make_unique<PlaybackSource>(std::move(opened), std::move(open), *playback);
+    };
+  }
+  return options;
+}
+
 int run_viewer(const ViewArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
   const bool snapshots = !args.snapshot_dir.empty();
@@ -196,39 +310,8 @@ int run_viewer(const ViewArgs& args) {
   const std::optional<PaneMode> pane_mode = parse_pane_mode(args.pane);
   if (!pane_mode) throw ConfigError("--pane: '" + args.pane + "' is not 2d, 3d or split");
 
-  // No display: one line and a non-zero exit, never a crash (GLFW would only say "X11: ...").
-  const char* x_display = std::getenv("DISPLAY");
-  const char* wayland_display = std::getenv("WAYLAND_DISPLAY");
-  if ((x_display == nullptr || *x_display == '\0') && (wayland_display == nullptr || *wayland_display == '\0')) {
-    std::fprintf(stderr,
-                 "hrcsense-view: no display (DISPLAY is not set); run it under `xvfb-run -a` for snapshots, or use "
-                 "`hrcsense run`\n");
-    return kExitNoDisplay;
-  }
-  glfwSetErrorCallback(nullptr);
-  if (glfwInit() != GLFW_TRUE) {
-    std::fprintf(stderr, "hrcsense-view: no display (%s); run it under `xvfb-run -a`, or use `hrcsense run`\n",
-                 glfw_error_text().c_str());
-    return kExitNoDisplay;
-  }
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
-  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-  glfwWindowHint(GLFW_VISIBLE, snapshots ? GLFW_FALSE : GLFW_TRUE);
-  GLFWwindow* window = glfwCreateWindow(kSnapshotWidth, kSnapshotHeight, "hrcsense-view", nullptr, nullptr);
-  if (window == nullptr) {
-    const std::string why = glfw_error_text();
-    glfwTerminate();
-    std::fprintf(stderr, "hrcsense-view: no OpenGL 3.3 core context (%s)\n", why.c_str());
-    return kExitNoDisplay;
-  }
-  glfwMakeContextCurrent(window);
-  glfwSwapInterval(snapshots ? 0 : 1);
-  // Before ImGui's init, which chains them.
-  glfwSetKeyCallback(window, on_key);
-  glfwSetCursorPosCallback(window, on_cursor);
-  glfwSetScrollCallback(window, on_scroll);
+  GLFWwindow* window = open_window(snapshots);
+  if (window == nullptr) return kExitNoDisplay;
   Renderer renderer;
   std::string gl_error;
   if (!renderer.init(window, gl_error)) {
@@ -240,27 +323,29 @@ int run_viewer(const ViewArgs& args) {
   }
 
   ViewTap tap(snapshot_frames);
-  app::SessionOptions options;
-  options.frames = args.frames;
-  options.out = args.out;
-  options.record = args.record;
-  options.unpaced = snapshots;  // snapshots wait for the renderer: a paced clock would drop
-  options.on_processed = [&tap](const Frame& frame, const Pipeline& pipeline, const FrameResult& result) {
-    tap.offer(frame, pipeline, result);
-  };
-  options.viewer_frames_dropped = [&tap] { return tap.dropped(); };
-  options.with_color = true;
   ControlInbox inbox;
-  options.before_process = [&inbox](Pipeline& pipeline, const FrameResult& previous) { inbox.apply(pipeline, previous); };
   PlaybackControl playback;
   // run_session wraps only recordings (.bag, folder); a headless run plays straight through.
   const bool replay = !snapshots && (config.source.type == "bag" || config.source.type == "folder");
-  if (replay) {
-    options.wrap_recording = [&playback](std::unique_ptr<Source> opened, std::function<std::unique_ptr<Source>()> open) {
-      return std::make_unique<PlaybackSource>(std::move(opened), std::move(open), playback);
-    };
-  }
+  const app::SessionOptions options = session_options(args, snapshots, tap, inbox, replay ? &playback : nullptr);
   Panels panels(PanelContext{args.config_path, args.sets, &inbox, replay ? &playback : nullptr}, config);
+  LoopState s;
+  s.mode = *pane_mode;
+  if (!snapshots) {
+    // One picture (NO DATA) before the run starts: llvmpipe compiles its shaders at the first
+    // draw on every core, which would otherwise starve the run's first frames (a paced run then
+    // drops one that no slowness of the pipeline caused).
+    int width = kSnapshotWidth, height = kSnapshotHeight;
+    glfwGetFramebufferSize(window, &width, &height);
+    const PaneRects rects = window_panes(s.mode, width, height);
+    compose_panes(s, rects, false);
+    const PaneImages panes{s.mode, rects.image_2d.width > 0 ? &s.image : nullptr,
+                           rects.cloud_3d.width > 0 ? &s.cloud : nullptr};
+    panels.take_events();
+    renderer.draw(s.frame, panes, shown_state(s.frame, steady_ns(), max_frame_age_s), s.stats, width, height,
+                  [&] { panels.draw(s.mode, s.reset_orbit); });
+    glfwSwapBuffers(window);
+  }
   std::atomic<bool> session_done{false};
   int session_code = 0;
   std::thread session([&] {
@@ -272,21 +357,6 @@ int run_viewer(const ViewArgs& args) {
     session_done.store(true);
   });
 
-  ViewFrame frame;
-  ColorImage image;  // the 2D pane
-  ColorImage cloud;  // the 3D pane
-  ColorImage snapshot;
-  ComposeScratch scratch;
-  Cloud3dScratch cloud_scratch;
-  OrbitCamera orbit;
-  bool orbit_ready = false;
-  bool reset_orbit = false;
-  PaneMode mode = *pane_mode;
-  int64_t serial = 0, serial_2d = -1, serial_3d = -1;  // which take() each pane image shows
-  ViewStats stats;
-  std::vector<double> frame_times_ms;   // compose + draw + swap of each new frame
-  std::vector<double> compose_times_ms; // compose_2d alone (CPU)
-  int64_t drawn = 0;
   const int64_t start_ns = steady_ns();
   int64_t ended_ns = 0;
   int exit_code = 0;
@@ -296,59 +366,38 @@ int run_viewer(const ViewArgs& args) {
     if (g_quit.load() || glfwWindowShouldClose(window)) quit_requested = true;
     // Asked again every turn: a request made before the run installed its handlers is reset.
     if (quit_requested && !session_done.load()) app::request_session_stop();
-    const bool orbit_moved = handle_input(replay ? &playback : nullptr, panels, mode, orbit_ready ? &orbit : nullptr);
-    const bool fresh = tap.take(frame, 1.0 / 60.0);
-    if (fresh) ++serial;
+    const bool orbit_moved = handle_input(replay ? &playback : nullptr, panels, s.mode, s.orbit_ready ? &s.orbit : nullptr);
+    const bool fresh = tap.take(s.frame, 1.0 / 60.0);
+    if (fresh) ++s.serial;
     if (session_done.load() && ended_ns == 0) ended_ns = steady_ns();
     if (snapshots && session_done.load() && !fresh) break;
     if (!snapshots && ended_ns != 0 && (quit_requested || steady_ns() - ended_ns > kLingerAfterEndS * 1e9)) break;
-    const bool take_snapshot = snapshots && fresh && snapshot_frames.count(frame.frame) > 0;
+    const bool take_snapshot = snapshots && fresh && snapshot_frames.count(s.frame.frame) > 0;
     if (snapshots && !take_snapshot) continue;  // headless: only the listed frames are drawn
     const auto t0 = std::chrono::steady_clock::now();
     int width = kSnapshotWidth, height = kSnapshotHeight;
     if (!snapshots) glfwGetFramebufferSize(window, &width, &height);
-    const PaneRects rects = window_panes(mode, width, height);
+    const PaneRects rects = window_panes(s.mode, width, height);
     if (fresh && args.slow_render_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(args.slow_render_ms));
-    if (rects.image_2d.width > 0 && serial_2d != serial) {
-      const auto c0 = std::chrono::steady_clock::now();
-      compose_2d(frame, kDepthAlpha, kMarkerRadiusPx, scratch, image);
-      compose_times_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - c0).count());
-      serial_2d = serial;
-    }
-    if (frame.frame >= 0 && (!orbit_ready || reset_orbit)) {
-      orbit = default_orbit(frame);
-      orbit_ready = true;
-      reset_orbit = false;
-      serial_3d = -1;
-    }
-    if (rects.cloud_3d.width > 0 && (serial_3d != serial || orbit_moved || cloud.width != rects.cloud_3d.width ||
-                                     cloud.height != rects.cloud_3d.height)) {
-      compose_3d(frame, orbit, rects.cloud_3d.width, rects.cloud_3d.height, cloud_scratch, cloud);
-      serial_3d = serial;
-    }
-    stats.viewer_dropped = tap.dropped();
-    stats.pipeline_dropped = tap.index_gaps() - playback.skipped();
-    tap.timeline(stats.timeline);
-    stats.session_ended = ended_ns != 0;
-    stats.notice = replay && playback.paused() ? paused_notice(playback) : std::string();
-    const double elapsed_s = static_cast<double>(steady_ns() - start_ns) * 1e-9;
-    stats.display_fps = elapsed_s > 0.0 ? static_cast<double>(drawn) / elapsed_s : 0.0;
+    compose_panes(s, rects, orbit_moved);
+    update_stats(s, tap, replay ? &playback : nullptr, start_ns, ended_ns != 0);
     // The state when drawn: a result older than max_frame_age_s is NO DATA (a frozen pipeline).
-    const ShownState state = shown_state(frame, steady_ns(), max_frame_age_s);
-    const PaneImages panes{mode, rects.image_2d.width > 0 ? &image : nullptr, rects.cloud_3d.width > 0 ? &cloud : nullptr};
+    const ShownState state = shown_state(s.frame, steady_ns(), max_frame_age_s);
+    const PaneImages panes{s.mode, rects.image_2d.width > 0 ? &s.image : nullptr,
+                           rects.cloud_3d.width > 0 ? &s.cloud : nullptr};
     if (take_snapshot || (!snapshots && g_screenshot.exchange(false))) {
       const std::string dir = snapshots ? args.snapshot_dir : std::string(".");
-      if (!write_snapshot(renderer, frame, panes, state, stats, dir, snapshot)) exit_code = 1;
-      if (take_snapshot) tap.rendered(frame.frame);
+      if (!write_snapshot(renderer, s.frame, panes, state, s.stats, dir, s.snapshot)) exit_code = 1;
+      if (take_snapshot) tap.rendered(s.frame.frame);
     }
     if (!snapshots) {
       panels.take_events();
-      renderer.draw(frame, panes, state, stats, width, height, [&] { panels.draw(mode, reset_orbit); });
+      renderer.draw(s.frame, panes, state, s.stats, width, height, [&] { panels.draw(s.mode, s.reset_orbit); });
       glfwSwapBuffers(window);
     }
     if (fresh) {
-      ++drawn;
-      frame_times_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      ++s.drawn;
+      s.frame_times_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
     if (snapshots && tap.snapshots_pending() == 0) break;
   }
@@ -360,10 +409,10 @@ int run_viewer(const ViewArgs& args) {
     spdlog::error("snapshot: {} of the --snapshot-at frames never came (the run ended before them)", missing);
     exit_code = 1;
   }
-  if (!frame_times_ms.empty()) {
+  if (!s.frame_times_ms.empty()) {
     spdlog::info("viewer: {} frames drawn, {} dropped; frame time p50 {:.2f} ms, p99 {:.2f} ms (compose p50 {:.2f} ms)",
-                 drawn, tap.dropped(), nearest_rank(frame_times_ms, 0.5), nearest_rank(frame_times_ms, 0.99),
-                 nearest_rank(compose_times_ms, 0.5));
+                 s.drawn, tap.dropped(), nearest_rank(s.frame_times_ms, 0.5), nearest_rank(s.frame_times_ms, 0.99),
+                 nearest_rank(s.compose_times_ms, 0.5));
   }
   renderer.shutdown();
   glfwDestroyWindow(window);

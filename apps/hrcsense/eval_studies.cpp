@@ -189,12 +189,12 @@ StudySection study_table_41(const StudyContext& ctx) {
   return section;
 }
 
-StudySection study_table_42(const StudyContext& ctx) {
-  SweepRequest request = ctx.sweep("table-4.2", ctx.scene("thesis-box.yaml"), kStudyFrames);
-  request.sets.push_back("filters.preset=thesis");
-  // The thesis's values; those the SDK refuses (α below 0.25, δ above 50) are listed as
-  // refused, with the configuration's own message, not run.
-  std::vector<std::pair<std::string, std::string>> refused;
+namespace {
+
+// Adds the thesis's Table 4.2 points that the SDK's ranges accept (α 0.25–1, δ 1–50), each as
+// the configuration loads it; returns the configuration's message for each refused one.
+std::vector<std::string> add_points_within_sdk(SweepRequest& request) {
+  std::vector<std::string> refused;
   const auto try_point = [&](const std::vector<std::string>& settings) {
     std::vector<std::string> sets = request.sets;
     sets.insert(sets.end(), settings.begin(), settings.end());
@@ -202,7 +202,7 @@ StudySection study_table_42(const StudyContext& ctx) {
       (void)load_config(request.scenes[0], sets);
       add_point(request, settings);
     } catch (const ConfigError& e) {
-      refused.emplace_back(settings.front().substr(settings.front().rfind('.') + 1), e.what());
+      refused.emplace_back(e.what());
     }
   };
   for (const ThesisFilterRow& t : kThesisAlpha) {
@@ -211,6 +211,51 @@ StudySection study_table_42(const StudyContext& ctx) {
   for (const ThesisFilterRow& t : kThesisDelta) {
     try_point({"filters.spatial.alpha=0.4", "filters.spatial.delta=" + value_text(t.value)});
   }
+  return refused;
+}
+
+// Where the 0.1 m rule starts to fail at α 0.4 (δ too large to stop the smoothing at the box's
+// edges), as a sentence; empty when it never does.
+std::string delta_breaks(const ResultTable& table) {
+  for (const ThesisFilterRow& t : kThesisDelta) {
+    const std::string settings = "filters.spatial.alpha=0.4;filters.spatial.delta=" + value_text(t.value);
+    for (size_t r = 0; r < table.rows.size(); ++r) {
+      if (table.text(r, "settings") != settings || table.number(r, "misrecognised_0.1m_per_1000") <= 100.0) continue;
+      return " From δ " + value_text(t.value) + " on (α 0.4) the filter no longer stops at the box's edges: it "
+             "blends box and background into points in front of the edge, the measured closest point is more "
+             "than 0.1 m from the true one in " + fixed(table.number(r, "misrecognised_0.1m_per_1000") / 10.0, 1) +
+             " % of the frames and the distance error is " + mm(table.number(r, "distance_error_mean_m")) +
+             (table.number(r, "unsafe_share") == 0.0 ? " (on the near, safe side)" : "") +
+             (table.text(r, "misrecognised_1m") == "0" ? "; the thesis's 1 m rule does not see it." : ".");
+    }
+  }
+  return "";
+}
+
+// What Table 4.2's numbers recommend.
+std::string smoothing_recommendation(const ResultTable& table, const PlotSeries& alpha_error) {
+  const ErrorSpread spread = error_spread(table);
+  std::ostringstream recommend;
+  recommend << "The lowest mean distance error, " << mm(spread.low_m) << ", is at `"
+            << table.text(spread.best_row, "settings") << "`"
+            << (alpha_error.y.size() >= 2 && alpha_error.y.front() > alpha_error.y.back()
+                    ? ": on a still box smoothing rounds the corner nearest the robot point a little, the more the "
+                      "lower α (" + mm(alpha_error.y.front()) + " at α " + value_text(alpha_error.x.front()) + ", " +
+                          mm(alpha_error.y.back()) + " at α " + value_text(alpha_error.x.back()) + ")."
+                    : ".")
+            << delta_breaks(table)
+            << " Keep δ at 20 or below and α at 0.4–0.5 (the thesis's 0.4 and the SDK's default 0.5) where the "
+               "smoothing is wanted against noise; on a moving person one pass (`filters.spatial.magnitude: 1`) "
+               "avoids smoothing a hand towards the arm (docs/ACCURACY.md).";
+  return recommend.str();
+}
+
+}  // namespace
+
+StudySection study_table_42(const StudyContext& ctx) {
+  SweepRequest request = ctx.sweep("table-4.2", ctx.scene("thesis-box.yaml"), kStudyFrames);
+  request.sets.push_back("filters.preset=thesis");
+  const std::vector<std::string> refused = add_points_within_sdk(request);
   add_point(request, {"filters.spatial.enabled=false"});
   const ResultTable table = run_sweep(request);
 
@@ -253,38 +298,9 @@ StudySection study_table_42(const StudyContext& ctx) {
   }
   line("–", "–", kThesisNoSmoothing, "filters.spatial.enabled=false", nullptr, 0.0);
   md << "\nRefused by the SDK's ranges (α 0.25–1, δ 1–50), as hrcsense's configuration refuses them:\n\n";
-  for (const auto& [name, message] : refused) md << "- `" << message << "`\n";
-  // Where the 0.1 m rule starts to fail at α 0.4: δ too large to stop the smoothing at the box's edges.
-  std::string breaks;
-  for (const ThesisFilterRow& t : kThesisDelta) {
-    const std::string settings = "filters.spatial.alpha=0.4;filters.spatial.delta=" + value_text(t.value);
-    for (size_t r = 0; r < table.rows.size(); ++r) {
-      if (breaks.empty() && table.text(r, "settings") == settings &&
-          table.number(r, "misrecognised_0.1m_per_1000") > 100.0) {
-        breaks = " From δ " + value_text(t.value) + " on (α 0.4) the filter no longer stops at the box's edges: it "
-                 "blends box and background into points in front of the edge, the measured closest point is more "
-                 "than 0.1 m from the true one in " + fixed(table.number(r, "misrecognised_0.1m_per_1000") / 10.0, 1) +
-                 " % of the frames and the distance error is " + mm(table.number(r, "distance_error_mean_m")) +
-                 (table.number(r, "unsafe_share") == 0.0 ? " (on the near, safe side)" : "") +
-                 (table.text(r, "misrecognised_1m") == "0" ? "; the thesis's 1 m rule does not see it." : ".");
-      }
-    }
-  }
-  const ErrorSpread spread = error_spread(table);
+  for (const std::string& message : refused) md << "- `" << message << "`\n";
   md << "\n" << rate_note(table) << "\n";
-  std::ostringstream recommend;
-  recommend << "The lowest mean distance error, " << mm(spread.low_m) << ", is at `"
-            << table.text(spread.best_row, "settings") << "`"
-            << (alpha_error.y.size() >= 2 && alpha_error.y.front() > alpha_error.y.back()
-                    ? ": on a still box smoothing rounds the corner nearest the robot point a little, the more the "
-                      "lower α (" + mm(alpha_error.y.front()) + " at α " + value_text(alpha_error.x.front()) + ", " +
-                          mm(alpha_error.y.back()) + " at α " + value_text(alpha_error.x.back()) + ")."
-                    : ".")
-            << breaks
-     << " Keep δ at 20 or below and α at 0.4–0.5 (the thesis's 0.4 and the SDK's default 0.5) where the smoothing "
-        "is wanted against noise; on a moving person one pass (`filters.spatial.magnitude: 1`) avoids smoothing a "
-        "hand towards the arm (docs/ACCURACY.md).";
-  StudySection section{"Table 4.2", md.str(), {}, recommend.str()};
+  StudySection section{"Table 4.2", md.str(), {}, smoothing_recommendation(table, alpha_error)};
   section.figures.push_back(ctx.figure("table-4.2", "alpha_error.png",
                                        {"", "closest-distance error against the spatial filter's alpha (delta 20)",
                                         "filters.spatial.alpha", "mean |measured - true| (m)", false, false,
