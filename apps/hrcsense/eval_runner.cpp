@@ -175,15 +175,9 @@ void draw(const Progress& p, double elapsed_s, const std::string& current) {
 
 // DIR/results.md: every row of results.csv in row order, with the columns a reader compares
 // (the rest are in the CSV).
-void write_results_md(const std::string& csv, const std::string& md) {
-  std::ifstream in(csv, std::ios::binary);
-  std::string line;
-  std::getline(in, line);
-  const std::vector<std::string> header = eval::split_csv_line(line);
-  std::vector<std::vector<std::string>> rows;
-  while (std::getline(in, line)) rows.push_back(eval::split_csv_line(line));
-  std::sort(rows.begin(), rows.end(),
-            [](const auto& a, const auto& b) { return std::stoll(a.at(0)) < std::stoll(b.at(0)); });
+void write_results_md(const ResultTable& table, const std::string& md) {
+  const std::vector<std::string>& header = table.header;
+  const std::vector<std::vector<std::string>>& rows = table.rows;  // in row order
   const std::vector<std::string> shown = {
       "row", "settings", "scene", "seed", "frames", "misrecognised_1m_per_thesis_minute",
       "misrecognised_0.1m_per_1000", "mse_thesis_m2", "mse_run_m2", "distance_error_mean_m", "distance_error_p95_m",
@@ -331,9 +325,10 @@ ResultTable run_sweep(const SweepRequest& request) {
   if (!out) throw std::runtime_error("eval: cannot write " + csv);
   out.close();
   const std::string md = (std::filesystem::path(request.out_dir) / "results.md").string();
-  write_results_md(csv, md);
+  ResultTable table = read_results(csv);  // read once: the rows resumed and the rows run now
+  write_results_md(table, md);
   spdlog::info("eval: {} rows in {} and {} ({} run now)", rows.size(), csv, md, pending.size());
-  return read_results(csv);
+  return table;
 }
 
 }  // namespace hrcsense::app
