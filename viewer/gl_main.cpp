@@ -2,8 +2,9 @@
 // hrcsense-view — `hrcsense run` with a window: the same flags, sinks and links, and the
 // viewer as one more consumer of the results (docs/VIEWER.md). The run goes on a thread of its
 // own; GLFW and OpenGL stay on the main thread, which reads the newest frame from the view
-// tap's latest-value mailbox; the panels' requests go back through a ControlInbox and a
-// recording's pause, step and seek through a PlaybackControl. Headless: --snapshot DIR
+// tap's latest-value mailbox (the processing thread's picture of each frame, published with
+// the verdict the run decided for it by a sink on the output thread); the panels' requests go
+// back through a ControlInbox and a recording's pause, step and seek through a PlaybackControl. Headless: --snapshot DIR
 // --snapshot-at LIST writes PNGs from an offscreen framebuffer and exits after the last.
 #include "viewer/cloud_view.hpp"
 #include "viewer/gl_panels.hpp"
@@ -273,10 +274,11 @@ void update_stats(LoopState& s, ViewTap& tap, const PlaybackControl* playback, i
   s.stats.display_fps = elapsed_s > 0.0 ? static_cast<double>(s.drawn) / elapsed_s : 0.0;
 }
 
-// The run's options: hrcsense run's, plus the view tap after each processed frame, the panels'
-// requests before each frame and, for a replay, the playback control around the recording.
-app::SessionOptions session_options(const ViewArgs& args, bool snapshots, ViewTap& tap, ControlInbox& inbox,
-                                    PlaybackControl* playback) {
+// The run's options: hrcsense run's, plus the view tap after each processed frame and its sink
+// for each decided result, the panels' requests before each frame and, for a replay, the
+// playback control around the recording.
+app::SessionOptions session_options(const ViewArgs& args, bool snapshots, ViewTap& tap, ViewSink& sink,
+                                    ControlInbox& inbox, PlaybackControl* playback) {
   app::SessionOptions options;
   options.frames = args.frames;
   options.out = args.out;
@@ -285,6 +287,7 @@ app::SessionOptions session_options(const ViewArgs& args, bool snapshots, ViewTa
   options.on_processed = [&tap](const Frame& frame, const Pipeline& pipeline, const FrameResult& result) {
     tap.offer(frame, pipeline, result);
   };
+  options.viewer_sink = &sink;
   options.viewer_frames_dropped = [&tap] { return tap.dropped(); };
   options.with_color = true;
   options.before_process = [&inbox](Pipeline& pipeline, const FrameResult& previous) { inbox.apply(pipeline, previous); };
@@ -323,11 +326,12 @@ int run_viewer(const ViewArgs& args) {
   }
 
   ViewTap tap(snapshot_frames);
+  ViewSink view_sink(tap);
   ControlInbox inbox;
   PlaybackControl playback;
   // run_session wraps only recordings (.bag, folder); a headless run plays straight through.
   const bool replay = !snapshots && (config.source.type == "bag" || config.source.type == "folder");
-  const app::SessionOptions options = session_options(args, snapshots, tap, inbox, replay ? &playback : nullptr);
+  const app::SessionOptions options = session_options(args, snapshots, tap, view_sink, inbox, replay ? &playback : nullptr);
   Panels panels(PanelContext{args.config_path, args.sets, &inbox, replay ? &playback : nullptr}, config);
   LoopState s;
   s.mode = *pane_mode;

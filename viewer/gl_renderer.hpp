@@ -23,9 +23,9 @@ namespace hrcsense::view {
 struct ViewStats {
   double display_fps = 0.0;     ///< frames drawn per second
   int64_t viewer_dropped = 0;   ///< frames the viewer never drew (ViewTap::dropped)
-  int64_t pipeline_dropped = 0; ///< source frames the pipeline never processed (paced runs)
+  int64_t pipeline_dropped = 0; ///< source frames the run never wrote (paced runs; ViewTap::index_gaps)
   bool session_ended = false;   ///< the run is over (the last frame stays on screen)
-  std::vector<TimelinePoint> timeline;  ///< every processed frame of the last seconds (ViewTap)
+  std::vector<TimelinePoint> timeline;  ///< every decided frame of the last seconds (ViewTap)
   std::string notice;           ///< one more line for the strip (e.g. "paused"); empty: none
 };
 

@@ -15,7 +15,7 @@
 
 namespace hrcsense::view {
 
-std::string relearn_refusal(const FrameResult& previous) {
+std::string relearn_refusal(const Measurement& previous, const SafetyParams& safety) {
   if (!previous.robot_state.valid) return "no valid robot state to judge by: the robot may be moving";
   for (size_t j = 0; j < previous.robot_state.qd_rad_s.size(); ++j) {
     const double speed = std::abs(previous.robot_state.qd_rad_s[j]);
@@ -25,7 +25,8 @@ std::string relearn_refusal(const FrameResult& previous) {
       return text;
     }
   }
-  const ReasonCode code = previous.verdict.code;
+  if (!previous.valid) return {};  // no contact measured (learning the background, no depth...)
+  const ReasonCode code = verdict_for_contact(safety, previous.contact, previous.foreground_points).code;
   if (code == ReasonCode::in_slow_zone || code == ReasonCode::in_stop_zone || code == ReasonCode::inside_robot) {
     char text[96];
     std::snprintf(text, sizeof text, "something is %.2f m from the robot (%s)",
@@ -67,7 +68,7 @@ void ControlInbox::apply(Pipeline& pipeline, const FrameResult& previous) {
     }
   }
   if (relearn) {
-    const std::string refusal = relearn_refusal(previous);
+    const std::string refusal = relearn_refusal(previous, pipeline.params().safety);
     if (refusal.empty()) {
       pipeline.relearn_background();
       events.push_back({after_frame, false, "relearning the background"});

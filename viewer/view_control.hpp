@@ -20,10 +20,13 @@ inline constexpr float kRobotMovingRadS = 1e-3F;
 
 /// Why the background may not be relearnt after the frame `previous`, or empty when it may:
 /// refused without a valid robot state to judge by, while any joint moves faster than
-/// kRobotMovingRadS, and while anything is within the slow distance of the robot (verdict
-/// in_slow_zone, in_stop_zone or inside_robot): a background learnt then would hide a person.
-/// A scene that moves while it is learnt restarts the learning by itself (BackgroundLearner).
-std::string relearn_refusal(const FrameResult& previous);
+/// kRobotMovingRadS, and while anything is within the slow distance of the robot (a valid
+/// measurement whose contact the zones rule, verdict_for_contact with `safety`, puts in_slow_zone,
+/// in_stop_zone or inside_robot, whatever safety.mode): a background learnt then would hide a
+/// person. Judged on the measurement itself: on the processing thread, where the relearn is
+/// applied, `previous` is not decided yet (its verdict is not set). A scene that moves while it
+/// is learnt restarts the learning by itself (BackgroundLearner).
+std::string relearn_refusal(const Measurement& previous, const SafetyParams& safety);
 
 /// What happened to a request, for the panel and the log.
 struct ControlEvent {
@@ -40,7 +43,8 @@ class ControlInbox {
   /// Relearn the background before the next frame, unless relearn_refusal() says no then.
   void post_relearn();
   /// The processing thread's side, before each frame (RunOptions::before_process): applies
-  /// what was posted, logs it and keeps the outcome for take_events(). Never waits for the
+  /// what was posted (a relearn judged by relearn_refusal with the pipeline's safety
+  /// parameters), logs it and keeps the outcome for take_events(). Never waits for the
   /// renderer (the lock only guards the posted values).
   void apply(Pipeline& pipeline, const FrameResult& previous);
   /// Outcomes since the last call, oldest first.

@@ -30,9 +30,11 @@ inline constexpr Rgb kStopColor{230, 0, 0};
 inline constexpr Rgb kNoDataColor{128, 128, 128};
 
 /// A copy of what the viewer shows of one processed frame, made on the processing thread by
-/// the view tap (its buffers are reused: no allocation once sized).
+/// the view tap, with the verdict the run's SafetyMonitor decided for it on the output thread
+/// (its buffers are reused: no allocation once sized).
 struct ViewFrame {
   int64_t frame = -1;            ///< source frame index; -1: nothing yet
+  int64_t publication = 0;       ///< the view tap's number for it (1, 2, ...); 0: not published
   int64_t timestamp_ns = 0;
   int64_t made_ns = 0;           ///< steady-clock time the result was made (NO DATA)
   DepthImage depth;              ///< the source frame's depth, as received (before filters)
@@ -44,7 +46,7 @@ struct ViewFrame {
   std::vector<Capsule> capsules_base;    ///< the robot's capsules of this frame (base frame)
   Pose T_camera_base = Pose::Identity(); ///< inverse of the configuration's T_base_camera
   Contact contact;
-  Verdict verdict;
+  Verdict verdict;               ///< the decided verdict (ViewTap::decided), never the viewer's own
   bool valid = false;
   size_t foreground_points = 0;
   /// Depth pixels per foreground point along a row: the depth image's width over the filtered

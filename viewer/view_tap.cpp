@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense viewer — the processing thread's tap into the renderer's mailbox (view_tap.hpp).
+// hrcsense viewer — the tap between the run's processing and output threads and the renderer's
+// mailbox (view_tap.hpp).
 #include "viewer/view_tap.hpp"
 
 #include <chrono>
@@ -57,7 +58,6 @@ void fill_view_frame(const Frame& frame, const Pipeline& pipeline, const FrameRe
   }
   out.T_camera_base = pipeline.params().T_base_camera.inverse();
   out.contact = result.contact;
-  out.verdict = result.verdict;
   out.foreground_points = result.foreground_points;
   out.invalid_pixels = result.invalid_pixels;
   out.latency_us = result.latency_us;
@@ -65,30 +65,85 @@ void fill_view_frame(const Frame& frame, const Pipeline& pipeline, const FrameRe
   out.stop_distance_m = pipeline.params().safety.stop_distance_m;
 }
 
-ViewTap::ViewTap(std::set<int64_t> snapshot_frames) : pending_(std::move(snapshot_frames)) {}
+ViewTap::ViewTap(std::set<int64_t> snapshot_frames) : snapshots_(std::move(snapshot_frames)) {}
 
 void ViewTap::offer(const Frame& frame, const Pipeline& pipeline, const FrameResult& result) {
-  const int64_t now_ns = steady_now_ns();
-  fill_view_frame(frame, pipeline, result, now_ns, scratch_);
-  TimelinePoint point;
-  point.timestamp_ns = result.timestamp_ns;
-  point.made_ns = now_ns;
-  point.distance_m = result.contact.valid ? result.contact.distance_m : -1.0F;
-  point.state = result.verdict.state;
-  point.latency_us = result.latency_us;
-  const bool snapshot = [&] {
+  fill_view_frame(frame, pipeline, result, steady_now_ns(), offer_scratch_);
+  std::lock_guard<std::mutex> lock(mutex_);
+  // A free slot, else the oldest: a frame the output has not decided after kPendingFrames
+  // newer ones were offered (a paced run drops such measurements undecided).
+  Pending* slot = nullptr;
+  for (Pending& p : pending_) {
+    if (p.offered == 0) {
+      slot = &p;
+      break;
+    }
+    if (slot == nullptr || p.offered < slot->offered) slot = &p;
+  }
+  std::swap(slot->view, offer_scratch_);  // the slot's old buffers are the next offer's
+  slot->frame = result.frame;
+  slot->delivered_ns = result.delivered_ns;
+  slot->offered = ++offered_;
+}
+
+void ViewTap::decided(const FrameResult& result) {
+  if (!result.source_frame) {
+    // A watchdog or end-of-run stop: the last frame published shows it (take()).
     std::lock_guard<std::mutex> lock(mutex_);
+    no_frame_ = result.verdict;
+    no_frame_after_ = published_;
+    return;
+  }
+  bool publish = false;
+  bool snapshot = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Pending* match = nullptr;
+    for (Pending& p : pending_) {
+      if (p.offered != 0 && p.frame == result.frame && p.delivered_ns == result.delivered_ns &&
+          (match == nullptr || p.offered < match->offered)) {
+        match = &p;
+      }
+    }
+    TimelinePoint point;
+    point.made_ns = steady_now_ns();
+    if (match != nullptr) {
+      // Views offered before this one were never decided: the pipeline dropped them.
+      for (Pending& p : pending_) {
+        if (p.offered != 0 && p.offered < match->offered) p.offered = 0;
+      }
+      std::swap(publish_scratch_, match->view);
+      match->offered = 0;
+      point.made_ns = publish_scratch_.made_ns;
+      publish_scratch_.publication = ++published_;
+      publish = true;
+    } else {
+      ++views_missing_;  // its view was forgotten: better no picture than another frame's
+    }
+    point.timestamp_ns = result.timestamp_ns;
+    point.distance_m = result.contact.valid ? result.contact.distance_m : -1.0F;
+    point.state = result.verdict.state;
+    point.latency_us = result.latency_us;
     timeline_.add(point);
-    // Frames the pipeline dropped (paced: processing behind the source) leave gaps in the
-    // processed frames' source indices.
+    // Frames dropped before or after processing (paced: processing or the output behind the
+    // source) leave gaps in the decided frames' source indices.
     if (last_index_ >= 0 && result.frame > last_index_ + 1) index_gaps_ += result.frame - last_index_ - 1;
     last_index_ = result.frame;
-    return result.source_frame && pending_.count(result.frame) > 0;
-  }();
-  if (!mailbox_.put(scratch_)) return;  // the renderer is gone
+    snapshot = publish && snapshots_.count(result.frame) > 0;
+  }
+  if (!publish) return;
+  publish_scratch_.verdict = result.verdict;
+  if (!mailbox_.put(publish_scratch_)) return;  // the renderer is gone
   if (!snapshot) return;
   std::unique_lock<std::mutex> lock(mutex_);
-  drawn_.wait(lock, [&] { return closed_ || pending_.count(result.frame) == 0; });
+  drawn_.wait(lock, [&] { return closed_ || snapshots_.count(result.frame) == 0; });
+}
+
+bool ViewTap::take(ViewFrame& out, double timeout_s) {
+  const bool fresh = mailbox_.take_for(out, timeout_s);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (no_frame_ && out.publication > 0 && out.publication == no_frame_after_) out.verdict = *no_frame_;
+  return fresh;
 }
 
 int64_t ViewTap::index_gaps() const {
@@ -96,9 +151,15 @@ int64_t ViewTap::index_gaps() const {
   return index_gaps_;
 }
 
+int64_t ViewTap::dropped() const {
+  const int64_t replaced = mailbox_.dropped();
+  std::lock_guard<std::mutex> lock(mutex_);
+  return replaced + views_missing_;
+}
+
 void ViewTap::rendered(int64_t index) {
   std::lock_guard<std::mutex> lock(mutex_);
-  pending_.erase(index);
+  snapshots_.erase(index);
   drawn_.notify_all();
 }
 
@@ -116,7 +177,7 @@ void ViewTap::timeline(std::vector<TimelinePoint>& out) const {
 
 size_t ViewTap::snapshots_pending() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return pending_.size();
+  return snapshots_.size();
 }
 
 }  // namespace hrcsense::view

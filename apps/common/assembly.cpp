@@ -7,6 +7,7 @@
 #include "hrcsense/link.hpp"
 #include "hrcsense/recordings.hpp"
 #include "hrcsense/rtde.hpp"
+#include "hrcsense/session.hpp"
 #include "hrcsense/udp_json.hpp"
 
 #if HRCSENSE_HAVE_DDS
@@ -275,6 +276,7 @@ std::string describe_link_counters(const UdpLinkSink& link) {
 RunHeader make_run_header(const Config& config, const SourceInfo& info) {
   RunHeader header;
   header.config_hash = config_hash(config);
+  header.session = process_session();  // the link's datagrams carry the same (UdpLinkParams::session 0)
   header.source = info;
   header.robot_state = config.robot_state.source;
   if (config.robot_state.source == "rtde") {

@@ -26,8 +26,9 @@
 namespace hrcsense::app {
 namespace {
 
-// Set by SIGINT, SIGTERM (systemd's stop) or SIGHUP (the terminal closed); the pipeline polls
-// it and ends the run with a final stop line and a summary.
+// Set by SIGINT, SIGTERM (systemd's stop), SIGHUP (the terminal closed) or SIGTSTP (Ctrl-Z:
+// a suspended process would look alive to its consumers while it decides nothing, so it ends
+// instead); the pipeline polls it and ends the run with a final stop line and a summary.
 std::atomic<bool> g_stop_requested{false};
 std::atomic<int> g_stop_signal{0};
 
@@ -37,7 +38,7 @@ extern "C" void on_stop_signal(int signal) {
   std::signal(signal, SIG_DFL);  // a second one kills, in case the run is stuck
 }
 
-constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGTSTP};
 
 // SIGPIPE is ignored for the whole run: a reader that goes away makes the write fail (EPIPE),
 // and the failed sink ends the run, instead of the signal killing it mid-line.
@@ -97,6 +98,7 @@ const char* signal_name(int signal) {
     case SIGINT: return "SIGINT";
     case SIGTERM: return "SIGTERM";
     case SIGHUP: return "SIGHUP";
+    case SIGTSTP: return "SIGTSTP";
     default: return "a signal";
   }
 }
@@ -160,7 +162,9 @@ int run_session(const Config& config, const SessionOptions& args) {
   const std::unique_ptr<RtdeLinkSink> rtde_link = make_rtde_link_sink(config);
   if (rtde_link) spdlog::info("link: speed scale to RTDE {}:{} ({})", config.robot_state.host, config.robot_state.port,
                               rtde_link->input_names());
-  TeeSink tee{link.get(), rtde_link.get(), labelled ? static_cast<Sink*>(&*labelled) : &jsonl, &console};
+  // A viewer's sink last: the controller, the files and the console have each result first.
+  TeeSink tee{link.get(), rtde_link.get(), labelled ? static_cast<Sink*>(&*labelled) : &jsonl, &console,
+              args.viewer_sink};
   std::optional<RecordCountersSink> with_record;
   if (recorder) with_record.emplace(tee, *recorder);
   Sink& recorded = with_record ? static_cast<Sink&>(*with_record) : tee;

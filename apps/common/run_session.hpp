@@ -22,8 +22,12 @@ struct SessionOptions {
   /// Play the source as fast as processing goes, whatever source.pace says (headless
   /// snapshots). A live camera paces itself either way.
   bool unpaced = false;
-  /// RunOptions::on_processed: a viewer's tap on the processing thread.
+  /// RunOptions::on_processed: a viewer's tap on the processing thread (the measurement, before
+  /// the verdict is decided).
   std::function<void(const Frame&, const Pipeline&, const FrameResult&)> on_processed;
+  /// Set: one more sink on the output thread, after all the others (the links, the JSON Lines,
+  /// the console): a viewer's, which gets every result as decided. Must outlive the run.
+  Sink* viewer_sink = nullptr;
   /// Set: the summary reports `viewer_frames_dropped` from it (read once the run has ended).
   std::function<int64_t()> viewer_frames_dropped;
   /// RunOptions::before_process: the viewer's requests to the pipeline, between frames.

@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense CLI — `hrcsense bench`: times Pipeline::process end to end on pre-rendered frames.
+// hrcsense CLI — `hrcsense bench`: times what a run does per frame on pre-rendered frames: the
+// measurement (Pipeline::process) and the SafetyMonitor's decision, with the robot state the
+// configured source gives each frame.
 #include "common/app_errors.hpp"
 #include "commands.hpp"
 
 #include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/robot_state.hpp"
+#include "hrcsense/safety.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -14,6 +17,8 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 namespace hrcsense::app {
@@ -77,6 +82,48 @@ BackgroundModel learn(const PipelineParams& params, const std::vector<Frame>& fr
   return learner.background();
 }
 
+// The robot state the configured source gives each frame at its timestamp (the simulator's
+// trajectory for `sim`, the recording's for `recorded`); live sources (rtde, udp_json) have no
+// state to replay, so their frames get robot.joints_rad, with a warning.
+std::vector<RobotState> robot_states_for(const Config& config, Source& source, const std::vector<Frame>& frames) {
+  std::unique_ptr<RobotStateSource> states;
+  const std::string& origin = config.robot_state.source;
+  if (origin == "fixed" || origin == "sim") {
+    states = make_robot_state_source(config);
+  } else if (origin == "recorded") {
+    states = make_robot_state_source(config, source);
+  } else {
+    spdlog::warn("bench: robot.state.source {} is live; the frames get robot.joints_rad instead", origin);
+  }
+  std::vector<RobotState> out(frames.size(), fixed_robot_state(config.robot_state.joints_rad));
+  if (!states) return out;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    if (!states->state_at(frames[i].timestamp_ns, out[i])) out[i].valid = false;
+  }
+  return out;
+}
+
+// Per stage, the median of its timings over the timed frames, in the order the stages ran.
+void print_stage_medians(const std::vector<std::pair<const char*, std::vector<double>>>& stages) {
+  std::printf("stages ms     median:");
+  for (const auto& [name, us] : stages) {
+    if (us.empty()) continue;
+    std::printf(" %s %.3f", name, percentile_ms(us, 0.50));
+  }
+  std::printf("\n");
+}
+
+// Adds `us` under `name` (static names: compared by pointer first, then by text).
+void add_stage(std::vector<std::pair<const char*, std::vector<double>>>& stages, const char* name, double us) {
+  for (auto& [stage, values] : stages) {
+    if (stage == name || std::string_view(stage) == name) {
+      values.push_back(us);
+      return;
+    }
+  }
+  stages.push_back({name, {us}});
+}
+
 }  // namespace
 
 int bench_command(const CommandArgs& args) {
@@ -98,17 +145,29 @@ int bench_command(const CommandArgs& args) {
     if (first == frames.size()) throw std::runtime_error("no frames left after background learning");
     std::vector<double> latencies_us;
     latencies_us.reserve((frames.size() - first) * kRepetitions);
+    const std::vector<RobotState> robot_states = robot_states_for(config, *source, frames);
     FrameResult result;
-    const RobotState robot_state = fixed_robot_state(config.robot_state.joints_rad);
-    for (size_t i = first; i < frames.size(); ++i) pipeline.process(frames[i], robot_state, result);  // warm-up
+    SafetyMonitor monitor(config.pipeline.safety);
+    std::vector<std::pair<const char*, std::vector<double>>> stages;
+    for (size_t i = first; i < frames.size(); ++i) {  // warm-up
+      pipeline.process(frames[i], robot_states[i], result);
+      monitor.decide(result, 0);
+    }
     double total_s = 0.0;
+    size_t decided_run = 0;
     for (int rep = 0; rep < kRepetitions; ++rep) {
       for (size_t i = first; i < frames.size(); ++i) {
         const Clock::time_point start = Clock::now();
-        pipeline.process(frames[i], robot_state, result);
-        const double us = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+        pipeline.process(frames[i], robot_states[i], result);
+        const Clock::time_point measured = Clock::now();
+        monitor.decide(result, 0);
+        const Clock::time_point decided = Clock::now();
+        const double us = std::chrono::duration<double, std::micro>(decided - start).count();
         latencies_us.push_back(us);
         total_s += us * 1e-6;
+        for (const StageTiming& timing : result.timings) add_stage(stages, timing.stage, timing.us);
+        add_stage(stages, "decision", std::chrono::duration<double, std::micro>(decided - measured).count());
+        decided_run += result.verdict.state == VerdictState::run ? 1 : 0;
       }
     }
     const double mean_ms = total_s * 1e3 / static_cast<double>(latencies_us.size());
@@ -118,6 +177,9 @@ int bench_command(const CommandArgs& args) {
     std::printf("frames/s      %.1f\n", static_cast<double>(latencies_us.size()) / total_s);
     std::printf("latency ms    mean %.3f  p50 %.3f  p99 %.3f\n", mean_ms, percentile_ms(latencies_us, 0.50),
                 percentile_ms(latencies_us, 0.99));
+    print_stage_medians(stages);
+    std::printf("verdicts      %zu of %zu timed frames run (%s mode)\n", decided_run, latencies_us.size(),
+                config.pipeline.safety.mode == SafetyParams::Mode::ssm ? "ssm" : "zones");
     std::printf("rendering     %.3f ms/frame (not included above)\n", render_s * 1e3 / static_cast<double>(frames.size()));
     std::printf("peak RSS      %.1f MiB (includes the pre-rendered frames)\n", peak_rss_mib());
     return 0;

@@ -159,7 +159,7 @@ void print_background(const Config& config, int64_t max_frames) {
     if (robot_states) robot_states->state_at(frame.timestamp_ns, state);
     pipeline.process(frame, state, result);
     ++frames;
-    learnt += result.verdict.code == ReasonCode::learning_background ? 1 : 0;
+    learnt += result.withheld_code == ReasonCode::learning_background ? 1 : 0;
   }
   if (!placed) std::printf("background: robot.state.source %s not connected: motion counted everywhere\n", state_source.c_str());
   // Every refused batch is background.frames learnt frames (a change of image size, which also

@@ -4,9 +4,19 @@
 #pragma once
 
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 
 namespace hrcsense {
+
+/// Seconds (a limit such as safety.max_frame_age_s, a nominal period) as ns. Not positive or NaN:
+/// 0 (every frame that took any time is then stale). At most 10^6 s, so that sums of run-clock
+/// times stay far inside int64.
+inline int64_t seconds_to_ns(double s) {
+  constexpr double kMaxS = 1e6;
+  if (!(s > 0.0)) return 0;
+  return static_cast<int64_t>(std::llround((s < kMaxS ? s : kMaxS) * 1e9));
+}
 
 /// The time source of run_pipeline. Times are integer nanoseconds from an arbitrary origin and
 /// never decrease. Implementations are called from the run's three threads at once.

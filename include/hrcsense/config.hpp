@@ -127,6 +127,10 @@ struct LinkConfig {
   /// `link.rtde.min_speed_slider`: the slider never goes below this fraction (a hard 0 then
   /// another value has caused protective stops); stops go through the register path.
   double rtde_min_speed_slider = 0.01;
+  /// `link.rtde.slider_unguarded_ok`: allow `speed_slider` in `safety.mode: ssm`. The slider
+  /// keeps its last value (1.0 after a `run`) when hrcsense dies, so it is refused there unless
+  /// the integrator has guarded it on the robot (docs/SAFETY.md) and says so here.
+  bool rtde_slider_unguarded_ok = false;
 };
 
 struct Config {

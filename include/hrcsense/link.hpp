@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — the verdict sent to the robot controller over UDP (`link.udp.*`, docs/SAFETY.md):
-// a fixed 41-byte little-endian datagram with a CRC-32, or the frame's JSON line.
+// a fixed 45-byte little-endian datagram (version 2, with the sender's session) with a CRC-32,
+// or the frame's JSON line.
 #pragma once
 
 #include "hrcsense/clock.hpp"
@@ -23,9 +24,10 @@ struct sockaddr_storage;  // <sys/socket.h>, kept out of this header
 namespace hrcsense {
 
 /// The datagram's total size in bytes, CRC included (docs/SAFETY.md has the byte offsets).
-inline constexpr size_t kLinkDatagramSize = 41;
-/// `version` of the layout below; a receiver rejects any other.
-inline constexpr uint16_t kLinkVersion = 1;
+inline constexpr size_t kLinkDatagramSize = 45;
+/// `version` of the layout below, the only one sent; a receiver rejects any other. Version 1
+/// (41 bytes, no session) let a restarted sender pass for the one that died: it is rejected.
+inline constexpr uint16_t kLinkVersion = 2;
 
 /// What a datagram stands for (`kind`, u16 at byte 6).
 enum class LinkKind : uint16_t {
@@ -37,7 +39,10 @@ enum class LinkKind : uint16_t {
 /// One datagram's values, before encoding or after decoding.
 struct LinkDatagram {
   LinkKind kind = LinkKind::frame;
-  uint32_t sequence = 0;       ///< +1 per datagram of any kind (wraps at 2^32)
+  /// The sender's process_session() (session.hpp): random, never 0 on the wire, one per process
+  /// start; a new value means a new sender whose sequence starts again.
+  uint32_t session = 0;
+  uint32_t sequence = 0;       ///< +1 per datagram of any kind within a session, from 0 (wraps at 2^32)
   int64_t timestamp_ns = 0;    ///< the frame's host time (FrameResult::host_time_ns), ns, >= 0
   VerdictState verdict = VerdictState::stop;
   ReasonCode reason = ReasonCode::no_frame;
@@ -54,31 +59,35 @@ using LinkBytes = std::array<uint8_t, kLinkDatagramSize>;
 /// xor 0xFFFFFFFF) of `size` bytes; `bytes` may be null when size is 0.
 uint32_t crc32_ieee(const uint8_t* bytes, size_t size);
 
-/// The datagram's bytes: little-endian, packed, CRC-32 of bytes 0..36 in bytes 37..40. The
-/// values are written as given (no validation: decode_link_datagram is the check).
+/// The datagram's bytes: little-endian, packed, the session in bytes 37..40, CRC-32 of bytes
+/// 0..40 in bytes 41..44. The values are written as given (no validation:
+/// decode_link_datagram is the check).
 LinkBytes encode_link_datagram(const LinkDatagram& datagram);
 
 /// What decode_link_datagram made of some bytes.
 struct LinkDecodeResult {
   bool ok = false;
   LinkDatagram datagram;  ///< valid only when ok
-  /// When !ok: the first problem, naming the field, e.g. "size: expected 41 bytes, got 40",
+  /// When !ok: the first problem, naming the field, e.g. "size: expected 45 bytes, got 44",
   /// "crc: 0x1234abcd in the datagram, 0x9f00e1c2 computed", "verdict: 7 is not 0, 1 or 2".
   std::string error;
 };
 
-/// Checks and reads one datagram (receivers, tests, the fuzzer): size, magic, version, CRC
-/// (before any value, so a damaged datagram reads as a CRC error), then every value: kind 1..3,
-/// verdict 0..2 and stop for heartbeats and final stops, a reason code hrcsense knows,
-/// timestamp >= 0, speed_scale in [0, 1], distance NaN or finite >= 0, protective distance
-/// finite >= 0. Never throws; `bytes` may be null when size is 0.
+/// Checks and reads one datagram (receivers, tests, the fuzzer): magic and version (another
+/// version is another layout, so they come before the size; version 1 is named as the old
+/// layout without a session), size, CRC (before any value, so a damaged datagram reads as a CRC
+/// error), then every value: kind 1..3, session non-zero, verdict 0..2 and stop for heartbeats
+/// and final stops, a reason code hrcsense knows, timestamp >= 0, speed_scale in [0, 1],
+/// distance NaN or finite >= 0, protective distance finite >= 0. Never throws; `bytes` may be
+/// null when size is 0. It checks one datagram; following a sender (session, sequence,
+/// timeout) is LinkReceiver's job (link_receiver.hpp).
 LinkDecodeResult decode_link_datagram(const uint8_t* bytes, size_t size);
 
 /// The datagram of a written verdict. Values a receiver would reject are made safe rather than
 /// sent: a non-finite speed scale is a stop for non_finite_input, the scale is clamped to
 /// [0, 1], a missing, negative or non-finite distance is NaN, a non-finite or negative
 /// protective distance 0, the robot state age rounded and saturated (unknown: 65535).
-LinkDatagram link_datagram_from(const FrameResult& result, LinkKind kind, uint32_t sequence);
+LinkDatagram link_datagram_from(const FrameResult& result, LinkKind kind, uint32_t session, uint32_t sequence);
 
 /// `link.udp.address` as a socket address: numeric IPv4 "a.b.c.d:port" or "[IPv6]:port", port
 /// 1..65535 (no name lookup). Throws std::invalid_argument naming link.udp.address otherwise.
@@ -91,6 +100,9 @@ struct UdpLinkParams {
   double heartbeat_hz = 20.0;  ///< `link.heartbeat_hz`, > 0
   /// json format: the proximity backend its lines name when no search ran (`proximity.backend`)
   std::string backend = "brute";
+  /// The datagrams' session; 0 (the default): process_session(), the same in the JSON Lines
+  /// header. Tests set one to tell two sinks apart.
+  uint32_t session = 0;
   /// How long, in real time, the sender thread waits at most before it reads the clock again:
   /// bounds how late a heartbeat is on a clock that jumps (a FakeClock in tests), ns.
   int64_t max_wait_ns = 2'000'000;
@@ -111,7 +123,9 @@ struct UdpLinkCounters {
 /// failed send is counted (counters()), never thrown; a sink whose link fails does not end
 /// the run (the controller stops on its own when datagrams stop arriving, docs/SAFETY.md).
 /// frame() and summary() come from the run's output thread; a sender thread writes the
-/// heartbeats; one mutex keeps the sequence in the order the datagrams leave.
+/// heartbeats; one mutex keeps the sequence in the order the datagrams leave. Every datagram
+/// carries the sink's session (json format: a `session` member), so that a receiver takes a
+/// restarted process for a new sender rather than for the dead one (LinkReceiver).
 class UdpLinkSink final : public Sink {
  public:
   /// Opens the socket and starts the heartbeat thread (its first heartbeat one period from
@@ -130,6 +144,8 @@ class UdpLinkSink final : public Sink {
 
   UdpLinkCounters counters() const;
   const std::string& address() const { return address_; }
+  /// The session every datagram of this sink carries (never 0).
+  uint32_t session() const { return session_; }
 
  private:
   void heartbeat_loop();
@@ -143,6 +159,7 @@ class UdpLinkSink final : public Sink {
   UdpLinkParams::Format format_;
   int64_t period_ns_;
   int64_t max_wait_ns_;
+  uint32_t session_;
   int fd_ = -1;
 
   mutable std::mutex mutex_;  // guards everything below

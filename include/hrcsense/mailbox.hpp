@@ -26,6 +26,22 @@ class Mailbox {
     ready_.notify_one();
     return true;
   }
+  /// Like put(), but a value about to be replaced is first handed to `merge(replaced, value)`
+  /// under the lock, so that what it said is carried into the value that replaces it (the
+  /// safety monitor's stops are never dropped unseen).
+  template <typename Merge>
+  bool put(T& value, Merge&& merge) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (closed_) return false;
+    if (full_) {
+      ++dropped_;
+      merge(static_cast<const T&>(slot_), value);
+    }
+    std::swap(slot_, value);
+    full_ = true;
+    ready_.notify_one();
+    return true;
+  }
   /// Like put(), but first waits until the slot is empty, so nothing is dropped: for unpaced
   /// runs, where the producer must wait for the consumer. False (value kept) once closed.
   bool put_wait(T& value) {

@@ -77,10 +77,13 @@ class Pipeline {
   void set_background(BackgroundModel model, std::string origin = "the loaded background");
   bool background_ready() const { return learner_.ready() || preset_background_; }
   const BackgroundModel& background() const;
-  /// Processes one frame into `result`, reusing its buffers. The robot's capsules are built
-  /// from `robot_state` (the arm's joints at the frame's time; ignored by robot.model points,
-  /// but an invalid state is a stop for every model), without allocating once sized.
-  void process(const Frame& frame, const RobotState& robot_state, FrameResult& result);
+  /// Measures one frame into `m`, reusing its buffers: validity (or why it is withheld), per
+  /// robot link the closest foreground point with its distance, the link point's speed towards
+  /// it and Z_d, the overall closest pair, unknown space, counts and timings. It decides
+  /// nothing: a SafetyMonitor turns `m` into the verdict. The robot's capsules are built from
+  /// `robot_state` (the arm's joints at the frame's time; ignored by robot.model points, but an
+  /// invalid state withholds the frame for every model), without allocating once sized.
+  void process(const Frame& frame, const RobotState& robot_state, Measurement& m);
   /// The tunable part of params() (LiveTuning).
   LiveTuning tuning() const;
   /// Takes `tuning` from the next frame on (call it between frames, on the processing thread).
@@ -119,27 +122,48 @@ class Pipeline {
   SelfFilter self_filter_;  ///< the arm's remembered poses rendered into the filtered frame
   BackgroundCheck check_;  ///< of a loaded background against the first frames
 
-  // The previous frame and contact, for the filters' lag and the contact's speed (Z_d).
+  // The previous frame, for the filters' lag, and per link its previous contact, for the
+  // contact's speed (Z_d).
+  struct PreviousContact {
+    bool seen = false;
+    int64_t timestamp_ns = 0;
+    float depth_m = 0.0F;
+  };
   bool have_previous_frame_ = false;
   int64_t previous_timestamp_ns_ = 0;
-  bool have_previous_contact_ = false;
-  int64_t previous_contact_ns_ = 0;
-  float previous_contact_depth_m_ = 0.0F;
+  std::vector<PreviousContact> previous_contacts_;  ///< by link index
+  std::vector<RobotModel> link_models_;  ///< robot_ split by link (buffers reused)
 
   std::vector<uint8_t> no_depth_frames_;  ///< per filtered pixel: frames in a row without depth
   std::vector<uint32_t> moved_reference_;  ///< moved_reference_pixels of the background in use
   bool moved_reference_ready_ = false;
 
+  // The stages of process(), in its order; each that fails withholds `m` with its reason.
+  /// Counts the raw invalid pixels and runs the filters; null when too little depth is left.
+  const Frame* filter(const Frame& source_frame, Measurement& m);
+  /// A learning frame: adds it to the learner (withheld).
+  void learn(const Frame& frame, const RobotState& robot_state, Measurement& m);
+  /// The background fits the frame, a loaded one is checked, and the camera sees the cell.
+  bool background_usable(const Frame& frame, Measurement& m);
+  /// The robot's capsules at a valid, finite state.
+  bool robot_placed(const RobotState& robot_state, Measurement& m);
+  /// The robot's envelope has depth enough (envelope_invalid).
+  bool envelope_seen(const Frame& frame, const RobotPixels* robot_pixels, Measurement& m);
+  /// The foreground against the background, less the robot's own pixels.
+  bool extract(const Frame& frame, const RobotPixels* robot_pixels, Measurement& m);
+  /// Measurement::links and the overall contact.
+  void search_links(Measurement& m);
+  void find_unknown_space(const Frame& frame, const RobotPixels* robot_pixels, Measurement& m);
+  /// v_i and Z_d of every link's contact.
+  void measure_links(const Frame& frame, const RobotState& robot_state, Measurement& m);
+  PreviousContact& previous_link_contact(int link);
   /// The image watchdogs that need only the background: camera_blocked, camera_moved.
-  bool camera_sees_the_cell(const Frame& frame, FrameResult& result);
-  /// Z_d and v_r of the frame's contact (FrameResult::distance_uncertainty_m,
-  /// robot_speed_towards_mps), NaN without a contact.
-  void measure_contact(const Frame& frame, const RobotState& robot_state, FrameResult& result);
-  bool enough_valid_depth(const Frame& frame, FrameResult& result) const;
+  bool camera_sees_the_cell(const Frame& frame, Measurement& m);
+  bool enough_valid_depth(const Frame& frame, Measurement& m) const;
   /// Remembers robot_ and renders the remembered poses into the filtered `frame`; the robot's
   /// pixels, or none without an arm.
-  std::optional<RobotPixels> render_robot(const Frame& frame, FrameResult& result);
-  bool background_checked(const Frame& frame, FrameResult& result);
+  std::optional<RobotPixels> render_robot(const Frame& frame, Measurement& m);
+  bool background_checked(const Frame& frame, Measurement& m);
 };
 
 struct RunOptions {
@@ -152,10 +176,11 @@ struct RunOptions {
   /// `robot.state.camera_latency_s`: the robot state is looked up this much before the frame's
   /// host time (positive: the camera's image is older than its stamp says).
   double camera_latency_s = 0.0;
-  /// Called on the processing thread with each frame, the pipeline and its result once the
-  /// verdict is final (stale check included), before the result goes to the output: the
-  /// viewer's tap (hrcsense-view). It delays the output by what it costs, so it must copy and
-  /// return, never wait (a headless snapshot, which waits on purpose, runs unpaced).
+  /// Called on the processing thread with each frame, the pipeline and its measurement (the
+  /// result before the SafetyMonitor decided it: its verdict is not yet set), before it goes to
+  /// the output: the viewer's tap (hrcsense-view), which takes the decided verdict from a sink
+  /// on the output thread. It delays the output by what it costs, so it must copy and return,
+  /// never wait.
   std::function<void(const Frame&, const Pipeline&, const FrameResult&)> on_processed;
   /// Called on the processing thread before each frame with the pipeline and the previous
   /// frame's result (a default, invalid one before the first): where the viewer's requests
@@ -175,8 +200,11 @@ bool host_time_is_source_time(RobotStateOrigin origin, bool paced);
 /// recorded, the latency already applied.
 int64_t robot_state_lookup_offset_ns(RobotStateOrigin origin, double camera_latency_s);
 
-/// Runs capture, processing and output on three threads joined by mailboxes. Unpaced runs
-/// process every frame (the source waits for processing); paced runs drop and count.
+/// Runs capture, processing and output on three threads joined by mailboxes. Processing
+/// measures (Pipeline::process); the output thread decides each measurement with one
+/// SafetyMonitor immediately before the sinks write it. Unpaced runs process every frame (the
+/// source waits for processing); paced runs drop and count, and a dropped measurement's verdict
+/// is carried into the next (carry_replaced).
 /// Each frame gets the robot state `robot_states` has at the frame's host time minus
 /// robot_state_lookup_offset_ns (camera_latency_s). The host time is the source's own (a live camera's capture time) when it
 /// sets Frame::host_time_ns; else the source timestamp with a `sim` state and for unpaced runs

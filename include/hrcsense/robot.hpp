@@ -221,6 +221,10 @@ struct TrajectorySample {
 /// Precondition: the trajectory is valid as RobotTrajectory says; an empty one gives zeros.
 TrajectorySample joints_at(const RobotTrajectory& trajectory, double t_s);
 
+/// `robot`'s capsules grouped by link (Capsule::link), one model per link in ascending link
+/// order, each keeping its capsules' order. Reuses `out`'s buffers: no allocation once sized.
+void split_by_link(const RobotModel& robot, std::vector<RobotModel>& out);
+
 /// The thesis's robot: one zero-length capsule per point (base frame), radius `padding_m`,
 /// link = the point's index.
 RobotModel robot_points(const std::vector<Eigen::Vector3f>& points_base, double padding_m);

@@ -11,6 +11,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace hrcsense {
 
@@ -61,13 +62,18 @@ struct VerdictInput {
   double frame_age_s = 0.0;      ///< the frame's age at the verdict: host time to now
 };
 
-/// The VerdictInput of a processed frame's result, its age at the verdict `frame_age_s`.
-VerdictInput verdict_input(const FrameResult& result, double frame_age_s);
+/// The VerdictInput of one link of a measurement (`link` null: the overall contact, with no
+/// speed or Z_d known), its age at the verdict `frame_age_s`.
+VerdictInput verdict_input(const Measurement& m, const LinkContact* link, double frame_age_s);
 
 /// The verdict and, in ssm mode with a contact, S_p's terms at the robot's present speed.
+/// For a measurement (decide_measurement): those of the governing link, and which it is.
 struct Decision {
   Verdict verdict;
   std::optional<SsmTerms> ssm;
+  int governing_link = -1;  ///< Capsule::link of the governing link; -1 without a contact
+  float distance_uncertainty_m = std::numeric_limits<float>::quiet_NaN();  ///< the governing link's Z_d
+  float robot_speed_towards_mps = std::numeric_limits<float>::quiet_NaN(); ///< the governing link's v_r
 };
 
 /// The verdict of a valid frame in `params.mode`: zones (verdict_for_contact) or ssm (stop
@@ -75,6 +81,21 @@ struct Decision {
 /// `speed_limited`; run otherwise), then the unknown-space policy. `distance_margin_m` is taken
 /// off the contact's distance (the hysteresis test of VerdictHold).
 Decision decide_verdict(const SafetyParams& params, const VerdictInput& input, float distance_margin_m = 0.0F);
+
+/// `safety.unknown_policy`: stop_within_m turns `verdict` into a stop (`unknown_space`) when
+/// unknown space lies within safety.unknown_stop_within_m (+ the margin) of the robot.
+void apply_unknown_policy(const SafetyParams& params, float unknown_distance_m, float distance_margin_m,
+                          Verdict& verdict);
+
+/// The decision on a measurement at age `frame_age_s` (s, host time to now), with no memory:
+/// a withheld measurement is a stop with its own reason; otherwise every link with a contact is
+/// decided on its own contact, speed towards it and Z_d (decide_verdict), and the strictest
+/// link governs: stop before slow before run, then the lowest speed scale, then the smallest
+/// d_i − S_p,i. The unknown-space policy applies once, after. `link_protective_distance_m`
+/// (optional) receives each link's S_p at its present speed, in the order of m.links.
+/// `out`'s buffers are reused.
+void decide_measurement(const SafetyParams& params, const Measurement& m, double frame_age_s, Decision& out,
+                        float distance_margin_m = 0.0F, std::vector<float>* link_protective_distance_m = nullptr);
 
 /// The verdict's memory over a run: entering a stricter state (run → slow → stop) is
 /// immediate; relaxing waits until min_hold_s has passed since the last frame that asked for
@@ -85,6 +106,9 @@ class VerdictHold {
   /// Replaces `decision` (the frame's own, from decide_verdict(params, input)) with the held
   /// one for a frame of host time `time_ns` (frames in time order).
   void apply(const SafetyParams& params, const VerdictInput& input, int64_t time_ns, Decision& decision);
+  /// The same with the frame's decision with the distance less hysteresis_m already made
+  /// (`with_margin`; a measurement's: decide_measurement with the margin).
+  void apply(const SafetyParams& params, const Decision& with_margin, int64_t time_ns, Decision& decision);
   /// A stop that no frame's verdict shows (the output's watchdog stop while no result came):
   /// held as if a frame of host time `time_ns` had asked for it, so that the frames after a
   /// silence relax no faster than after any other stop.
@@ -104,11 +128,61 @@ class VerdictHold {
   float held_scale_ = 0.0F;
 };
 
+/// Turns each measurement into the verdict, the speed scale and S_p, once, where the result is
+/// written (run_pipeline's output thread, immediately before the sinks): the frame's age is
+/// taken at that moment, so a measurement that waited in a mailbox or through a stalled process
+/// is judged at its real age. Owns the verdict's hold and the no-frame watchdog. One monitor
+/// per run; not thread-safe. A fuser of several cameras hands their measurements to one.
+class SafetyMonitor {
+ public:
+  /// `nominal_fps` and `frames_at_a_rate` (a live or paced source) set the no-frame watchdog:
+  /// safety.max_frame_age_s, or safety.max_frame_gap_periods nominal periods when shorter.
+  explicit SafetyMonitor(SafetyParams params, double nominal_fps = 0.0, bool frames_at_a_rate = false);
+  const SafetyParams& params() const { return params_; }
+  /// Decides `result` at run-clock time `now_ns`: a stop (`stale_frame`) when it was
+  /// delivered more than watchdog_after_ns() before (a frame older than the no-frame limit is
+  /// no fresher than no frame); T_r from its seen time
+  /// (Measurement::seen_ns; an age of 0 when not clocked); merged with the strictest of the
+  /// measurements it replaced (FrameResult::replaced); then held (VerdictHold) on the frame's
+  /// host time. Fills verdict, ssm, governing_link, the governing Z_d and v_r, frame_age_s.
+  void decide(FrameResult& result, int64_t now_ns);
+  /// How long the output may wait for a result before a no-frame stop (ns), and the rule that
+  /// says so (e.g. "max_frame_gap_periods 2 at 30 frames/s").
+  int64_t watchdog_after_ns() const { return watchdog_after_ns_; }
+  const char* watchdog_rule() const { return watchdog_rule_; }
+  /// The stop written when no result came for watchdog_after_ns() (reason `code`: no_frame or
+  /// camera_disconnected, with `reason`); the next frame's verdict holds it (VerdictHold::stop_at
+  /// at that frame's own time, later than the silence began: the cautious side).
+  Verdict silence(ReasonCode code, const std::string& reason);
+  /// Forgets the past (a new run).
+  void reset();
+
+ private:
+  SafetyParams params_;
+  VerdictHold hold_;
+  bool silence_pending_ = false;
+  int64_t watchdog_after_ns_ = 0;
+  char watchdog_rule_[64] = {};
+  Decision decision_;     ///< scratch: the frame's decision (buffers circulate with the results')
+  Decision with_margin_;  ///< scratch: the frame's decision with the hysteresis margin
+};
+
+/// Carries `replaced` (a measurement a mailbox is about to drop before anyone decided it) into
+/// `next` (the one that replaces it): decided by `monitor`'s rules without its memory at
+/// `now_ns` on the run's clock (stale included), and kept in next.replaced if it is the
+/// strictest so far (stop before slow before run, then the lowest scale). Called by the
+/// mailbox's producer under its lock; it reads only `monitor`'s constant settings, so it may
+/// run on another thread than the monitor's decide().
+void carry_replaced(const SafetyMonitor& monitor, const FrameResult& replaced, int64_t now_ns, FrameResult& next);
+
 /// A stop verdict with its code and a reason for people (empty: the code's name).
 Verdict stop_verdict(ReasonCode code, std::string reason = {});
 
 /// The stable snake_case name of a reason code ("in_stop_zone", "non_finite_input", ...).
 const char* reason_code_name(ReasonCode code);
+
+/// 0 run, 1 slow, 2 stop: a larger number is the stricter state.
+int verdict_strictness(VerdictState state);
 
 /// Name used in the output: "run", "slow", "stop".
 const char* verdict_name(VerdictState state);

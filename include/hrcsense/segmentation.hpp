@@ -167,8 +167,14 @@ struct ForegroundParams {
   /// max(k_sigma · learnt spread, k_sigma · σ_model(z), min_margin_m).
   float k_sigma = 4.0F;
   float min_margin_m = 0.02F;     ///< metres
-  /// Blobs whose physical size at their depth is below this are removed (speckles).
-  float min_object_mm = 40.0F;
+  /// Blobs whose physical size at their depth is below this are removed (speckles), mm. A blob's
+  /// size is the diameter of the disc of its pixel area at its mean depth z:
+  /// 2 · sqrt(pixels / π) · z / fx (8-connected pixels, split at depth jumps), so that it
+  /// compares with a detection capability d given as a test piece's diameter (ISO 13855).
+  /// 32 = 0.8 · the default d of 40 mm: a 40 mm sphere measures 35-45 mm (its visible cap's
+  /// mean depth is nearer than its outline, edge pixels drop out; docs/SAFETY.md, "C and the
+  /// detection capability"), so a threshold at d itself would remove it.
+  float min_object_mm = 32.0F;
   /// Where the background was never valid, a pixel counts only inside this box (base frame).
   /// Default: everywhere, so nothing unknown is ignored.
   AlignedBox workspace_base;

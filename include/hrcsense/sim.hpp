@@ -171,6 +171,9 @@ struct SimScratch {
   PointCloud points_camera;        ///< the same points, camera frame
   RobotModel arm_render;           ///< the moving arm's visual capsules this frame (SimArm)
   RobotModel arm_searched;         ///< its searched capsules this frame, for the truth contact
+  std::vector<RobotModel> truth_links;  ///< the truth's capsules split by link (GroundTruth::links)
+  RobotModel arm_nearby;           ///< the searched capsules a moment before or after (link speeds)
+  std::vector<RobotModel> nearby_links;  ///< arm_nearby split by link
   std::vector<float> label_z_m;    ///< hit_at()'s z-buffer
   int64_t label_index = -1;        ///< the frame hit_at() last cast (object_ids, label_z_m hold it); -1: none
 };

@@ -19,6 +19,9 @@ struct RunHeader {
   std::string version;  ///< empty: the JSON Lines sink writes the version it was built as
   std::string commit;   ///< empty: likewise the commit
   std::string config_hash;
+  /// The process's session (process_session(), session.hpp), the one the link's datagrams
+  /// carry, so a file and a receiver's log can be matched; 0: not known (written as null).
+  uint32_t session = 0;
   SourceInfo source;
   std::string robot_state;  ///< `robot.state.source` (fixed, sim, rtde, udp_json); empty: not written
   /// What the robot state source delivers beyond time-stamped joints: "robot_status" (frames

@@ -23,6 +23,10 @@ struct SsmParams {
   /// data); 0: stopping takes robot_stop_time_s whatever the speed.
   float robot_decel_mps2 = 0.0F;
   float detection_mm = 40.0F;         ///< d, the detection capability; C = 8·(d − 14) mm, ≥ 0, up to 40 mm; 850 mm beyond
+  /// `safety.detection_range_m`: the camera distance (m, along its axis) up to which detection_mm
+  /// holds for this camera and filter chain (docs/SAFETY.md, "C and the detection capability");
+  /// 0: not stated. A statement for the integrator; S_p does not use it.
+  float detection_range_m = 0.0F;
   float robot_uncertainty_m = 0.01F;  ///< Z_r, the robot's position uncertainty
 };
 

@@ -89,6 +89,13 @@ struct Contact {
   int pixel = -1;                                  ///< source pixel index (v * width + u), -1 if none
 };
 
+/// The simulator's truth for one robot link (GroundTruth::links).
+struct LinkTruth {
+  int link = -1;                   ///< robot link index (Capsule::link)
+  float distance_m = 0.0F;         ///< padded capsules to the nearest moving object's pixel, m
+  float speed_towards_mps = 0.0F;  ///< the link point's speed towards that pixel, m/s (negative: away)
+};
+
 /// What the simulator knows exactly about a frame it rendered.
 struct GroundTruth {
   std::vector<float> depth_m;    ///< noise-free Z per pixel, metres; 0 where nothing was hit
@@ -100,6 +107,11 @@ struct GroundTruth {
   Contact contact;
   /// Closest point over the analytic surfaces of non-static, non-robot objects, visible or not.
   Contact analytic_contact;
+  /// Per robot link (in link order, links with a capsule only): the distance from the link's
+  /// searched capsules to the nearest noise-free rendered pixel of a moving object and that
+  /// link point's speed towards it from the trajectory's joint velocities (`truth.links`).
+  /// Computed in the simulator's own code; empty when nothing moving was rendered.
+  std::vector<LinkTruth> links;
 };
 
 /// One depth frame from a source, with everything needed to interpret it.
@@ -257,16 +269,35 @@ struct StageTiming {
   double us = 0.0;    ///< microseconds
 };
 
-/// Everything a sink needs about one processed frame.
-struct FrameResult {
+/// One robot link's closest foreground point and what the decision needs of it
+/// (Measurement::links).
+struct LinkContact {
+  int link = -1;     ///< robot link index (Capsule::link): a UR link, the tool, or one point of robot.model points
+  Contact contact;   ///< the closest pair between the foreground and this link's capsules
+  /// v_i: the velocity of this link's closest point along the separation vector towards the
+  /// foreground point, m/s (negative: away; 0 for fixed points); NaN when not computed.
+  float speed_towards_mps = std::numeric_limits<float>::quiet_NaN();
+  /// Z_d of this contact (contact_uncertainty_m), m; NaN when not computed.
+  float distance_uncertainty_m = std::numeric_limits<float>::quiet_NaN();
+};
+
+/// What processing measured for one frame (Pipeline::process), before any decision: the
+/// SafetyMonitor turns it into the verdict on the output thread. Buffers are reused frame to
+/// frame. A camera's measurement is what a fuser of several cameras would receive.
+struct Measurement {
   int64_t frame = 0;          ///< source frame index
-  /// false for a verdict that stands for no new source frame (watchdog timeout, end of run);
+  /// false for a result that stands for no new source frame (watchdog timeout, end of run);
   /// it then repeats the last frame's index and timestamp.
   bool source_frame = true;
   int64_t timestamp_ns = 0;
-  bool valid = false;         ///< usable depth, processed, background ready
-  Verdict verdict;
-  Contact contact;            ///< contact.valid false when there is no foreground
+  /// Usable depth, processed, background ready: the contacts below can be decided on. False:
+  /// the measurement is withheld and `withheld_code` / `withheld_reason` say why (a stop).
+  bool valid = false;
+  ReasonCode withheld_code = ReasonCode::no_valid_depth;  ///< why not valid
+  std::string withheld_reason;                             ///< the same for people, with details
+  Contact contact;            ///< the overall closest pair; contact.valid false when there is no foreground
+  /// Per robot link with a measured contact, in link order (empty without foreground).
+  std::vector<LinkContact> links;
   size_t foreground_points = 0;
   /// Pixels the self-filter removed from the foreground (the robot's own); 0 without an arm.
   size_t self_filtered_pixels = 0;
@@ -279,22 +310,21 @@ struct FrameResult {
   int64_t host_time_ns = 0;      ///< the frame's host time (Frame::host_time_ns as the run set it)
   /// Frame host time minus robot_state.sample_time_ns, ≥ 0; 0 for a state that ages not.
   double robot_state_age_ms = 0.0;
+  /// Run-clock times of the frame, set by run_pipeline (`clocked`): when the source delivered
+  /// it (the stale limit counts from here) and when it was seen (its host time when the source
+  /// set one, else the delivery; T_r counts from here). Not clocked (a caller of
+  /// Pipeline::process alone): the decision takes an age of 0 and never calls it stale.
+  bool clocked = false;
+  int64_t delivered_ns = 0;
+  int64_t seen_ns = 0;
   std::optional<Contact> truth;  ///< simulated sources: ground-truth contact
+  std::vector<LinkTruth> truth_links;  ///< simulated sources: GroundTruth::links
   /// Simulated sources: the truth label's name under the measured contact's source pixel
   /// (`truth.contact_label`: "static", "robot" or the object's name); null when there is no
   /// measured contact or nobody set it. The pipeline leaves it alone: the app's truth-label
   /// sink (apps/common) sets it from the simulator; static text or owned by that sink.
   const char* truth_contact_label = nullptr;
-  double latency_us = 0.0;       ///< from the frame entering processing to the result
-  /// `safety.mode: ssm`, a valid frame with a contact: S_p's terms at the robot's present
-  /// speed (their sum is Verdict::protective_distance_m; the stop threshold is S_p at rest);
-  /// none otherwise.
-  std::optional<SsmTerms> ssm;
-  /// Z_d of the contact, m (computed in both modes); NaN without a measured contact.
-  float distance_uncertainty_m = std::numeric_limits<float>::quiet_NaN();
-  /// v_r: the robot's speed towards the contact at its closest point, m/s (negative: away);
-  /// NaN when not computed.
-  float robot_speed_towards_mps = std::numeric_limits<float>::quiet_NaN();
+  double latency_us = 0.0;       ///< from the frame entering processing to the measurement
   /// The robot's distance to the nearest unknown ray (docs/SAFETY.md), m; NaN: none known.
   float unknown_distance_m = std::numeric_limits<float>::quiet_NaN();
   /// The proximity backend that searched this frame (static name, e.g. "octree" when `auto`
@@ -303,6 +333,36 @@ struct FrameResult {
   /// Static text when the frame's source timestamp was out of order (backwards, repeated, a
   /// gap or a jump; RunSummary::timestamps counts them); null when in order.
   const char* timestamp_warning = nullptr;
+};
+
+/// The strictest of the measurements a mailbox replaced before they were decided
+/// (FrameResult::replaced): the result written next carries it.
+struct ReplacedVerdicts {
+  int64_t count = 0;                         ///< measurements replaced since the last decision
+  VerdictState state = VerdictState::run;    ///< the strictest of their verdicts (count > 0)
+  float speed_scale = 1.0F;                  ///< the lowest of their speed scales
+  ReasonCode code = ReasonCode::clear;       ///< the strictest verdict's reason
+  std::string reason;
+};
+
+/// Everything a sink needs about one frame: the measurement and the SafetyMonitor's decision.
+struct FrameResult : Measurement {
+  Verdict verdict;
+  /// `safety.mode: ssm`, a valid frame with a contact: the governing link's S_p terms at its
+  /// present speed (their sum is Verdict::protective_distance_m); none otherwise.
+  std::optional<SsmTerms> ssm;
+  /// The link whose d_i − S_p,i is smallest among the links with the strictest verdict: it
+  /// governs verdict and scale (`governing_link`); -1 without a contact.
+  int governing_link = -1;
+  /// Z_d of the governing link's contact, m; NaN without a measured contact.
+  float distance_uncertainty_m = std::numeric_limits<float>::quiet_NaN();
+  /// v_r of the governing link towards its contact, m/s (negative: away); NaN when not computed.
+  float robot_speed_towards_mps = std::numeric_limits<float>::quiet_NaN();
+  /// Per link with a contact (`links`): its S_p at its own present speed, m; same order as
+  /// Measurement::links.
+  std::vector<float> link_protective_distance_m;
+  double frame_age_s = 0.0;      ///< the frame's age when it was decided (host time to then)
+  ReplacedVerdicts replaced;     ///< measurements replaced before decision; merged into verdict
 };
 
 }  // namespace hrcsense

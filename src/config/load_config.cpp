@@ -176,14 +176,25 @@ void read_safety_behaviour(KeyReader& r, Config& c) {
   r.number_in("safety.robot_stop_time_s", ssm.robot_stop_time_s, 0.0, 10.0, " s");
   r.number("safety.robot_decel_mps2", ssm.robot_decel_mps2, Bound::non_negative, 1000.0F);
   r.number("safety.detection_mm", ssm.detection_mm, Bound::positive, 1000.0F);
+  // Where detection_mm was measured to hold (docs/SAFETY.md, "C and the detection capability"):
+  // a statement about the camera and filter chain for the integrator and the effective
+  // configuration, not a term of S_p; 0 (the default) leaves it unstated.
+  r.number("safety.detection_range_m", ssm.detection_range_m, Bound::non_negative, kMaxCoordinateM);
   r.number("safety.robot_uncertainty_m", ssm.robot_uncertainty_m, Bound::non_negative, 1.0F);
-  // The system cannot detect what it removes as speckle (foreground.min_object_mm). Checked
+  // The system cannot detect what it removes as speckle (foreground.min_object_mm), and a test
+  // piece of d measures less than d: the mean depth of a sphere's visible cap is nearer than its
+  // outline, and edge pixels drop out (35-45 mm for 40 mm on the simulated D435, docs/SAFETY.md,
+  // "C and the detection capability"). So the speckle threshold must stay 20 % below d. Checked
   // where C is used, in ssm mode: zones mode never reads detection_mm.
-  if (safety.mode == SafetyParams::Mode::ssm && ssm.detection_mm < c.pipeline.foreground.min_object_mm) {
+  constexpr float kSpeckleShareOfDetection = 0.8F;
+  const float max_min_object_mm = kSpeckleShareOfDetection * ssm.detection_mm;
+  if (safety.mode == SafetyParams::Mode::ssm && c.pipeline.foreground.min_object_mm > max_min_object_mm) {
     r.fail_pair("safety.detection_mm", "foreground.min_object_mm",
-                "expected detection_mm >= min_object_mm (objects smaller than min_object_mm are removed as "
-                "speckle, so they are not detected), got " + config_detail::float_text(ssm.detection_mm) + " < " +
-                    config_detail::float_text(c.pipeline.foreground.min_object_mm));
+                "expected min_object_mm <= 0.8 * detection_mm (a test piece of detection_mm measures down to about "
+                "0.88 of it, and blobs smaller than min_object_mm are removed as speckle, so they are not "
+                "detected), got min_object_mm " + config_detail::float_text(c.pipeline.foreground.min_object_mm) +
+                    " > " + config_detail::float_text(max_min_object_mm) + " (detection_mm " +
+                    config_detail::float_text(ssm.detection_mm) + ")");
   }
   // Relaxing waits by default in ssm mode (a verdict that flickers between slow and run jerks
   // the arm); zones mode keeps the thesis's frame-by-frame rule unless told otherwise.
@@ -228,8 +239,20 @@ void read_link(KeyReader& r, Config& c) {
   // Registers 0-23 belong to the controller's fieldbus adapters; 24-47 are free for RTDE clients.
   r.integer("link.rtde.register", link.rtde_register, 24, 47);
   r.number_in("link.rtde.min_speed_slider", link.rtde_min_speed_slider, 0.001, 1.0, "");
+  r.flag("link.rtde.slider_unguarded_ok", link.rtde_slider_unguarded_ok);
   if (link.rtde_write != "off" && c.robot_state.host.empty()) {
     r.fail_pair("link.rtde.write", "robot.state.host", "link.rtde.write needs the controller's address");
+  }
+  // The slider is a value the controller keeps: when hrcsense dies (kill -9, a crash, a lost
+  // host) it stays where the last write left it, 1.0 after a `run`, and nothing on the robot
+  // notices. In ssm mode the scale is the protection against the person, so the slider is
+  // refused there until the integrator has guarded it on the robot (docs/SAFETY.md) and says so.
+  if (link.rtde_write == "speed_slider" && c.pipeline.safety.mode == SafetyParams::Mode::ssm &&
+      !link.rtde_slider_unguarded_ok) {
+    r.fail_pair("link.rtde.write", "safety.mode",
+                "speed_slider in ssm mode keeps the robot at the last speed written (1.0 after a run) when "
+                "hrcsense dies; use link.rtde.write: register with a URScript and rtde_set_watchdog, or guard the "
+                "slider on the robot and set link.rtde.slider_unguarded_ok: true (docs/SAFETY.md)");
   }
 }
 

@@ -7,6 +7,7 @@
 #include "hrcsense/link.hpp"
 
 #include "hrcsense/safety.hpp"
+#include "hrcsense/session.hpp"
 #include "hrcsense/sinks.hpp"
 
 #include <arpa/inet.h>
@@ -30,10 +31,14 @@
 namespace hrcsense {
 namespace {
 
-// Byte offsets (docs/SAFETY.md's table).
+// Byte offsets (docs/SAFETY.md's version 2 table). Version 2 appends the session to version 1's
+// fields, so every other offset stayed where it was.
 constexpr size_t kMagicAt = 0, kVersionAt = 4, kKindAt = 6, kSequenceAt = 8, kTimestampAt = 12, kVerdictAt = 20,
-                 kReasonAt = 21, kSpeedScaleAt = 23, kDistanceAt = 27, kProtectiveAt = 31, kAgeAt = 35, kCrcAt = 37;
+                 kReasonAt = 21, kSpeedScaleAt = 23, kDistanceAt = 27, kProtectiveAt = 31, kAgeAt = 35,
+                 kSessionAt = 37, kCrcAt = 41;
 static_assert(kCrcAt + 4 == kLinkDatagramSize, "the CRC closes the datagram");
+constexpr uint16_t kVersionWithoutSession = 1;
+constexpr size_t kVersionWithoutSessionSize = 41;
 constexpr char kMagic[4] = {'H', 'R', 'C', 'S'};
 
 constexpr std::array<uint32_t, 256> make_crc_table() {
@@ -115,19 +120,29 @@ LinkBytes encode_link_datagram(const LinkDatagram& d) {
   put_le(bytes.data() + kDistanceAt, float_bits(d.distance_m), 4);
   put_le(bytes.data() + kProtectiveAt, float_bits(d.protective_distance_m), 4);
   put_le(bytes.data() + kAgeAt, d.robot_state_age_ms, 2);
+  put_le(bytes.data() + kSessionAt, d.session, 4);
   put_le(bytes.data() + kCrcAt, crc32_ieee(bytes.data(), kCrcAt), 4);
   return bytes;
 }
 
 LinkDecodeResult decode_link_datagram(const uint8_t* bytes, size_t size) {
-  if (size != kLinkDatagramSize) {
+  const auto size_error = [size] {
     return fail("size: expected " + std::to_string(kLinkDatagramSize) + " bytes, got " + std::to_string(size));
-  }
+  };
+  // Magic and version first: another version is another layout, whose size says nothing, and a
+  // version 1 sender (no session) should be named as such rather than as 4 bytes short.
+  if (size < kKindAt) return size_error();
   if (std::memcmp(bytes + kMagicAt, kMagic, sizeof kMagic) != 0) return fail("magic: expected \"HRCS\"");
   const auto version = static_cast<uint16_t>(get_le(bytes + kVersionAt, 2));
+  if (version == kVersionWithoutSession) {
+    return fail("version: 1 is the " + std::to_string(kVersionWithoutSessionSize) +
+                "-byte layout without a session, which cannot tell a restarted sender from the one that died; "
+                "expected " + std::to_string(kLinkVersion) + " (update the sender)");
+  }
   if (version != kLinkVersion) {
     return fail("version: " + std::to_string(version) + ", expected " + std::to_string(kLinkVersion));
   }
+  if (size != kLinkDatagramSize) return size_error();
   const auto sent_crc = static_cast<uint32_t>(get_le(bytes + kCrcAt, 4));
   const uint32_t crc = crc32_ieee(bytes, kCrcAt);
   if (sent_crc != crc) return fail("crc: " + hex32(sent_crc) + " in the datagram, " + hex32(crc) + " computed");
@@ -137,6 +152,8 @@ LinkDecodeResult decode_link_datagram(const uint8_t* bytes, size_t size) {
   const auto kind = static_cast<uint16_t>(get_le(bytes + kKindAt, 2));
   if (kind < 1 || kind > 3) return fail("kind: " + std::to_string(kind) + " is not 1, 2 or 3");
   d.kind = static_cast<LinkKind>(kind);
+  d.session = static_cast<uint32_t>(get_le(bytes + kSessionAt, 4));
+  if (d.session == 0) return fail("session: 0 is never sent (a sender draws a non-zero session at start)");
   d.sequence = static_cast<uint32_t>(get_le(bytes + kSequenceAt, 4));
   d.timestamp_ns = static_cast<int64_t>(get_le(bytes + kTimestampAt, 8));
   if (d.timestamp_ns < 0) return fail("timestamp_ns: " + std::to_string(d.timestamp_ns) + " is negative");
@@ -167,9 +184,10 @@ LinkDecodeResult decode_link_datagram(const uint8_t* bytes, size_t size) {
   return result;
 }
 
-LinkDatagram link_datagram_from(const FrameResult& result, LinkKind kind, uint32_t sequence) {
+LinkDatagram link_datagram_from(const FrameResult& result, LinkKind kind, uint32_t session, uint32_t sequence) {
   LinkDatagram d;
   d.kind = kind;
+  d.session = session;
   d.sequence = sequence;
   d.timestamp_ns = std::max<int64_t>(0, result.host_time_ns);
   d.verdict = result.verdict.state;
@@ -234,16 +252,22 @@ sockaddr_storage parse_link_address(const std::string& address, unsigned& length
 // so a frame allocates nothing once the longest line has been seen).
 class UdpLinkSink::JsonFrames {
  public:
-  explicit JsonFrames(const std::string& backend) : stream_(&buffer_), sink_(stream_, backend) {}
+  JsonFrames(const std::string& backend, uint32_t session)
+      : stream_(&buffer_), sink_(stream_, backend), session_member_("\"session\":" + std::to_string(session) + ",") {}
   void header(const RunHeader& header) {
     sink_.header(header);  // the sink learns what frames carry (robot_status); the line is not sent
     buffer_.text.clear();
   }
-  /// The frame's line without its newline.
+  /// The frame's line without its newline, with `"session":N` after its first member (`type`),
+  /// so that a json receiver can tell a restarted sender too. The line is the JSON Lines
+  /// sink's, whose first member is always `"type":"frame"` or `"type":"verdict"` (no comma
+  /// inside), so the first comma ends it.
   std::string_view line(const FrameResult& result) {
     buffer_.text.clear();
     stream_.clear();
     sink_.frame(result);
+    const size_t first_comma = buffer_.text.find(',');
+    if (first_comma != std::string::npos) buffer_.text.insert(first_comma + 1, session_member_);
     std::string_view text = buffer_.text;
     if (!text.empty() && text.back() == '\n') text.remove_suffix(1);
     return text;
@@ -264,6 +288,7 @@ class UdpLinkSink::JsonFrames {
   Buffer buffer_;
   std::ostream stream_;
   JsonLinesSink sink_;
+  std::string session_member_;  ///< `"session":N,`
 };
 
 UdpLinkSink::UdpLinkSink(const UdpLinkParams& params, const RunClock& clock)
@@ -271,13 +296,14 @@ UdpLinkSink::UdpLinkSink(const UdpLinkParams& params, const RunClock& clock)
       address_(params.address),
       format_(params.format),
       period_ns_(std::max<int64_t>(1, std::llround(1e9 / params.heartbeat_hz))),
-      max_wait_ns_(std::max<int64_t>(1, params.max_wait_ns)) {
+      max_wait_ns_(std::max<int64_t>(1, params.max_wait_ns)),
+      session_(params.session != 0 ? params.session : process_session()) {
   if (!(params.heartbeat_hz > 0.0) || !std::isfinite(params.heartbeat_hz)) {
     throw std::invalid_argument("link.heartbeat_hz: expected a positive rate");
   }
   unsigned length = 0;
   const sockaddr_storage destination = parse_link_address(address_, length);
-  if (format_ == UdpLinkParams::Format::json) json_ = std::make_unique<JsonFrames>(params.backend);
+  if (format_ == UdpLinkParams::Format::json) json_ = std::make_unique<JsonFrames>(params.backend, session_);
   fd_ = ::socket(destination.ss_family, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   if (fd_ < 0) {
     throw std::runtime_error("link.udp.address '" + address_ + "': socket: " + std::system_category().message(errno));
@@ -367,24 +393,25 @@ void UdpLinkSink::send_locked(LinkKind kind, const FrameResult* result, ReasonCo
     return;
   }
   if (json_) {
-    // {"type":"heartbeat"|"final_stop","sequence":N,"timestamp_ns":T,"verdict":"stop","reason_code":"..."}
+    // {"type":"heartbeat"|"final_stop","session":S,"sequence":N,"timestamp_ns":T,"verdict":"stop","reason_code":"..."}
     char text[256];
     const int n = std::snprintf(text, sizeof text,
-                                "{\"type\":\"%s\",\"sequence\":%u,\"timestamp_ns\":%lld,\"verdict\":\"stop\","
-                                "\"reason_code\":\"%s\"}",
-                                kind == LinkKind::heartbeat ? "heartbeat" : "final_stop", sequence,
+                                "{\"type\":\"%s\",\"session\":%u,\"sequence\":%u,\"timestamp_ns\":%lld,"
+                                "\"verdict\":\"stop\",\"reason_code\":\"%s\"}",
+                                kind == LinkKind::heartbeat ? "heartbeat" : "final_stop", session_, sequence,
                                 static_cast<long long>(last_timestamp_ns_), reason_code_name(reason));
     send_bytes_locked(text, static_cast<size_t>(std::clamp(n, 0, static_cast<int>(sizeof text) - 1)), kind);
     return;
   }
   LinkDatagram d;
   if (result != nullptr) {
-    d = link_datagram_from(*result, kind, sequence);
+    d = link_datagram_from(*result, kind, session_, sequence);
   } else {
     // Heartbeat and final stop: fail safe. The link is alive, but no fresh verdict exists, so
     // the datagram says stop, stamped with the last frame's time so that a receiver can tell
     // how old the last real verdict is.
     d.kind = kind;
+    d.session = session_;
     d.sequence = sequence;
     d.timestamp_ns = last_timestamp_ns_;
     d.verdict = VerdictState::stop;

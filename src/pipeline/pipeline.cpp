@@ -39,52 +39,56 @@ size_t count_invalid(const DepthImage& depth) {
   return invalid;
 }
 
-// Sets `verdict` to a stop with `code` and `reason`, reusing the reason's buffer.
-void set_stop(Verdict& verdict, ReasonCode code, const char* reason) {
-  verdict.state = VerdictState::stop;
-  verdict.speed_scale = 0.0F;
-  verdict.protective_distance_m = 0.0F;
-  verdict.code = code;
-  verdict.reason.assign(reason);
+// Withholds the measurement: not valid, with `code` and `reason` (the reason's buffer reused).
+void withhold(Measurement& m, ReasonCode code, const char* reason) {
+  m.valid = false;
+  m.withheld_code = code;
+  m.withheld_reason.assign(reason);
 }
 
 // Runs `stage` and appends its duration under the static name `name`.
 template <typename Stage>
-void timed(FrameResult& result, const char* name, Stage&& stage) {
+void timed(Measurement& m, const char* name, Stage&& stage) {
   const Clock::time_point start = Clock::now();
   stage();
-  result.timings.push_back({name, elapsed_us(start)});
+  m.timings.push_back({name, elapsed_us(start)});
 }
 
-// Resets the per-frame fields of `result`, keeping its buffers.
-void begin_result(const Frame& frame, const RobotState& robot_state, FrameResult& result) {
-  result.frame = frame.index;
-  result.robot_state = robot_state;
-  result.host_time_ns = frame.host_time_ns;
-  result.robot_state_age_ms =
+// Resets the per-frame fields of `m`, keeping its buffers.
+void begin_measurement(const Frame& frame, const RobotState& robot_state, Measurement& m) {
+  m.frame = frame.index;
+  m.source_frame = true;
+  m.clocked = false;  // run_pipeline sets the run-clock times after processing
+  m.robot_state = robot_state;
+  m.host_time_ns = frame.host_time_ns;
+  m.robot_state_age_ms =
       robot_state.sample_time_ns > 0
           ? static_cast<double>(std::max<int64_t>(0, frame.host_time_ns - robot_state.sample_time_ns)) * 1e-6
           : 0.0;
-  result.timestamp_ns = frame.timestamp_ns;
-  result.valid = false;
-  result.contact = Contact{};
-  result.backend = nullptr;
-  result.foreground_points = 0;
-  result.self_filtered_pixels = 0;
-  result.invalid_pixels = 0;
-  result.valid_share = 0.0F;
-  result.timings.clear();  // keeps its capacity: one entry per filter block and stage after the first frame
-  result.truth.reset();
-  if (frame.truth) result.truth = frame.truth->contact;
-  result.ssm.reset();
-  result.distance_uncertainty_m = std::numeric_limits<float>::quiet_NaN();
-  result.robot_speed_towards_mps = std::numeric_limits<float>::quiet_NaN();
-  result.unknown_distance_m = std::numeric_limits<float>::quiet_NaN();
+  m.timestamp_ns = frame.timestamp_ns;
+  m.valid = false;
+  m.withheld_code = ReasonCode::no_valid_depth;
+  m.withheld_reason.clear();
+  m.contact = Contact{};
+  m.links.clear();  // keeps its capacity: one entry per link after the first frames
+  m.backend = nullptr;
+  m.foreground_points = 0;
+  m.self_filtered_pixels = 0;
+  m.invalid_pixels = 0;
+  m.valid_share = 0.0F;
+  m.timings.clear();  // keeps its capacity: one entry per filter block and stage after the first frame
+  m.truth.reset();
+  m.truth_links.clear();
+  if (frame.truth) {
+    m.truth = frame.truth->contact;
+    m.truth_links.assign(frame.truth->links.begin(), frame.truth->links.end());
+  }
+  m.unknown_distance_m = std::numeric_limits<float>::quiet_NaN();
 }
 
-// v_r: the velocity of the arm's closest point projected on the direction from it to the
-// contact (positive: towards the person). 0 for fixed capsules (robot.model points) and for a
-// contact on the capsule's axis (no direction: the speed along it is then the full speed).
+// v_i: the velocity of a link's closest point projected on the direction from it to its
+// contact (positive: towards the person). 0 for fixed capsules (robot.model points); for a
+// contact on the capsule's axis (no direction) the full speed.
 float robot_speed_towards(const RobotParams& robot, const RobotState& state, const Contact& contact) {
   if (!robot.arm) return 0.0F;
   const Eigen::Vector3d robot_point = contact.closest_robot_base.cast<double>();
@@ -110,25 +114,25 @@ double temporal_lag_s(const FilterChainParams& filters, double frame_period_s) {
   return (1.0 - alpha) / alpha * frame_period_s;
 }
 
-// The stop verdict of a learning frame, with the learner's last restart message if any.
+// The withheld measurement of a learning frame, with the learner's last restart message if any.
 // Formatted into a stack buffer and assigned, so the reason's buffer is reused.
-void set_learning(Verdict& verdict, int frames_seen, int frames_total, const std::string& message) {
+void set_learning(Measurement& m, int frames_seen, int frames_total, const std::string& message) {
   char text[96];
   std::snprintf(text, sizeof text, "learning background (%d/%d frames)", frames_seen, frames_total);
-  set_stop(verdict, ReasonCode::learning_background, text);
+  withhold(m, ReasonCode::learning_background, text);
   if (!message.empty()) {
-    verdict.reason.append("; restarted: ");
-    verdict.reason.append(message);
+    m.withheld_reason.append("; restarted: ");
+    m.withheld_reason.append(message);
   }
 }
 
-// Adds a frame to the learner and sets the learning verdict. The frame that completes the
-// model is a learning frame too, so it stays invalid like the ones before it.
+// Adds a frame to the learner and withholds the frame. The frame that completes the model is
+// a learning frame too, so it stays withheld like the ones before it.
 void learn_background(BackgroundLearner& learner, const Frame& frame, const MotionRegion* region,
-                      const RobotPixels* robot, Verdict& verdict) {
+                      const RobotPixels* robot, Measurement& m) {
   const int frames_total = learner.params.frames;
   const bool completed = learner.add(frame, region, robot) == BackgroundLearner::Status::ready;
-  set_learning(verdict, completed ? frames_total : learner.frames_seen(), frames_total, learner.message());
+  set_learning(m, completed ? frames_total : learner.frames_seen(), frames_total, learner.message());
 }
 
 bool same_size(const BackgroundModel& model, const DepthImage& depth) {
@@ -147,21 +151,13 @@ bool extract_foreground(ForegroundExtractor& extractor, const BackgroundModel& b
 
 // The depth filters, one timing per block named after it; the source frame itself when the
 // chain is empty (no copy).
-const Frame& run_filters(FilterChain& chain, const Frame& frame, Frame& filtered, FrameResult& result) {
+const Frame& run_filters(FilterChain& chain, const Frame& frame, Frame& filtered, Measurement& m) {
   if (chain.params.order.empty()) return frame;
   chain.start(frame, filtered);
   for (size_t i = 0; i < chain.block_count(); ++i) {
-    timed(result, filter_block_name(chain.block(i)), [&] { chain.run_block(i, filtered); });
+    timed(m, filter_block_name(chain.block(i)), [&] { chain.run_block(i, filtered); });
   }
   return filtered;
-}
-
-// Latency from the frame entering processing to its result.
-void finish(FrameResult& result, Clock::time_point start) { result.latency_us = elapsed_us(start); }
-
-void finish_stop(FrameResult& result, ReasonCode code, const char* reason, Clock::time_point start) {
-  set_stop(result.verdict, code, reason);
-  finish(result, start);
 }
 
 // The configured backend; config validates the name first, so a bad one here is a caller's bug.
@@ -218,9 +214,9 @@ void Pipeline::relearn_background() {
   filters_.reset();  // the temporal filter's history holds the scene as it was
 }
 
-std::optional<RobotPixels> Pipeline::render_robot(const Frame& frame, FrameResult& result) {
+std::optional<RobotPixels> Pipeline::render_robot(const Frame& frame, Measurement& m) {
   if (!params_.robot.arm) return std::nullopt;
-  timed(result, "self_filter", [&] {
+  timed(m, "self_filter", [&] {
     self_filter_.add_pose(robot_);
     self_filter_.render(frame, params_.T_base_camera, params_.foreground);
   });
@@ -253,98 +249,139 @@ const BackgroundModel& Pipeline::background() const {
   return preset_background_ ? preset_model_ : learner_.model();
 }
 
-// One line per stage; every early return leaves a stop verdict with its reason.
-void Pipeline::process(const Frame& source_frame, const RobotState& robot_state, FrameResult& result) {
+// One line per stage; a stage that cannot go on withholds the measurement with its reason.
+void Pipeline::process(const Frame& source_frame, const RobotState& robot_state, Measurement& m) {
   const Clock::time_point start = Clock::now();
-  begin_result(source_frame, robot_state, result);
-  result.invalid_pixels = count_invalid(source_frame.depth);
-  if (result.invalid_pixels == source_frame.depth.pixels.size()) {
-    return finish_stop(result, ReasonCode::no_valid_depth, "no valid depth", start);
-  }
-  const Frame& frame = run_filters(filters_, source_frame, filtered_, result);
-  count_no_depth_frames(frame.depth, no_depth_frames_);  // for unknown space; every filtered frame counts
-  if (!enough_valid_depth(frame, result)) return finish(result, start);
-  if (!background_ready()) {
-    // Motion counts near the robot where it is now, and the robot's own pixels are no samples;
-    // without a usable state, motion counts everywhere.
-    const bool placed = robot_state.valid && all_finite(robot_state.q_rad);
-    std::optional<RobotPixels> robot_pixels;
-    if (placed) {
-      robot_model_at(params_.robot, robot_state.q_rad, robot_);
-      robot_pixels = render_robot(frame, result);
-    } else {
-      self_filter_.clear_poses();
+  begin_measurement(source_frame, robot_state, m);
+  const Frame* frame = filter(source_frame, m);
+  if (frame != nullptr && !background_ready()) {
+    learn(*frame, robot_state, m);
+  } else if (frame != nullptr && background_usable(*frame, m) && robot_placed(robot_state, m)) {
+    const std::optional<RobotPixels> robot_pixels = render_robot(*frame, m);
+    const RobotPixels* pixels = robot_pixels ? &*robot_pixels : nullptr;
+    if (envelope_seen(*frame, pixels, m) && extract(*frame, pixels, m)) {
+      timed(m, "proximity", [&] { search_links(m); });
+      timed(m, "unknown_space", [&] { find_unknown_space(*frame, pixels, m); });
+      timed(m, "safety", [&] { measure_links(*frame, robot_state, m); });
+      m.valid = true;
     }
-    timed(result, "background", [&] {
-      const MotionRegion region{params_.T_base_camera, placed ? &robot_ : nullptr, params_.foreground.workspace_base};
-      learn_background(learner_, frame, &region, robot_pixels ? &*robot_pixels : nullptr, result.verdict);
-    });
-    return finish(result, start);
   }
+  m.latency_us = elapsed_us(start);
+}
+
+const Frame* Pipeline::filter(const Frame& source_frame, Measurement& m) {
+  m.invalid_pixels = count_invalid(source_frame.depth);
+  if (m.invalid_pixels == source_frame.depth.pixels.size()) {
+    withhold(m, ReasonCode::no_valid_depth, "no valid depth");
+    return nullptr;
+  }
+  const Frame& frame = run_filters(filters_, source_frame, filtered_, m);
+  count_no_depth_frames(frame.depth, no_depth_frames_);  // for unknown space; every filtered frame counts
+  return enough_valid_depth(frame, m) ? &frame : nullptr;
+}
+
+// Motion counts near the robot where it is now, and the robot's own pixels are no samples;
+// without a usable state, motion counts everywhere.
+void Pipeline::learn(const Frame& frame, const RobotState& robot_state, Measurement& m) {
+  const bool placed = robot_state.valid && all_finite(robot_state.q_rad);
+  std::optional<RobotPixels> robot_pixels;
+  if (placed) {
+    robot_model_at(params_.robot, robot_state.q_rad, robot_);
+    robot_pixels = render_robot(frame, m);
+  } else {
+    self_filter_.clear_poses();
+  }
+  timed(m, "background", [&] {
+    const MotionRegion region{params_.T_base_camera, placed ? &robot_ : nullptr, params_.foreground.workspace_base};
+    learn_background(learner_, frame, &region, robot_pixels ? &*robot_pixels : nullptr, m);
+  });
+}
+
+bool Pipeline::background_usable(const Frame& frame, Measurement& m) {
   if (!same_size(background(), frame.depth)) {
-    return finish_stop(result, ReasonCode::background_mismatch, "background size mismatch", start);
+    withhold(m, ReasonCode::background_mismatch, "background size mismatch");
+    return false;
   }
-  if (!background_checked(frame, result)) return finish(result, start);
-  if (!camera_sees_the_cell(frame, result)) return finish(result, start);
+  return background_checked(frame, m) && camera_sees_the_cell(frame, m);
+}
+
+// The robot's capsules at the frame's state; a missing, stale or non-finite state withholds.
+bool Pipeline::robot_placed(const RobotState& robot_state, Measurement& m) {
   if (!robot_state.valid || !all_finite(robot_state.q_rad)) self_filter_.clear_poses();  // its poses are history
   if (!robot_state.valid) {
     // A state with a sample time had samples that are now too old; one without never had any.
     if (robot_state.sample_time_ns > 0) {
       char text[64];
-      std::snprintf(text, sizeof text, "robot state stale (%.1f ms old)", result.robot_state_age_ms);
-      return finish_stop(result, ReasonCode::robot_state_stale, text, start);
+      std::snprintf(text, sizeof text, "robot state stale (%.1f ms old)", m.robot_state_age_ms);
+      withhold(m, ReasonCode::robot_state_stale, text);
+    } else {
+      withhold(m, ReasonCode::no_robot_state, "no robot state");
     }
-    return finish_stop(result, ReasonCode::no_robot_state, "no robot state", start);
+    return false;
   }
   if (!all_finite(robot_state.q_rad)) {
-    return finish_stop(result, ReasonCode::non_finite_input, "non-finite joint angle in the robot state", start);
+    withhold(m, ReasonCode::non_finite_input, "non-finite joint angle in the robot state");
+    return false;
   }
   robot_model_at(params_.robot, robot_state.q_rad, robot_);
-  if (robot_.capsules.empty()) return finish_stop(result, ReasonCode::no_robot_model, "no robot model", start);
-  const std::optional<RobotPixels> robot_pixels = render_robot(frame, result);
-  const RobotPixels* self_filter = params_.self_filter.enabled && robot_pixels ? &*robot_pixels : nullptr;
-  if (robot_pixels) {
-    // A person next to the arm may hide in depth the camera cannot measure there.
-    const EnvelopeCount envelope = envelope_invalid(frame.depth, background(), &*robot_pixels);
-    if (envelope.share() > params_.checks.max_envelope_invalid_share) {
-      char text[96];
-      std::snprintf(text, sizeof text, "%.0f %% of the robot's envelope without depth (max_envelope_invalid_share %.2f)",
-                    100.0 * envelope.share(), static_cast<double>(params_.checks.max_envelope_invalid_share));
-      return finish_stop(result, ReasonCode::envelope_invalid, text, start);
-    }
+  if (robot_.capsules.empty()) {
+    withhold(m, ReasonCode::no_robot_model, "no robot model");
+    return false;
   }
-  bool extracted = false;
-  timed(result, "foreground", [&] {
-    extracted = extract_foreground(extractor_, background(), frame, params_.T_base_camera, self_filter, foreground_);
-  });
-  result.self_filtered_pixels = foreground_.self_filtered_pixels;
-  if (!extracted) {
-    return finish_stop(result, ReasonCode::foreground_failed, "foreground extraction failed", start);
-  }
-  timed(result, "proximity", [&] {
-    result.contact = proximity_.closest(foreground_.points_base, foreground_.points_camera, robot_);
-    result.backend = proximity_backend_name(proximity_.last_backend());
-  });
-  result.foreground_points = foreground_.points_base.size();
-  timed(result, "unknown_space", [&] {
-    const UnknownSpace unknown = unknown_space(frame.depth, frame.intrinsics, background(), foreground_.mask,
-                                               robot_pixels ? &*robot_pixels : nullptr, params_.T_base_camera, robot_,
-                                               frame.stereo_baseline_mm * 1e-3F, no_depth_frames_);
-    result.unknown_distance_m = unknown.distance_m;
-  });
-  timed(result, "safety", [&] {
-    measure_contact(frame, robot_state, result);
-    const Decision decision =
-        decide_verdict(params_.safety, verdict_input(result, static_cast<double>(elapsed_us(start)) * 1e-6));
-    result.verdict = decision.verdict;
-    result.ssm = decision.ssm;
-  });
-  result.valid = true;
-  finish(result, start);
+  return true;
 }
 
-void Pipeline::measure_contact(const Frame& frame, const RobotState& robot_state, FrameResult& result) {
-  const Contact& contact = result.contact;
+// A person next to the arm may hide in depth the camera cannot measure there.
+bool Pipeline::envelope_seen(const Frame& frame, const RobotPixels* robot_pixels, Measurement& m) {
+  if (robot_pixels == nullptr) return true;
+  const EnvelopeCount envelope = envelope_invalid(frame.depth, background(), robot_pixels);
+  if (!(envelope.share() > params_.checks.max_envelope_invalid_share)) return true;
+  char text[96];
+  std::snprintf(text, sizeof text, "%.0f %% of the robot's envelope without depth (max_envelope_invalid_share %.2f)",
+                100.0 * envelope.share(), static_cast<double>(params_.checks.max_envelope_invalid_share));
+  withhold(m, ReasonCode::envelope_invalid, text);
+  return false;
+}
+
+bool Pipeline::extract(const Frame& frame, const RobotPixels* robot_pixels, Measurement& m) {
+  const RobotPixels* self_filter = params_.self_filter.enabled ? robot_pixels : nullptr;
+  bool extracted = false;
+  timed(m, "foreground", [&] {
+    extracted = extract_foreground(extractor_, background(), frame, params_.T_base_camera, self_filter, foreground_);
+  });
+  m.self_filtered_pixels = foreground_.self_filtered_pixels;
+  m.foreground_points = foreground_.points_base.size();
+  if (!extracted) withhold(m, ReasonCode::foreground_failed, "foreground extraction failed");
+  return extracted;
+}
+
+// Per link, the closest pair of the foreground and that link's capsules (each backend is
+// exact on any set of capsules); the overall pair is the closest of them, the lower link on a
+// tie.
+void Pipeline::search_links(Measurement& m) {
+  split_by_link(robot_, link_models_);
+  for (const RobotModel& link_model : link_models_) {
+    const Contact contact = proximity_.closest(foreground_.points_base, foreground_.points_camera, link_model);
+    m.backend = proximity_backend_name(proximity_.last_backend());
+    if (!contact.valid) continue;
+    LinkContact link;
+    link.link = link_model.capsules.front().link;
+    link.contact = contact;
+    m.links.push_back(link);
+    // NaN distances never win, so a non-finite contact cannot hide a finite one.
+    if (!m.contact.valid || contact.distance_m < m.contact.distance_m) m.contact = contact;
+  }
+}
+
+void Pipeline::find_unknown_space(const Frame& frame, const RobotPixels* robot_pixels, Measurement& m) {
+  const UnknownSpace unknown = unknown_space(frame.depth, frame.intrinsics, background(), foreground_.mask,
+                                             robot_pixels, params_.T_base_camera, robot_,
+                                             frame.stereo_baseline_mm * 1e-3F, no_depth_frames_);
+  m.unknown_distance_m = unknown.distance_m;
+}
+
+// Per link: v_i of its closest point towards its contact and Z_d of that contact.
+void Pipeline::measure_links(const Frame& frame, const RobotState& robot_state, Measurement& m) {
   // The period between frames, for the filter's lag; the nominal 30 frames/s until two frames
   // were seen, and never more than a second (a pause in a replay).
   double period_s = 1.0 / 30.0;
@@ -353,13 +390,7 @@ void Pipeline::measure_contact(const Frame& frame, const RobotState& robot_state
   }
   have_previous_frame_ = true;
   previous_timestamp_ns_ = frame.timestamp_ns;
-  if (!contact.valid || contact.inside || !contact.closest_base.allFinite()) {
-    have_previous_contact_ = false;
-    return;
-  }
-  result.robot_speed_towards_mps = robot_speed_towards(params_.robot, robot_state, contact);
   ContactUncertaintyInput in;
-  in.depth_m = contact.closest_camera.z();
   in.fx_px = frame.intrinsics.fx;
   const float baseline_m = frame.stereo_baseline_mm * 1e-3F;
   const double learnt = preset_background_ ? 0.0 : learner_.noise_per_z2();
@@ -370,30 +401,44 @@ void Pipeline::measure_contact(const Frame& frame, const RobotState& robot_state
                         ? params_.foreground.subpixel_rms_px / (source_fx * baseline_m)
                         : static_cast<float>(learnt > 0.0 ? learnt : params_.background.max_noise_per_z2);
   in.filter_lag_s = temporal_lag_s(params_.filters, period_s);
-  // The filters lag in depth only, so the contact's speed along the camera's axis counts,
-  // from the last frame's contact; the contact may jump to another body part, which
-  // overstates it, and the cap at the human speed bounds that.
-  if (have_previous_contact_ && frame.timestamp_ns > previous_contact_ns_) {
-    const double dt_s = static_cast<double>(frame.timestamp_ns - previous_contact_ns_) * 1e-9;
-    in.contact_speed_mps = static_cast<float>(std::abs(contact.closest_camera.z() - previous_contact_depth_m_) / dt_s);
+  for (LinkContact& link : m.links) {
+    const Contact& contact = link.contact;
+    if (contact.inside || !contact.closest_base.allFinite()) continue;  // a stop either way
+    link.speed_towards_mps = robot_speed_towards(params_.robot, robot_state, contact);
+    in.depth_m = contact.closest_camera.z();
+    // The filters lag in depth only, so the contact's speed along the camera's axis counts,
+    // from this link's contact in the last frame; the contact may jump to another body part,
+    // which overstates it, and the cap at the human speed bounds that.
+    in.contact_speed_mps = std::numeric_limits<float>::quiet_NaN();
+    PreviousContact& previous = previous_link_contact(link.link);
+    if (previous.seen && frame.timestamp_ns > previous.timestamp_ns) {
+      const double dt_s = static_cast<double>(frame.timestamp_ns - previous.timestamp_ns) * 1e-9;
+      in.contact_speed_mps = static_cast<float>(std::abs(contact.closest_camera.z() - previous.depth_m) / dt_s);
+    }
+    link.distance_uncertainty_m = contact_uncertainty_m(params_.safety.ssm, in);
+    previous = {true, frame.timestamp_ns, contact.closest_camera.z()};
   }
-  have_previous_contact_ = true;
-  previous_contact_ns_ = frame.timestamp_ns;
-  previous_contact_depth_m_ = contact.closest_camera.z();
-  result.distance_uncertainty_m = contact_uncertainty_m(params_.safety.ssm, in);
+  // A link without a contact this frame starts again: its next contact has no speed.
+  for (PreviousContact& previous : previous_contacts_) previous.seen = previous.seen && previous.timestamp_ns == frame.timestamp_ns;
+}
+
+Pipeline::PreviousContact& Pipeline::previous_link_contact(int link) {
+  const size_t i = static_cast<size_t>(std::max(0, link));
+  if (i >= previous_contacts_.size()) previous_contacts_.resize(i + 1);  // grows during the first frames only
+  return previous_contacts_[i];
 }
 
 // A large surface right in front of the lens, or the static scene seen farther than it was
 // learnt at the sparse reference pixels (the camera was knocked or moved): the background no
 // longer describes what the camera sees, so nothing it says can be trusted.
-bool Pipeline::camera_sees_the_cell(const Frame& frame, FrameResult& result) {
+bool Pipeline::camera_sees_the_cell(const Frame& frame, Measurement& m) {
   const CellCheckParams& checks = params_.checks;
   const float blocked = blocked_share(checks, frame.depth, background());
   if (blocked >= checks.blocked_share) {
     char text[96];
     std::snprintf(text, sizeof text, "%.0f %% of the image nearer than %.2f m: camera blocked", 100.0 * blocked,
                   static_cast<double>(checks.blocked_depth_m));
-    set_stop(result.verdict, ReasonCode::camera_blocked, text);
+    withhold(m, ReasonCode::camera_blocked, text);
     return false;
   }
   if (!moved_reference_ready_) {
@@ -405,7 +450,7 @@ bool Pipeline::camera_sees_the_cell(const Frame& frame, FrameResult& result) {
     char text[112];
     std::snprintf(text, sizeof text, "%.0f %% of %zu reference pixels farther than the background: camera moved",
                   100.0 * moved.share(), moved.valid);
-    set_stop(result.verdict, ReasonCode::camera_moved, text);
+    withhold(m, ReasonCode::camera_moved, text);
     return false;
   }
   return true;
@@ -414,27 +459,27 @@ bool Pipeline::camera_sees_the_cell(const Frame& frame, FrameResult& result) {
 // The filtered frame must still see the cell: no valid pixel at all, or fewer than
 // safety.min_valid_share of them (a covered or blinded camera, a threshold that cuts the
 // scene away), is a stop, and such a frame is not learnt from either.
-bool Pipeline::enough_valid_depth(const Frame& frame, FrameResult& result) const {
+bool Pipeline::enough_valid_depth(const Frame& frame, Measurement& m) const {
   const size_t pixels = frame.depth.pixels.size();
-  const size_t invalid = &frame.depth == &filtered_.depth ? count_invalid(frame.depth) : result.invalid_pixels;
+  const size_t invalid = &frame.depth == &filtered_.depth ? count_invalid(frame.depth) : m.invalid_pixels;
   const size_t valid = pixels - invalid;
   if (valid == 0) {
-    set_stop(result.verdict, ReasonCode::no_valid_depth, "no valid depth after filters");
+    withhold(m, ReasonCode::no_valid_depth, "no valid depth after filters");
     return false;
   }
   const double share = static_cast<double>(valid) / static_cast<double>(pixels);
-  result.valid_share = static_cast<float>(share);
+  m.valid_share = static_cast<float>(share);
   if (share >= params_.safety.min_valid_share) return true;
   char text[96];
   std::snprintf(text, sizeof text, "valid depth %.4f of pixels after filters, below min_valid_share %.4g", share,
                 static_cast<double>(params_.safety.min_valid_share));
-  set_stop(result.verdict, ReasonCode::low_valid_share, text);
+  withhold(m, ReasonCode::low_valid_share, text);
   return false;
 }
 
 // A background loaded from a file is compared with the first frames before it is trusted
 // (BackgroundCheck); those frames are stops. A mismatch ends the run with an error.
-bool Pipeline::background_checked(const Frame& frame, FrameResult& result) {
+bool Pipeline::background_checked(const Frame& frame, Measurement& m) {
   if (!preset_background_ || check_.done()) return true;
   const int seen = check_.add(preset_model_, frame.depth);
   if (check_.done() && check_.mismatch()) {
@@ -448,7 +493,7 @@ bool Pipeline::background_checked(const Frame& frame, FrameResult& result) {
   }
   char text[64];
   std::snprintf(text, sizeof text, "checking loaded background (%d/%d frames)", seen, check_.frames);
-  set_stop(result.verdict, ReasonCode::checking_background, text);
+  withhold(m, ReasonCode::checking_background, text);
   return false;
 }
 

@@ -10,21 +10,14 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <limits>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace hrcsense {
 namespace {
-
-// Seconds (safety.max_frame_age_s, a nominal period) as ns. Not positive or NaN: 0 (every
-// frame that took any time is then stale). At most 10^6 s, so that sums of run-clock times
-// stay far inside int64.
-int64_t seconds_to_ns(double s) {
-  constexpr double kMaxS = 1e6;
-  if (!(s > 0.0)) return 0;
-  return std::llround(std::min(s, kMaxS) * 1e9);
-}
 
 double ns_to_seconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
 
@@ -187,47 +180,37 @@ struct ProcessingStats {
   std::string error;
 };
 
-// Processes every frame it takes; a frame older than max_frame_age_s at the end of its
-// processing becomes a stop. Reads the clock once per frame, there (tests rely on it). Closes
-// `results` when `frames` is closed and drained. `watchdog_stopped` is set by the output loop
-// when it wrote a watchdog stop: the next frame's verdict holds that stop (VerdictHold::stop_at
-// at the frame's own time, later than the silence began: the cautious side).
+// Measures every frame it takes and hands the measurement to the output, where the monitor
+// decides it. A paced run's measurement that replaces one not yet taken carries that one's
+// verdict (carry_replaced), so a stop is never dropped unseen. Closes `results` when `frames`
+// is closed and drained.
 void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const RunOptions& options,
-                     const RunClock& clock, double max_frame_age_s, Mailbox<Captured>& frames,
-                     Mailbox<FrameResult>& results, std::atomic<bool>& watchdog_stopped, ProcessingStats& stats) {
-  const int64_t max_frame_age_ns = seconds_to_ns(max_frame_age_s);
+                     const RunClock& clock, const SafetyMonitor& monitor, Mailbox<Captured>& frames,
+                     Mailbox<FrameResult>& results, ProcessingStats& stats) {
   const int64_t camera_latency_ns = robot_state_lookup_offset_ns(robot_states.origin(), options.camera_latency_s);
+  const auto carry = [&](const FrameResult& replaced, FrameResult& next) {
+    carry_replaced(monitor, replaced, clock.now_ns(), next);
+  };
   Captured in;
   FrameResult result;
   FrameResult previous;  // for before_process; its buffers are reused
   RobotState robot_state;
-  const SafetyParams& safety = pipeline.params().safety;
-  VerdictHold hold;
   try {
     while (frames.take(in)) {
       if (options.before_process) options.before_process(pipeline, previous);
-      // The robot as it was when the camera saw the frame; none is a stop (Pipeline::process).
+      // The robot as it was when the camera saw the frame; none withholds it (Pipeline::process).
       if (!robot_states.state_at(in.frame.host_time_ns - camera_latency_ns, robot_state)) robot_state.valid = false;
       pipeline.process(in.frame, robot_state, result);
       result.timestamp_warning = in.timestamp_warning;
-      const int64_t now_ns = clock.now_ns();
-      const int64_t age_ns = now_ns - in.captured_ns;
-      // The verdict again with the frame's age as it is now, T_r of the protective distance.
-      const VerdictInput input = verdict_input(result, ns_to_seconds(now_ns - in.seen_ns));
-      Decision decision{std::move(result.verdict), result.ssm};  // moved, not copied: no allocation
-      if (result.valid) decision = decide_verdict(safety, input);
-      if (age_ns > max_frame_age_ns) decision.verdict = stop_verdict(ReasonCode::stale_frame, "stale frame");
-      // Held on the frames' own times: a replay faster than real time holds as many frames
-      // as the live cell would.
-      if (watchdog_stopped.exchange(false)) hold.stop_at(result.host_time_ns);
-      hold.apply(safety, input, result.host_time_ns, decision);
-      result.verdict = std::move(decision.verdict);
-      result.ssm = decision.ssm;
+      result.clocked = true;
+      result.delivered_ns = in.captured_ns;
+      result.seen_ns = in.seen_ns;
+      result.replaced.count = 0;
       if (options.on_processed) options.on_processed(in.frame, pipeline, result);
       if (options.before_process) previous = result;  // put() swaps `result` with an older buffer
       ++stats.processed;
       stats.latencies.add(result.latency_us);
-      if (!(options.pace ? results.put(result) : results.put_wait(result))) break;  // the output ended
+      if (!(options.pace ? results.put(result, carry) : results.put_wait(result))) break;  // the output ended
     }
   } catch (const std::exception& e) {
     stats.error = "processing error at frame " + std::to_string(in.frame.index) + ": " + e.what();
@@ -238,7 +221,7 @@ void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const R
 
 // A stop result that stands for no source frame (watchdog, end of run): it repeats the last
 // frame's index and timestamp, so that the output's frame numbers never go backwards.
-void write_stop(Sink& sink, FrameResult& scratch, const FrameResult& last, ReasonCode code, const std::string& reason) {
+void write_stop(Sink& sink, FrameResult& scratch, const FrameResult& last, Verdict verdict) {
   scratch.source_frame = false;
   scratch.frame = last.frame;
   scratch.timestamp_ns = last.timestamp_ns;
@@ -246,8 +229,17 @@ void write_stop(Sink& sink, FrameResult& scratch, const FrameResult& last, Reaso
   scratch.robot_state = RobotState{};  // a stop that stands for no frame measured against no robot
   scratch.robot_state_age_ms = 0.0;
   scratch.valid = false;
-  scratch.verdict = stop_verdict(code, reason);
+  scratch.verdict = std::move(verdict);
+  scratch.withheld_code = scratch.verdict.code;
   scratch.contact = Contact{};
+  scratch.links.clear();
+  scratch.ssm.reset();
+  scratch.governing_link = -1;
+  scratch.link_protective_distance_m.clear();
+  scratch.distance_uncertainty_m = std::numeric_limits<float>::quiet_NaN();
+  scratch.robot_speed_towards_mps = std::numeric_limits<float>::quiet_NaN();
+  scratch.unknown_distance_m = std::numeric_limits<float>::quiet_NaN();
+  scratch.truth_links.clear();
   scratch.foreground_points = 0;
   scratch.invalid_pixels = 0;
   scratch.valid_share = 0.0F;
@@ -286,29 +278,6 @@ bool take_until(Mailbox<FrameResult>& results, FrameResult& out, const RunClock&
   }
 }
 
-// How long the output waits for a result before its watchdog stop, and the rule that says so.
-struct Watchdog {
-  int64_t after_ns = 0;
-  char rule[64] = {};  ///< e.g. "max_frame_age_s 0.500", "max_frame_gap_periods 2 at 30 frames/s"
-};
-
-// safety.max_frame_age_s, and for live or paced sources (frames at a rate, not on demand)
-// safety.max_frame_gap_periods nominal periods when that is shorter.
-Watchdog watchdog_for(const SafetyParams& safety, const SourceInfo& info, bool paced) {
-  Watchdog w;
-  w.after_ns = seconds_to_ns(safety.max_frame_age_s);
-  std::snprintf(w.rule, sizeof w.rule, "max_frame_age_s %.3f", safety.max_frame_age_s);
-  if ((info.live || paced) && info.nominal_fps > 0.0) {
-    const int64_t gap_ns = seconds_to_ns(safety.max_frame_gap_periods / info.nominal_fps);
-    if (gap_ns < w.after_ns) {
-      w.after_ns = gap_ns;
-      std::snprintf(w.rule, sizeof w.rule, "max_frame_gap_periods %g at %g frames/s", safety.max_frame_gap_periods,
-                    info.nominal_fps);
-    }
-  }
-  return w;
-}
-
 // Writes every result; when none arrives within the watchdog's limit (on the run clock), writes
 // a watchdog stop (with the source's reason for the silence: no_frame, or camera_disconnected),
 // and another each limit after it. The wait for the next result
@@ -316,10 +285,9 @@ Watchdog watchdog_for(const SafetyParams& safety, const SourceInfo& info, bool p
 // it). Ends early when the sink fails (a closed pipe, a full disk): closes `results` so that
 // processing and capture end too, and says why in `error`. Returns the last result written
 // (for the final stop's frame index).
-FrameResult output_loop(Sink& sink, const Source& source, const RunClock& clock, const Watchdog& watchdog_limit,
-                        Mailbox<FrameResult>& results, std::atomic<bool>& watchdog_stopped, RunSummary& summary,
-                        std::string& error) {
-  const int64_t max_frame_age_ns = watchdog_limit.after_ns;
+FrameResult output_loop(Sink& sink, const Source& source, const RunClock& clock, SafetyMonitor& monitor,
+                        Mailbox<FrameResult>& results, RunSummary& summary, std::string& error) {
+  const int64_t max_frame_age_ns = monitor.watchdog_after_ns();
   FrameResult result, last, watchdog;
   int64_t last_arrival_ns = clock.now_ns();
   int64_t waiting_since_ns = last_arrival_ns;
@@ -330,6 +298,8 @@ FrameResult output_loop(Sink& sink, const Source& source, const RunClock& clock,
         break;
       }
       if (take_until(results, result, clock, waiting_since_ns + max_frame_age_ns)) {
+        // Decided here, immediately before the write, at the frame's age as it is now.
+        monitor.decide(result, clock.now_ns());
         sink.frame(result);
         tally(summary, result);
         last_arrival_ns = waiting_since_ns = clock.now_ns();
@@ -341,11 +311,8 @@ FrameResult output_loop(Sink& sink, const Source& source, const RunClock& clock,
       char reason[128];
       std::snprintf(reason, sizeof reason, "%sno frame for %.3f s (%s)",
                     silence == ReasonCode::camera_disconnected ? "camera disconnected: " : "",
-                    ns_to_seconds(clock.now_ns() - last_arrival_ns), watchdog_limit.rule);
-      // Raised before the stop is written: a frame that anyone saw arrive after the stop
-      // (the sink, a controller) is processed with the flag already set, so it holds the stop.
-      watchdog_stopped = true;
-      write_stop(sink, watchdog, last, silence, reason);
+                    ns_to_seconds(clock.now_ns() - last_arrival_ns), monitor.watchdog_rule());
+      write_stop(sink, watchdog, last, monitor.silence(silence, reason));
       waiting_since_ns = clock.now_ns();
     }
   } catch (const std::exception& e) {
@@ -385,16 +352,14 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
   CaptureOutcome outcome;
   RunSummary summary;
   std::string output_error;
-  std::atomic<bool> watchdog_stopped{false};
 
   sink.header(header);
   const bool source_time = host_time_is_source_time(robot_states.origin(), options.pace);
   std::thread capture([&] { capture_loop(source, options, clock, max_frame_age_s, source_time, frames, outcome); });
-  std::thread processing([&] {
-    processing_loop(pipeline, robot_states, options, clock, max_frame_age_s, frames, results, watchdog_stopped, stats);
-  });
-  const Watchdog watchdog = watchdog_for(pipeline.params().safety, source.info(), options.pace);
-  const FrameResult last = output_loop(sink, source, clock, watchdog, results, watchdog_stopped, summary, output_error);
+  // The watchdog counts nominal periods for sources that deliver at a rate (live or paced).
+  SafetyMonitor monitor(pipeline.params().safety, source.info().nominal_fps, source.info().live || options.pace);
+  std::thread processing([&] { processing_loop(pipeline, robot_states, options, clock, monitor, frames, results, stats); });
+  const FrameResult last = output_loop(sink, source, clock, monitor, results, summary, output_error);
   processing.join();
   capture.join();
 
@@ -424,7 +389,7 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
   // gets it too: it may still reach a file whose pipe reader left).
   try {
     FrameResult scratch;
-    write_stop(sink, scratch, last, summary.end_code, outcome.final_reason);
+    write_stop(sink, scratch, last, stop_verdict(summary.end_code, outcome.final_reason));
     summary.wall_s = ns_to_seconds(clock.now_ns() - start_ns);
     summary.fps = summary.wall_s > 0.0 ? static_cast<double>(summary.frames_processed) / summary.wall_s : 0.0;
     sink.summary(summary);

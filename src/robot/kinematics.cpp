@@ -3,6 +3,7 @@
 #include "hrcsense/robot.hpp"
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace hrcsense {
@@ -195,6 +196,28 @@ RobotModel robot_points(const std::vector<Eigen::Vector3f>& points_base, double 
     model.capsules.push_back(Capsule{points_base[i], points_base[i], static_cast<float>(padding_m), static_cast<int>(i)});
   }
   return model;
+}
+
+void split_by_link(const RobotModel& robot, std::vector<RobotModel>& out) {
+  // Links are few (8 for an arm with a tool) and each capsule is visited once per link: no
+  // sort, no map, no allocation once `out` has its size.
+  size_t links = 0;
+  int previous = std::numeric_limits<int>::min();
+  for (;;) {
+    int next = std::numeric_limits<int>::max();
+    for (const Capsule& c : robot.capsules) {
+      if (c.link > previous && c.link < next) next = c.link;
+    }
+    if (next == std::numeric_limits<int>::max()) break;
+    if (out.size() <= links) out.emplace_back();
+    RobotModel& model = out[links++];
+    model.capsules.clear();
+    for (const Capsule& c : robot.capsules) {
+      if (c.link == next) model.capsules.push_back(c);
+    }
+    previous = next;
+  }
+  out.resize(links);
 }
 
 }  // namespace hrcsense

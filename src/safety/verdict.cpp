@@ -64,14 +64,7 @@ Verdict verdict_for_contact(const SafetyParams& params, const Contact& contact, 
 
 namespace {
 
-int strictness(VerdictState state) {
-  switch (state) {
-    case VerdictState::run: return 0;
-    case VerdictState::slow: return 1;
-    case VerdictState::stop: return 2;
-  }
-  return 2;
-}
+int strictness(VerdictState state) { return verdict_strictness(state); }
 
 Verdict ssm_verdict(const SafetyParams& params, const VerdictInput& input, float distance_m,
                     std::optional<SsmTerms>& terms) {
@@ -109,15 +102,22 @@ Verdict ssm_verdict(const SafetyParams& params, const VerdictInput& input, float
 
 }  // namespace
 
-VerdictInput verdict_input(const FrameResult& result, double frame_age_s) {
+VerdictInput verdict_input(const Measurement& m, const LinkContact* link, double frame_age_s) {
   VerdictInput input;
-  input.contact = result.contact;
-  input.foreground_points = result.foreground_points;
-  input.distance_uncertainty_m = result.distance_uncertainty_m;
-  input.robot_speed_towards_mps = result.robot_speed_towards_mps;
-  input.unknown_distance_m = result.unknown_distance_m;
+  input.contact = link != nullptr ? link->contact : m.contact;
+  input.foreground_points = m.foreground_points;
+  if (link != nullptr) {
+    input.distance_uncertainty_m = link->distance_uncertainty_m;
+    input.robot_speed_towards_mps = link->speed_towards_mps;
+  } else {
+    // The overall pair alone says nothing of the robot's speed or the contact's uncertainty:
+    // NaN, which the ssm mode turns into a stop.
+    input.distance_uncertainty_m = std::numeric_limits<float>::quiet_NaN();
+    input.robot_speed_towards_mps = std::numeric_limits<float>::quiet_NaN();
+  }
+  input.unknown_distance_m = m.unknown_distance_m;
   input.frame_age_s = frame_age_s;
-  const RobotStatus& status = result.robot_state.status;
+  const RobotStatus& status = m.robot_state.status;
   if (status.known && status.speed_scaling > 0.0 && status.speed_scaling <= 1.0) {
     input.robot_speed_scaling = status.speed_scaling;
   }
@@ -144,16 +144,25 @@ Decision decide_verdict(const SafetyParams& params, const VerdictInput& input, f
     far.frame_age_s = input.frame_age_s;
     decision.verdict.protective_distance_m = protective_distance(params.ssm, far, 0.0F).protective_distance_m;
   }
-  if (params.unknown_policy == SafetyParams::UnknownPolicy::stop_within_m &&
-      input.unknown_distance_m <= params.unknown_stop_within_m + distance_margin_m &&
-      decision.verdict.state != VerdictState::stop) {
-    decision.verdict = make_verdict(VerdictState::stop, 0.0F, decision.verdict.protective_distance_m,
-                                    ReasonCode::unknown_space, "unknown space");
-  }
+  apply_unknown_policy(params, input.unknown_distance_m, distance_margin_m, decision.verdict);
   return decision;
 }
 
+void apply_unknown_policy(const SafetyParams& params, float unknown_distance_m, float distance_margin_m,
+                          Verdict& verdict) {
+  if (params.unknown_policy == SafetyParams::UnknownPolicy::stop_within_m &&
+      unknown_distance_m <= params.unknown_stop_within_m + distance_margin_m && verdict.state != VerdictState::stop) {
+    verdict = make_verdict(VerdictState::stop, 0.0F, verdict.protective_distance_m, ReasonCode::unknown_space,
+                           "unknown space");
+  }
+}
+
 void VerdictHold::apply(const SafetyParams& params, const VerdictInput& input, int64_t time_ns, Decision& decision) {
+  // The margin's decision is needed only to relax; made here for the single-contact callers.
+  apply(params, decide_verdict(params, input, params.hysteresis_m), time_ns, decision);
+}
+
+void VerdictHold::apply(const SafetyParams& params, const Decision& with_margin, int64_t time_ns, Decision& decision) {
   Verdict& verdict = decision.verdict;
   if (!have_ || strictness(verdict.state) >= strictness(held_)) {
     // As strict or stricter: taken at once, and the hold starts again from this frame.
@@ -166,7 +175,6 @@ void VerdictHold::apply(const SafetyParams& params, const VerdictInput& input, i
   // More relaxed. It must have been so for min_hold_s, and hold with the distance less the
   // hysteresis; it relaxes only as far as that stricter reading allows.
   const double held_s = static_cast<double>(time_ns - since_ns_) * 1e-9;
-  const Decision with_margin = decide_verdict(params, input, params.hysteresis_m);
   const VerdictState target = strictness(with_margin.verdict.state) > strictness(verdict.state)
                                   ? with_margin.verdict.state
                                   : verdict.state;
@@ -236,6 +244,15 @@ const char* reason_code_name(ReasonCode code) {
     case ReasonCode::holding: return "holding";
   }
   return "unknown";
+}
+
+int verdict_strictness(VerdictState state) {
+  switch (state) {
+    case VerdictState::run: return 0;
+    case VerdictState::slow: return 1;
+    case VerdictState::stop: return 2;
+  }
+  return 2;
 }
 
 const char* verdict_name(VerdictState state) {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — foreground extraction: background subtraction, speckle removal by physical size,
-// deprojection into camera- and base-frame point clouds.
+// hrcsense — foreground extraction: background subtraction, speckle removal by physical size
+// (a blob's equivalent disc diameter at its depth), deprojection into camera- and base-frame
+// point clouds.
 
 #include "foreground_tables.hpp"
 
@@ -27,6 +28,7 @@ constexpr uint8_t kUnknown = 4;     // valid depth where the background was neve
 constexpr uint8_t kVisited = 8;     // in the blob being flood-filled
 
 constexpr uint64_t kEveryByte = 0x0101010101010101ULL;
+constexpr double kPi = 3.14159265358979323846;
 
 /// Whether any of the 16 mask bytes starting at `i` has a bit of `bits` (repeated per byte) set.
 bool any_bits16(const uint8_t* mask, size_t i, uint64_t bits) {
@@ -185,18 +187,22 @@ struct Kept {
 };
 
 /// Removes blobs smaller than `min_object_mm` and marks the rest kForeground. A blob's size is
-/// the side of a square of the same pixel area at the blob's mean depth:
-/// sqrt(pixel count) · mean_z / fx, in millimetres.
+/// the diameter of a disc of the same pixel area at the blob's mean depth:
+/// 2 · sqrt(pixel count / π) · mean_z / fx, in millimetres. A disc, not a square, because the
+/// detection capability d (`safety.detection_mm`) is the diameter of a test piece (a sphere or
+/// rod, ISO 13855): a square of side d has 4/π times a d-disc's area, so a 40 mm ball measured
+/// as a square came out 35 mm and was removed at min_object_mm 40.
 Kept remove_speckles(const Frame& frame, const int32_t* jump_limit_raw, float min_object_mm,
                      const uint8_t* row_states, uint8_t* mask, int32_t* queue) {
   const DepthImage& depth = frame.depth;
   const size_t width = static_cast<size_t>(depth.width);
-  const double mm_per_raw_px = 1000.0 * depth.depth_scale_m / frame.intrinsics.fx;
+  // 2 / sqrt(π) folded into the per-raw-unit factor: one multiplication per blob.
+  const double mm_per_raw_px = 2.0 / std::sqrt(kPi) * 1000.0 * depth.depth_scale_m / frame.intrinsics.fx;
   Kept kept;
   for_each_marked_in_rows(mask, row_states, width, 0, static_cast<size_t>(depth.height), kCandidate, [&](size_t i) {
     const int v = static_cast<int>(i / width);
     const Blob blob = fill_blob(depth, jump_limit_raw, v << 16 | static_cast<int32_t>(i % width), mask, queue);
-    // sqrt(count) · (raw_sum / count) · scale / fx, in mm.
+    // 2 · sqrt(count / π) · (raw_sum / count) · scale / fx = raw_sum / sqrt(count) · mm_per_raw_px, in mm.
     const double size_mm =
         static_cast<double>(blob.raw_sum) / std::sqrt(static_cast<double>(blob.count)) * mm_per_raw_px;
     const bool keep = size_mm >= min_object_mm;

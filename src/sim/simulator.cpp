@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -153,6 +154,56 @@ void fill_truth_labels(const SimScratch& scratch, GroundTruth& truth) {
   }
 }
 
+// The distance from `p` to the surface of the nearest of `link`'s capsules, in double.
+double link_distance_m(const RobotModel& link, const Eigen::Vector3f& p_f) {
+  const Eigen::Vector3d p = p_f.cast<double>();
+  double best = std::numeric_limits<double>::infinity();
+  for (const Capsule& capsule : link.capsules) {
+    const Eigen::Vector3d a = capsule.a.cast<double>();
+    const Eigen::Vector3d ab = capsule.b.cast<double>() - a;
+    const double length2 = ab.squaredNorm();
+    const double t = length2 > 0.0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+    best = std::min(best, std::max(0.0, (p - (a + t * ab)).norm() - static_cast<double>(capsule.radius_m)));
+  }
+  return best;
+}
+
+// The link's capsules (index `i` of the split) `dt_s` after frame `index`'s time.
+const RobotModel& link_at(const Simulator& sim, int64_t index, double dt_s, size_t i) {
+  SimScratch& scratch = sim.scratch;
+  const double t_s = static_cast<double>(index) / sim.params.fps + dt_s;
+  robot_model_at(sim.arm->robot, joints_at(sim.arm->trajectory, t_s).q_rad, scratch.arm_nearby);
+  split_by_link(scratch.arm_nearby, scratch.nearby_links);
+  return scratch.nearby_links[i];
+}
+
+/// GroundTruth::links: per link of the truth's capsules, the nearest noise-free moving-object
+/// pixel and the link's speed towards it. The speed is the rate at which that pixel's distance
+/// to the link's surface shrinks, by central differences of the trajectory's poses around the
+/// frame's time: the surface point's velocity along the surface normal, which is the
+/// separation direction, without the kinematics' Jacobian (point_velocity) or the search.
+void fill_truth_links(const Simulator& sim, int64_t index, GroundTruth& truth) {
+  SimScratch& scratch = sim.scratch;
+  truth.links.clear();
+  if (scratch.points_base.empty()) return;
+  split_by_link(truth_robot(sim), scratch.truth_links);
+  constexpr double kHalfStepS = 1e-4;
+  for (size_t i = 0; i < scratch.truth_links.size(); ++i) {
+    const RobotModel& link = scratch.truth_links[i];
+    const Contact c = sim_detail::rendered_truth_contact(scratch.points_base, scratch.points_camera, link);
+    if (!c.valid) continue;
+    LinkTruth out;
+    out.link = link.capsules.front().link;
+    out.distance_m = c.distance_m;
+    if (sim.arm) {
+      const double before_m = link_distance_m(link_at(sim, index, -kHalfStepS, i), c.closest_base);
+      const double after_m = link_distance_m(link_at(sim, index, kHalfStepS, i), c.closest_base);
+      out.speed_towards_mps = static_cast<float>((before_m - after_m) / (2.0 * kHalfStepS));
+    }
+    truth.links.push_back(out);
+  }
+}
+
 void fill_truth_contacts(const Simulator& sim, const PoseF& T_base_camera, GroundTruth& truth) {
   SimScratch& scratch = sim.scratch;
   scratch.points_base.clear();
@@ -272,6 +323,7 @@ void Simulator::render(int64_t index, Frame& out) const {
   sim_detail::write_sensor_depth(params, in.fx, index, truth.depth_m.data(), scratch, out.depth);
   fill_truth_labels(scratch, truth);
   fill_truth_contacts(*this, T_base_camera_f, truth);
+  fill_truth_links(*this, index, truth);
   render_color(*this, T_base_camera_f, out);
 }
 

@@ -156,6 +156,33 @@ struct Members {
   void close() { line += '}'; }
 };
 
+// `governing_link` and `links`: per link with a measured contact its distance, speed towards
+// the contact, Z_d and S_p at its own speed; [] and null without a contact.
+void put_links(Members& m, const FrameResult& result) {
+  if (result.governing_link >= 0) {
+    m.integer("governing_link", result.governing_link);
+  } else {
+    m.null("governing_link");
+  }
+  std::string& line = m.line;
+  put_key(line, "links");
+  line += '[';
+  for (size_t i = 0; i < result.links.size(); ++i) {
+    const LinkContact& link = result.links[i];
+    if (i > 0) line += ',';
+    line += '{';
+    m.integer("link", link.link);
+    m.number("distance_m", link.contact.distance_m);
+    m.number_or_null("speed_towards_mps", std::isfinite(link.speed_towards_mps), link.speed_towards_mps);
+    m.number_or_null("distance_uncertainty_m", std::isfinite(link.distance_uncertainty_m),
+                     link.distance_uncertainty_m);
+    const bool has_sp = i < result.link_protective_distance_m.size();
+    m.number_or_null("protective_distance_m", has_sp, has_sp ? result.link_protective_distance_m[i] : 0.0F);
+    line += '}';
+  }
+  line += ']';
+}
+
 void put_pinhole(Members& m, const Intrinsics& in) {
   m.integer("width", in.width);
   m.integer("height", in.height);
@@ -186,6 +213,12 @@ void JsonLinesSink::header(const RunHeader& header) {
   m.text("version", header.version.empty() ? HRCSENSE_VERSION : header.version);
   m.text("commit", header.commit.empty() ? HRCSENSE_COMMIT : header.commit);
   m.text("config_hash", header.config_hash);
+  // The link's datagrams carry the same session: a receiver's log and this file name one process.
+  if (header.session != 0) {
+    m.integer("session", header.session);
+  } else {
+    m.null("session");
+  }
   // Every output says it, where a reader of the file would otherwise assume it (issue G2).
   m.text("safety_notice", kSafetyNotice);
   if (!header.robot_state.empty()) {
@@ -271,6 +304,7 @@ void JsonLinesSink::frame(const FrameResult& result) {
   m.number_or_null("robot_speed_towards_mps", std::isfinite(result.robot_speed_towards_mps),
                    result.robot_speed_towards_mps);
   m.number_or_null("unknown_distance_m", std::isfinite(result.unknown_distance_m), result.unknown_distance_m);
+  put_links(m, result);
   m.point_or_null("closest_camera", contact.valid, contact.closest_camera);
   m.point_or_null("closest_base", contact.valid, contact.closest_base);
   m.point_or_null("closest_robot_base", contact.valid, contact.closest_robot_base);
@@ -288,6 +322,7 @@ void JsonLinesSink::frame(const FrameResult& result) {
   m.integer("invalid_pixels", static_cast<int64_t>(result.invalid_pixels));
   m.number("valid_share", result.valid_share);
   m.integer("host_time_ns", result.host_time_ns);
+  m.number("frame_age_s", result.frame_age_s);  // when the monitor decided it: what T_r counted
   // The joints the robot's capsules were built from; null without a valid robot state.
   put_key(line_, "joints_rad");
   if (result.robot_state.valid) {
@@ -329,6 +364,17 @@ void JsonLinesSink::frame(const FrameResult& result) {
     } else {
       m.null("contact_label");
     }
+    put_key(line_, "links");
+    line_ += '[';
+    for (const LinkTruth& link : result.truth_links) {
+      if (line_.back() != '[') line_ += ',';
+      line_ += '{';
+      m.integer("link", link.link);
+      m.number("distance_m", link.distance_m);
+      m.number("speed_towards_mps", link.speed_towards_mps);
+      line_ += '}';
+    }
+    line_ += ']';
     m.close();
   }
   line_ += "}\n";

@@ -2,6 +2,7 @@
 // Acceptance: the UR5 cell. The arm is rendered as part of the static scene, learnt as
 // background, and searched as capsules; a person walks up to it.
 
+#include "../support/decide.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/robot_state.hpp"
@@ -69,7 +70,7 @@ TEST(CellUr5, ContactIsOnTheTrueLinkWithinOneMillimetre) {
     for (int64_t i = 0; i < sim.params.frames; ++i) {
       if (i > learning && i % kFrameStep != 0) continue;
       sim.render(i, frame);
-      pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
+      test::process_and_decide(pipeline, frame, fixed_robot_state(config.robot_state.joints_rad), result);
       if (i < learning) continue;
       ASSERT_TRUE(result.valid) << backend << " frame " << i;
       const Contact& truth = frame.truth->contact;
@@ -120,7 +121,7 @@ TEST(CellUr5, NoisyContactOnTheTrueLinkAndNeverFartherThanTheTruth) {
     // The temporal filter needs consecutive frames: sanitizers stop early instead of skipping.
     if (i >= 120 + 240 / kFrameStep) break;
     sim.render(i, frame);
-    pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state(config.robot_state.joints_rad), result);
     if (!result.valid) continue;
     const Contact& truth = frame.truth->contact;
     if (!truth.valid) {

@@ -5,6 +5,7 @@
 // frames at 848x480; and the default sdk preset runs the pipeline at the decimated resolution.
 // The numbers these tests print are the ones in docs/ACCURACY.md.
 
+#include "../support/decide.hpp"
 #include "../support/sanitized.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/camera.hpp"
@@ -147,7 +148,7 @@ TEST(FiltersAcceptance, ThesisPresetClosestDistanceWithinTenMillimetres) {
   int n = 0;
   for (int i = 0; i < learn + measured; ++i) {
     sim.render(i, frame);
-    pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state(config.robot_state.joints_rad), result);
     if (i < learn) continue;
     ASSERT_TRUE(result.valid) << "frame " << i << ": " << result.verdict.reason;
     ASSERT_TRUE(frame.truth->contact.valid) << "frame " << i;
@@ -185,7 +186,7 @@ TEST(FiltersAcceptance, SdkPresetRunsAtTheDecimatedResolution) {
   FrameResult result;
   for (int i = 0; i < learn + measured; ++i) {
     sim.render(i, frame);
-    pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state(config.robot_state.joints_rad), result);
     chain.process(frame, filtered);
     if (i < learn) continue;
     ASSERT_TRUE(result.valid) << "frame " << i << ": " << result.verdict.reason;
@@ -239,7 +240,7 @@ Excess headon_excess(const std::string& preset) {
   int approach_n = 0, still_n = 0;
   for (int i = 0; i <= still_last; ++i) {
     sim.render(i, frame);
-    pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state(config.robot_state.joints_rad), result);
     const bool approaching = i >= approach_first && i < arrive, still = i >= still_first;
     if (!approaching && !still) continue;
     EXPECT_TRUE(result.contact.valid && frame.truth->contact.valid) << preset << " frame " << i;

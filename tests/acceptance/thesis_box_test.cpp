@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Acceptance: the whole processing path on the thesis's box scene against the simulator's truth.
 
+#include "../support/decide.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/camera.hpp"
 #include "hrcsense/robot_state.hpp"
@@ -35,7 +36,7 @@ void run_scene(const Config& config, int64_t frames, Check check) {
   FrameResult result;
   for (int64_t i = 0; i < frames; ++i) {
     sim.render(i, frame);
-    pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state(config.robot_state.joints_rad), result);
     if (pipeline.background_ready() && result.valid) check(frame, result, pipeline);
   }
 }

@@ -11,6 +11,7 @@
 #include "hrcsense/config.hpp"
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/pipeline.hpp"
+#include "hrcsense/safety.hpp"
 
 #include <gtest/gtest.h>
 
@@ -54,23 +55,37 @@ std::vector<Frame> walk_frames(const Config& config) {
   return frames;
 }
 
-// Allocations during the second pass over the frames, after a first pass has grown every
-// buffer to the largest cloud.
+// Allocations during the last of three passes over the person frames, after the first two
+// have grown every buffer to the largest cloud.
 long allocations_after_warm_up(const std::string& preset, const std::string& backend) {
   const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/walk.yaml",
                                     {"filters.preset=" + preset, "proximity.backend=" + backend,
                                      "background.frames=" + std::to_string(kLearnFrames), "sim.color=false"});
   const std::vector<Frame> frames = walk_frames(config);
   Pipeline pipeline(config.pipeline);
+  SafetyMonitor monitor(config.pipeline.safety);  // the output thread's decision, measured too
   FrameResult result;
   size_t largest_cloud = 0;
+  const RobotState state = fixed_robot_state(config.robot_state.joints_rad);
   for (const Frame& frame : frames) {
-    pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
+    pipeline.process(frame, state, result);
+    monitor.decide(result, 0);
     largest_cloud = std::max(largest_cloud, result.foreground_points);
   }
   EXPECT_GT(largest_cloud, 1000U) << preset << "/" << backend << ": the person was not found";
+  // The person frames once more before counting: the jump from frame 200 back to frame 100
+  // leaves the temporal filter's memory of frame 200 in the first frames of a replay (sdk,
+  // thesis), so the counted pass must follow a pass that began the same way; otherwise those
+  // frames' filter remnants (small blobs the speckle rule keeps) give the octree a new shape.
+  const auto person_pass = [&] {
+    for (size_t i = kLearnFrames; i < frames.size(); ++i) {
+      pipeline.process(frames[i], state, result);
+      monitor.decide(result, 0);
+    }
+  };
+  person_pass();
   const long before = g_allocations.load();
-  for (size_t i = kLearnFrames; i < frames.size(); ++i) pipeline.process(frames[i], fixed_robot_state(config.robot_state.joints_rad), result);
+  person_pass();
   const long allocations = g_allocations.load() - before;
   EXPECT_TRUE(result.valid) << result.verdict.reason;
   return allocations;
@@ -86,11 +101,12 @@ TEST(PipelineAllocations, NoneAfterWarmUpForEveryPresetWithBruteAndOctree) {
 
 // A UR5 whose joints change every frame (cell-ur5.yaml, the person at the table): the pipeline
 // rebuilds the arm's capsules from each robot state into its own buffer, so a moving arm
-// allocates nothing either once warmed up.
+// allocates nothing either once warmed up; nor does the per-link measurement and its ssm
+// decision.
 TEST(PipelineAllocations, NoneWithAnArmMovingEveryFrame) {
   const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5.yaml",
                                     {"background.frames=" + std::to_string(kLearnFrames), "sim.color=false",
-                                     "sim.width=424", "sim.height=240"});
+                                     "sim.width=424", "sim.height=240", "safety.mode=ssm"});
   const Simulator sim = make_simulator(config);
   std::vector<Frame> frames;
   for (int i = 0; i < kLearnFrames; ++i) sim.render(i, frames.emplace_back());
@@ -103,10 +119,18 @@ TEST(PipelineAllocations, NoneWithAnArmMovingEveryFrame) {
     state.q_rad[0] += 0.01 * static_cast<double>(i % 11);
     return state;
   };
-  for (size_t i = 0; i < frames.size(); ++i) pipeline.process(frames[i], state_for(i), result);
+  SafetyMonitor monitor(config.pipeline.safety);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    pipeline.process(frames[i], state_for(i), result);
+    monitor.decide(result, 0);
+  }
   const long before = g_allocations.load();
-  for (size_t i = kLearnFrames; i < frames.size(); ++i) pipeline.process(frames[i], state_for(i + 3), result);
+  for (size_t i = kLearnFrames; i < frames.size(); ++i) {
+    pipeline.process(frames[i], state_for(i + 3), result);
+    monitor.decide(result, 0);
+  }
   EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_FALSE(result.links.empty()) << "every link near the person is measured";
   EXPECT_TRUE(result.valid) << result.verdict.reason;
   EXPECT_TRUE(result.contact.valid) << "the person at the table must be found";
 }

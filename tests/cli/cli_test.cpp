@@ -36,8 +36,9 @@ std::vector<json> results_without_timings(const fs::path& jsonl) {
   std::istringstream in(read_text(jsonl));
   for (std::string line; std::getline(in, line);) {
     json result = json::parse(line);
+    // Wall-clock figures, and the session (random per process start), differ from run to run.
     for (const char* key : {"commit", "latency_us", "timings_us", "wall_s", "fps", "latency_p50_us",
-                            "latency_p99_us"}) {
+                            "latency_p99_us", "frame_age_s", "session"}) {
       result.erase(key);
     }
     lines.push_back(std::move(result));

@@ -249,6 +249,51 @@ TEST_F(FailsafeCli, SighupEndsWithStopAndSummary) {
   expect_stop_then_summary(lines, "stop requested");
 }
 
+// S1: Ctrl-Z (SIGTSTP) ends the run like SIGINT; a suspended process would look alive to the
+// consumers of its output while it decides nothing.
+TEST_F(FailsafeCli, SigtstpEndsWithStopAndSummary) {
+  int status = 0;
+  const std::vector<json> lines = signal_a_paced_run(SIGTSTP, status);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << read_text(dir_ / "stderr.txt");
+  expect_stop_then_summary(lines, "stop requested");
+}
+
+// S1: the whole process frozen (SIGSTOP, as a VM pause or a debugger would) for 0.5 s while
+// it runs paced at 30 frames/s, then thawed. Whatever was measured before the freeze is
+// decided after it, at its real age: no line may say run or slow for a frame older than the
+// no-frame limit (2 periods, 66.7 ms). Several freezes, so that some fall between a
+// measurement and its write.
+TEST_F(FailsafeCli, FrozenProcessWritesNothingOldAsRunOrSlow) {
+  const fs::path out = dir_ / "out.jsonl";
+  Child child({"run", "--config", config("thesis-box.yaml"), "--set", "source.pace=true", "--set",
+               "sim.width=424", "--set", "sim.height=240", "--set", "background.frames=10", "--frames", "3000",
+               "--out", out.string()},
+              dir_ / "stderr.txt");
+  const Clock::time_point deadline = Clock::now() + std::chrono::seconds(60);
+  while (read_text(out).find("\"verdict\":\"run\"") == std::string::npos && Clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_NE(read_text(out).find("\"verdict\":\"run\""), std::string::npos) << "the run never said run";
+  for (int freeze = 0; freeze < 4; ++freeze) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(97 + 31 * freeze));  // a different phase each time
+    ::kill(child.pid(), SIGSTOP);
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    ::kill(child.pid(), SIGCONT);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ::kill(child.pid(), SIGINT);
+  const int status = child.wait(30.0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << read_text(dir_ / "stderr.txt");
+  const std::vector<json> lines = json_lines(read_text(out));
+  int moving = 0;
+  for (const json& line : lines) {
+    if (line["type"] != "frame" || line["verdict"] == "stop") continue;
+    ++moving;
+    EXPECT_LE(line["frame_age_s"].get<double>(), 2.0 / 30.0) << line.dump();
+  }
+  EXPECT_GT(moving, 0);
+}
+
 TEST_F(FailsafeCli, SigintEndsWithStopAndSummary) {
   int status = 0;
   const std::vector<json> lines = signal_a_paced_run(SIGINT, status);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The filter keys of the configuration (filters.preset, filters.order, filters.<block>.<option>)
 // with the SDK's ranges, and the chain's per-block timings in Pipeline::process.
+#include "../support/decide.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/pipeline.hpp"
@@ -120,12 +121,12 @@ TEST(FiltersPipeline, EveryBlockIsTimedUnderItsName) {
   frame.intrinsics.fx = frame.intrinsics.fy = 30.0F;
   frame.stereo_baseline_mm = 50.0F;
   FrameResult result;
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   std::vector<std::string> stages;
   for (const StageTiming& timing : result.timings) stages.emplace_back(timing.stage);
   EXPECT_EQ(stages, (std::vector<std::string>{"threshold", "to_disparity", "spatial", "temporal", "to_depth", "background"}));
   frame.stereo_baseline_mm = 0.0F;  // no baseline: the blocks run on depth, no transforms
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   stages.clear();
   for (const StageTiming& timing : result.timings) stages.emplace_back(timing.stage);
   EXPECT_EQ(stages, (std::vector<std::string>{"threshold", "spatial", "temporal", "background"}));

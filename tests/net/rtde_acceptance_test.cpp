@@ -6,6 +6,7 @@
 // within an interpolation error bound derived by hand from the waypoints; a stalled controller
 // is a stop within robot.state.max_age_s plus one frame, and the verdict is run again once data
 // resumes.
+#include "../support/decide.hpp"
 #include "rtde_rig.hpp"
 
 #include "../pipeline/fake_scene.hpp"
@@ -225,7 +226,7 @@ TEST_P(RtdeStallVerdict, StopWithinMaxAgePlusOneFrameAndRunAgainAfterResume) {
   FrameResult result;
   for (int i = 0; i < test::kLearnFrames; ++i) {
     test::fill_frame(i, 0.0F, frame);
-    pipeline.process(frame, fixed_robot_state({}), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   }
   int64_t index = test::kLearnFrames;
   auto verdict_at = [&](int64_t host_ns) {
@@ -233,7 +234,7 @@ TEST_P(RtdeStallVerdict, StopWithinMaxAgePlusOneFrameAndRunAgainAfterResume) {
     frame.host_time_ns = host_ns;
     RobotState state;
     if (!rig.client->state_at(host_ns, state)) state.valid = false;
-    pipeline.process(frame, state, result);
+    test::process_and_decide(pipeline, frame, state, result);
     return result.verdict;
   };
 

@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
-// The link to the controller: the HRCS datagram against bytes laid out by hand from the layout
-// in docs/SAFETY.md (CRC values from zlib's crc32), its decoder against every kind of damage, and
-// UdpLinkSink against a receiver socket in this process on 127.0.0.1 (ephemeral ports, every
-// wait bounded), on a fake clock; then `hrcsense run` with the link on.
+// The link to the controller: the HRCS datagram (version 2, with the session) against bytes laid
+// out by hand from the layout in docs/SAFETY.md (CRC values from zlib's crc32), its decoder
+// against every kind of damage and against version 1, and UdpLinkSink against a receiver socket
+// in this process on 127.0.0.1 (ephemeral ports, every wait bounded), on a fake clock; then
+// `hrcsense run` with the link on.
 #include "hrcsense/link.hpp"
 
 #include "hrcsense/clock.hpp"
 #include "hrcsense/safety.hpp"
+#include "hrcsense/session.hpp"
 #include "hrcsense/sinks.hpp"
 
 #include "../support/loopback.hpp"
@@ -41,13 +43,13 @@ namespace {
 
 constexpr int64_t kMs = 1'000'000;
 
-// A frame datagram laid out by hand: magic "HRCS", version 1, kind 1, sequence 0x01020304,
+// A frame datagram laid out by hand: magic "HRCS", version 2, kind 1, sequence 0x01020304,
 // timestamp 0x0011223344556677, verdict 1 (slow), reason 2 (in_slow_zone), speed_scale 0.5
-// (0x3F000000), distance 1.25 (0x3FA00000), protective 0.75 (0x3F400000), age 12 ms, then
-// zlib.crc32 of those 37 bytes, 0x760D0479.
-constexpr std::array<uint8_t, 41> kHandLaid = {
+// (0x3F000000), distance 1.25 (0x3FA00000), protective 0.75 (0x3F400000), age 12 ms, session
+// 0x89ABCDEF, then zlib.crc32 of those 41 bytes, 0xA82F0729.
+constexpr std::array<uint8_t, 45> kHandLaid = {
     0x48, 0x52, 0x43, 0x53,                          //  0 magic
-    0x01, 0x00,                                      //  4 version
+    0x02, 0x00,                                      //  4 version
     0x01, 0x00,                                      //  6 kind
     0x04, 0x03, 0x02, 0x01,                          //  8 sequence
     0x77, 0x66, 0x55, 0x44, 0x33, 0x22, 0x11, 0x00,  // 12 timestamp_ns
@@ -57,13 +59,23 @@ constexpr std::array<uint8_t, 41> kHandLaid = {
     0x00, 0x00, 0xA0, 0x3F,                          // 27 distance_m
     0x00, 0x00, 0x40, 0x3F,                          // 31 protective_distance_m
     0x0C, 0x00,                                      // 35 robot state age, ms
-    0x79, 0x04, 0x0D, 0x76,                          // 37 CRC-32
+    0xEF, 0xCD, 0xAB, 0x89,                          // 37 session
+    0x29, 0x07, 0x2F, 0xA8,                          // 41 CRC-32
 };
-constexpr uint32_t kHandLaidCrc = 0x760D0479U;
+constexpr uint32_t kHandLaidCrc = 0xA82F0729U;
+
+// The same frame in version 1's 41-byte layout (no session; zlib.crc32 of 37 bytes, 0x760D0479):
+// what a sender before version 2 sent. It must be refused, by name.
+constexpr std::array<uint8_t, 41> kVersion1 = {
+    0x48, 0x52, 0x43, 0x53, 0x01, 0x00, 0x01, 0x00, 0x04, 0x03, 0x02, 0x01, 0x77, 0x66,
+    0x55, 0x44, 0x33, 0x22, 0x11, 0x00, 0x01, 0x02, 0x00, 0x00, 0x00, 0x00, 0x3F, 0x00,
+    0x00, 0xA0, 0x3F, 0x00, 0x00, 0x40, 0x3F, 0x0C, 0x00, 0x79, 0x04, 0x0D, 0x76,
+};
 
 LinkDatagram hand_laid_values() {
   LinkDatagram d;
   d.kind = LinkKind::frame;
+  d.session = 0x89ABCDEFU;
   d.sequence = 0x01020304U;
   d.timestamp_ns = 0x0011223344556677LL;
   d.verdict = VerdictState::slow;
@@ -82,8 +94,8 @@ LinkDecodeResult decode(const std::vector<uint8_t>& bytes) { return decode_link_
 std::vector<uint8_t> patched(size_t at, const std::vector<uint8_t>& patch) {
   std::vector<uint8_t> bytes(kHandLaid.begin(), kHandLaid.end());
   std::copy(patch.begin(), patch.end(), bytes.begin() + static_cast<std::ptrdiff_t>(at));
-  const uint32_t crc = crc32_ieee(bytes.data(), 37);  // checked against zlib's value below
-  for (int i = 0; i < 4; ++i) bytes[37 + static_cast<size_t>(i)] = static_cast<uint8_t>(crc >> (8 * i));
+  const uint32_t crc = crc32_ieee(bytes.data(), 41);  // checked against zlib's value below
+  for (int i = 0; i < 4; ++i) bytes[41 + static_cast<size_t>(i)] = static_cast<uint8_t>(crc >> (8 * i));
   return bytes;
 }
 
@@ -100,18 +112,20 @@ TEST(UdpLinkCrc, MatchesTheStandardCheckValues) {
   const std::string check = "123456789";
   EXPECT_EQ(crc32_ieee(reinterpret_cast<const uint8_t*>(check.data()), check.size()), 0xCBF43926U);
   EXPECT_EQ(crc32_ieee(nullptr, 0), 0U);
-  EXPECT_EQ(crc32_ieee(kHandLaid.data(), 37), kHandLaidCrc);
+  EXPECT_EQ(crc32_ieee(kHandLaid.data(), 41), kHandLaidCrc);
+  EXPECT_EQ(crc32_ieee(kVersion1.data(), 37), 0x760D0479U);
 }
 
 TEST(UdpLinkEncode, EveryFieldAtItsHandWrittenOffset) {
   const LinkBytes bytes = encode_link_datagram(hand_laid_values());
-  ASSERT_EQ(bytes.size(), 41U);
+  ASSERT_EQ(bytes.size(), 45U);
   for (size_t i = 0; i < bytes.size(); ++i) EXPECT_EQ(bytes[i], kHandLaid[i]) << "byte " << i;
 }
 
 TEST(UdpLinkEncode, NanDistanceAndSaturatedFields) {
   LinkDatagram d;
   d.kind = LinkKind::heartbeat;
+  d.session = 0xFFFFFFFFU;
   d.sequence = 0xFFFFFFFFU;
   d.timestamp_ns = 1;
   d.reason = ReasonCode::no_frame;  // 16
@@ -131,12 +145,14 @@ TEST(UdpLinkEncode, NanDistanceAndSaturatedFields) {
   EXPECT_EQ(b[30], 0x7F);
   EXPECT_EQ(b[35], 0xFF);
   EXPECT_EQ(b[36], 0xFF);
+  for (size_t i = 37; i < 41; ++i) EXPECT_EQ(b[i], 0xFF) << "session byte " << i;
 }
 
 TEST(UdpLinkDecode, ReadsTheHandLaidDatagram) {
   const LinkDecodeResult r = decode_link_datagram(kHandLaid.data(), kHandLaid.size());
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_EQ(r.datagram.kind, LinkKind::frame);
+  EXPECT_EQ(r.datagram.session, 0x89ABCDEFU);
   EXPECT_EQ(r.datagram.sequence, 0x01020304U);
   EXPECT_EQ(r.datagram.timestamp_ns, 0x0011223344556677LL);
   EXPECT_EQ(r.datagram.verdict, VerdictState::slow);
@@ -148,11 +164,24 @@ TEST(UdpLinkDecode, ReadsTheHandLaidDatagram) {
 }
 
 TEST(UdpLinkDecode, WrongLengthIsRejected) {
-  EXPECT_EQ(decode_link_datagram(nullptr, 0).error, "size: expected 41 bytes, got 0");
-  EXPECT_EQ(decode_link_datagram(kHandLaid.data(), 40).error, "size: expected 41 bytes, got 40");
+  EXPECT_EQ(decode_link_datagram(nullptr, 0).error, "size: expected 45 bytes, got 0");
+  EXPECT_EQ(decode_link_datagram(kHandLaid.data(), 5).error, "size: expected 45 bytes, got 5");
+  EXPECT_EQ(decode_link_datagram(kHandLaid.data(), 41).error, "size: expected 45 bytes, got 41");
+  EXPECT_EQ(decode_link_datagram(kHandLaid.data(), 44).error, "size: expected 45 bytes, got 44");
   std::vector<uint8_t> longer(kHandLaid.begin(), kHandLaid.end());
   longer.push_back(0);
-  EXPECT_EQ(decode(longer).error, "size: expected 41 bytes, got 42");
+  EXPECT_EQ(decode(longer).error, "size: expected 45 bytes, got 46");
+}
+
+TEST(UdpLinkDecode, VersionOneIsRejectedByName) {
+  // A version 1 sender cannot be told from its restarted self: refused however long it is.
+  const std::string expected =
+      "version: 1 is the 41-byte layout without a session, which cannot tell a restarted sender from the one "
+      "that died; expected 2 (update the sender)";
+  EXPECT_EQ(decode_link_datagram(kVersion1.data(), kVersion1.size()).error, expected);
+  EXPECT_EQ(decode(patched(4, {1, 0})).error, expected);  // 45 bytes saying version 1
+  EXPECT_EQ(decode(patched(4, {3, 0})).error, "version: 3, expected 2");
+  EXPECT_EQ(decode(patched(4, {0, 0})).error, "version: 0, expected 2");
 }
 
 TEST(UdpLinkDecode, EveryFlippedBitAndByteIsRejected) {
@@ -176,16 +205,20 @@ TEST(UdpLinkDecode, EveryFlippedBitAndByteIsRejected) {
     }
   }
   std::vector<uint8_t> crc_flipped(kHandLaid.begin(), kHandLaid.end());
-  crc_flipped[37] ^= 0x01;
-  EXPECT_EQ(decode(crc_flipped).error, "crc: 0x760d0478 in the datagram, 0x760d0479 computed");
+  crc_flipped[41] ^= 0x01;
+  EXPECT_EQ(decode(crc_flipped).error, "crc: 0xa82f0728 in the datagram, 0xa82f0729 computed");
+  std::vector<uint8_t> session_flipped(kHandLaid.begin(), kHandLaid.end());
+  session_flipped[37] ^= 0x01;  // the CRC covers the session
+  EXPECT_EQ(decode(session_flipped).error.rfind("crc: ", 0), 0U);
 }
 
 TEST(UdpLinkDecode, EachBadValueWithAGoodCrcNamesItsField) {
   const auto error_of = [](size_t at, const std::vector<uint8_t>& patch) { return decode(patched(at, patch)).error; };
   EXPECT_EQ(error_of(0, {'H', 'R', 'C', 'X'}), "magic: expected \"HRCS\"");
-  EXPECT_EQ(error_of(4, {2, 0}), "version: 2, expected 1");
+  EXPECT_EQ(error_of(4, {9, 0}), "version: 9, expected 2");
   EXPECT_EQ(error_of(6, {0, 0}), "kind: 0 is not 1, 2 or 3");
   EXPECT_EQ(error_of(6, {4, 0}), "kind: 4 is not 1, 2 or 3");
+  EXPECT_EQ(error_of(37, {0, 0, 0, 0}), "session: 0 is never sent (a sender draws a non-zero session at start)");
   EXPECT_EQ(error_of(12, {0, 0, 0, 0, 0, 0, 0, 0x80}), "timestamp_ns: -9223372036854775808 is negative");
   EXPECT_EQ(error_of(20, {3}), "verdict: 3 is not 0, 1 or 2");
   EXPECT_EQ(error_of(6, {2, 0}), "verdict: a heartbeat must say stop (2), got 1");
@@ -204,6 +237,8 @@ TEST(UdpLinkDecode, EachBadValueWithAGoodCrcNamesItsField) {
   EXPECT_TRUE(decode(patched(23, float_le(0.0F))).ok);
   EXPECT_TRUE(decode(patched(23, float_le(1.0F))).ok);
   EXPECT_TRUE(decode(patched(21, {30, 0})).ok);
+  EXPECT_EQ(decode(patched(37, {1, 0, 0, 0})).datagram.session, 1U);
+  EXPECT_EQ(decode(patched(37, {0xFF, 0xFF, 0xFF, 0xFF})).datagram.session, 0xFFFFFFFFU);
 }
 
 TEST(UdpLinkDecode, FuzzSeedsDecodeAsNamed) {
@@ -218,7 +253,11 @@ TEST(UdpLinkDecode, FuzzSeedsDecodeAsNamed) {
   EXPECT_EQ(decode(read("no_contact")).ok, true);
   EXPECT_TRUE(std::isnan(decode(read("no_contact")).datagram.distance_m));
   EXPECT_EQ(decode(read("bad_crc")).error.rfind("crc: ", 0), 0U);
-  EXPECT_EQ(decode(read("short")).error, "size: expected 41 bytes, got 20");
+  EXPECT_EQ(decode(read("short")).error, "size: expected 45 bytes, got 20");
+  EXPECT_EQ(decode(read("version1")).error.rfind("version: 1 is the 41-byte layout without a session", 0), 0U);
+  for (const char* name : {"frame", "heartbeat", "final_stop", "no_contact"}) {
+    EXPECT_NE(decode(read(name)).datagram.session, 0U) << name;
+  }
 }
 
 TEST(UdpLinkDatagramFrom, TakesTheVerdictAndMakesUnsendableValuesSafe) {
@@ -231,8 +270,9 @@ TEST(UdpLinkDatagramFrom, TakesTheVerdictAndMakesUnsendableValuesSafe) {
   r.contact.valid = true;
   r.contact.distance_m = 0.8F;
   r.robot_state_age_ms = 12.5;  // rounds half away from zero
-  LinkDatagram d = link_datagram_from(r, LinkKind::frame, 7);
+  LinkDatagram d = link_datagram_from(r, LinkKind::frame, 0xC0FFEEU, 7);
   EXPECT_EQ(d.kind, LinkKind::frame);
+  EXPECT_EQ(d.session, 0xC0FFEEU);
   EXPECT_EQ(d.sequence, 7U);
   EXPECT_EQ(d.timestamp_ns, 123456789);
   EXPECT_EQ(d.verdict, VerdictState::slow);
@@ -243,19 +283,19 @@ TEST(UdpLinkDatagramFrom, TakesTheVerdictAndMakesUnsendableValuesSafe) {
   EXPECT_EQ(d.robot_state_age_ms, 13);
 
   r.contact.valid = false;  // no contact: NaN
-  EXPECT_TRUE(std::isnan(link_datagram_from(r, LinkKind::frame, 0).distance_m));
+  EXPECT_TRUE(std::isnan(link_datagram_from(r, LinkKind::frame, 1, 0).distance_m));
   r.robot_state_age_ms = 70000.0;
-  EXPECT_EQ(link_datagram_from(r, LinkKind::frame, 0).robot_state_age_ms, 65535);
+  EXPECT_EQ(link_datagram_from(r, LinkKind::frame, 1, 0).robot_state_age_ms, 65535);
   r.robot_state_age_ms = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_EQ(link_datagram_from(r, LinkKind::frame, 0).robot_state_age_ms, 65535);
+  EXPECT_EQ(link_datagram_from(r, LinkKind::frame, 1, 0).robot_state_age_ms, 65535);
   r.robot_state_age_ms = -3.0;
-  EXPECT_EQ(link_datagram_from(r, LinkKind::frame, 0).robot_state_age_ms, 0);
+  EXPECT_EQ(link_datagram_from(r, LinkKind::frame, 1, 0).robot_state_age_ms, 0);
   r.verdict.speed_scale = 1.5F;
-  EXPECT_EQ(link_datagram_from(r, LinkKind::frame, 0).speed_scale, 1.0F);
+  EXPECT_EQ(link_datagram_from(r, LinkKind::frame, 1, 0).speed_scale, 1.0F);
   r.verdict.protective_distance_m = std::numeric_limits<float>::infinity();
-  EXPECT_EQ(link_datagram_from(r, LinkKind::frame, 0).protective_distance_m, 0.0F);
+  EXPECT_EQ(link_datagram_from(r, LinkKind::frame, 1, 0).protective_distance_m, 0.0F);
   r.verdict.speed_scale = std::numeric_limits<float>::quiet_NaN();
-  d = link_datagram_from(r, LinkKind::frame, 0);
+  d = link_datagram_from(r, LinkKind::frame, 1, 0);
   EXPECT_EQ(d.verdict, VerdictState::stop);
   EXPECT_EQ(d.reason, ReasonCode::non_finite_input);
   EXPECT_EQ(d.speed_scale, 0.0F);
@@ -344,11 +384,15 @@ TEST(UdpLinkSink, FramesArriveInOrderWithTheirValues) {
   const Receiver receiver;
   FakeClock clock(1000 * kMs);
   UdpLinkSink sink(params_for(receiver), clock);
+  // By default the process's session, the one the JSON Lines header names.
+  EXPECT_NE(sink.session(), 0U);
+  EXPECT_EQ(sink.session(), process_session());
   sink.header(RunHeader{});
   for (int64_t k = 0; k < 10; ++k) sink.frame(frame_at(k, 1000 * kMs + k, k % 2 == 1));
   for (uint32_t k = 0; k < 10; ++k) {
     const LinkDatagram d = receiver.next_datagram();
     EXPECT_EQ(d.kind, LinkKind::frame);
+    EXPECT_EQ(d.session, process_session());
     EXPECT_EQ(d.sequence, k);
     EXPECT_EQ(d.timestamp_ns, 1000 * kMs + k);
     if (k % 2 == 1) {
@@ -399,6 +443,36 @@ TEST(UdpLinkSink, HeartbeatsWhenFramesStopSayStopWithTheLastFramesTime) {
   EXPECT_EQ(d.sequence, 5U);
   EXPECT_EQ(d.timestamp_ns, 400 * kMs);
   EXPECT_EQ(sink.counters().heartbeats, 4);
+}
+
+TEST(UdpLinkSink, EveryKindCarriesTheSinksSessionAndASecondSinkStartsItsOwnCount) {
+  const Receiver receiver;
+  FakeClock clock(0);
+  UdpLinkParams first_params = params_for(receiver);
+  first_params.session = 0x11111111U;
+  {
+    UdpLinkSink first(first_params, clock);
+    EXPECT_EQ(first.session(), 0x11111111U);
+    first.frame(frame_at(0, 5 * kMs, false));
+    clock.advance(100 * kMs);  // one heartbeat
+    const LinkDatagram frame = receiver.next_datagram();
+    const LinkDatagram heartbeat = receiver.next_datagram();
+    EXPECT_EQ(frame.session, 0x11111111U);
+    EXPECT_EQ(heartbeat.kind, LinkKind::heartbeat);
+    EXPECT_EQ(heartbeat.session, 0x11111111U);
+    EXPECT_EQ(heartbeat.sequence, 1U);
+  }
+  const LinkDatagram last = receiver.next_datagram();  // the destructor's final stop
+  EXPECT_EQ(last.kind, LinkKind::final_stop);
+  EXPECT_EQ(last.session, 0x11111111U);
+  // What a restart looks like on the wire: another session, the sequence from 0 again.
+  UdpLinkParams second_params = params_for(receiver);
+  second_params.session = 0x22222222U;
+  UdpLinkSink second(second_params, clock);
+  second.frame(frame_at(0, 900 * kMs, false));
+  const LinkDatagram again = receiver.next_datagram();
+  EXPECT_EQ(again.session, 0x22222222U);
+  EXPECT_EQ(again.sequence, 0U);
 }
 
 TEST(UdpLinkSink, NoHeartbeatWhileFramesCome) {
@@ -493,6 +567,7 @@ TEST(UdpLinkSink, JsonFormatSendsTheFramesLine) {
   UdpLinkParams params = params_for(receiver);
   params.format = UdpLinkParams::Format::json;
   params.backend = "octree";  // proximity.backend, named when no search ran
+  params.session = 4000000000U;  // above 2^31: written unsigned
   UdpLinkSink sink(params, clock);
   sink.header(RunHeader{});
   FrameResult frame = frame_at(3, 42 * kMs, true);
@@ -505,26 +580,31 @@ TEST(UdpLinkSink, JsonFormatSendsTheFramesLine) {
   std::string expected = expected_out.str();
   ASSERT_FALSE(expected.empty());
   expected.pop_back();  // the newline
+  // ... with the session as its second member.
+  const std::string type_member = "{\"type\":\"frame\",";
+  ASSERT_EQ(expected.rfind(type_member, 0), 0U) << expected;
+  expected.insert(type_member.size(), "\"session\":4000000000,");
   const std::optional<std::string> line = receiver.next();
   ASSERT_TRUE(line);
   EXPECT_EQ(*line, expected);
   EXPECT_EQ(nlohmann::json::parse(*line).at("type"), "frame");
+  EXPECT_EQ(nlohmann::json::parse(*line).at("session").get<uint64_t>(), 4000000000U);
   EXPECT_EQ(nlohmann::json::parse(*line).at("backend"), "octree");
 
   clock.advance(100 * kMs);
   const std::optional<std::string> heartbeat = receiver.next();
   ASSERT_TRUE(heartbeat);
   EXPECT_EQ(*heartbeat,
-            "{\"type\":\"heartbeat\",\"sequence\":1,\"timestamp_ns\":42000000,\"verdict\":\"stop\","
-            "\"reason_code\":\"no_frame\"}");
+            "{\"type\":\"heartbeat\",\"session\":4000000000,\"sequence\":1,\"timestamp_ns\":42000000,"
+            "\"verdict\":\"stop\",\"reason_code\":\"no_frame\"}");
   RunSummary summary;
   summary.end_code = ReasonCode::stop_requested;
   sink.summary(summary);
   const std::optional<std::string> last = receiver.next();
   ASSERT_TRUE(last);
   EXPECT_EQ(*last,
-            "{\"type\":\"final_stop\",\"sequence\":2,\"timestamp_ns\":42000000,\"verdict\":\"stop\","
-            "\"reason_code\":\"stop_requested\"}");
+            "{\"type\":\"final_stop\",\"session\":4000000000,\"sequence\":2,\"timestamp_ns\":42000000,"
+            "\"verdict\":\"stop\",\"reason_code\":\"stop_requested\"}");
 }
 
 TEST(UdpLinkSink, SendErrorsAreCountedNeverThrown) {
@@ -587,11 +667,13 @@ TEST(UdpLinkCli, RunSendsOneDatagramPerVerdictLineThenAFinalStop) {
   // The lines the run wrote through its sinks, in order: frames and verdicts (watchdog and
   // end-of-run stops).
   std::vector<nlohmann::json> lines;
+  nlohmann::json header;
   std::ifstream in(out);
   std::string text;
   while (std::getline(in, text)) {
     nlohmann::json j = nlohmann::json::parse(text);
     if (j.at("type") == "frame" || j.at("type") == "verdict") lines.push_back(j);
+    if (j.at("type") == "header") header = j;
   }
   std::remove(out.c_str());
   int frame_lines = 0;
@@ -605,6 +687,9 @@ TEST(UdpLinkCli, RunSendsOneDatagramPerVerdictLineThenAFinalStop) {
         decode_link_datagram(reinterpret_cast<const uint8_t*>(datagrams[k].data()), datagrams[k].size());
     ASSERT_TRUE(r.ok) << k << ": " << r.error;
     EXPECT_EQ(r.datagram.sequence, k) << "+1 per datagram, from 0";
+    // One session for the whole run, the one its JSON Lines header names.
+    ASSERT_TRUE(header.contains("session") && header.at("session").is_number_unsigned()) << header.dump();
+    EXPECT_EQ(r.datagram.session, header.at("session").get<uint32_t>()) << k;
     if (r.datagram.kind == LinkKind::frame) frames.push_back(r.datagram);
     if (r.datagram.kind == LinkKind::heartbeat) {
       EXPECT_EQ(r.datagram.verdict, VerdictState::stop);

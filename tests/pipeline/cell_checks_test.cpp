@@ -4,6 +4,7 @@
 // pipeline must stop with the fault's reason code within 100 ms of the frames' own time (the
 // frame times are the simulator's: the clock is the scene's, not the machine's).
 
+#include "../support/decide.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/cell_checks.hpp"
 #include "hrcsense/config.hpp"
@@ -106,7 +107,7 @@ struct FaultRig {
     state.qd_rad_s = joints.qd_rad_s;
     state.sample_time_ns = frame.timestamp_ns;
     frame.host_time_ns = frame.timestamp_ns;
-    pipeline.process(frame, state, result);
+    test::process_and_decide(pipeline, frame, state, result);
   }
   // Runs frames 0..129 of `faulty` (frames from 110 on; `clean` before), returning the first
   // frame from 110 on whose verdict has `code`, -1 if none; every frame 100..109 must run.

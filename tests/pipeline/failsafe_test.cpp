@@ -3,6 +3,7 @@
 // pose that overflows, frames the filters empty, a damaged loaded background, timestamps that
 // jump, go backwards or repeat, a sink whose reader left.
 
+#include "../support/decide.hpp"
 #include "fake_scene.hpp"
 
 #include "hrcsense/sinks.hpp"
@@ -39,7 +40,7 @@ TEST(Failsafe, ForegroundWithoutContactIsStop) {
   FrameResult result;
   ASSERT_TRUE(test::learn_wall(pipeline, frame, result));
   fill_frame(3, 1.5F, frame);  // a 40x40 px object at 1.5 m: 1600 foreground pixels
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.foreground_points, 1600U);
   EXPECT_FALSE(result.contact.valid);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
@@ -47,7 +48,7 @@ TEST(Failsafe, ForegroundWithoutContactIsStop) {
   EXPECT_EQ(result.verdict.code, ReasonCode::non_finite_input);
   // The empty cell with the same broken pose has no foreground: that one is still run.
   fill_frame(4, 0.0F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.foreground_points, 0U);
   EXPECT_EQ(result.verdict.state, VerdictState::run);
 }
@@ -61,7 +62,7 @@ TEST(Failsafe, RobotAtInfinityIsStop) {
   FrameResult result;
   ASSERT_TRUE(test::learn_wall(pipeline, frame, result));
   fill_frame(3, 1.5F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_GT(result.foreground_points, 0U);
   EXPECT_NE(result.verdict.state, VerdictState::run) << result.verdict.reason;
   EXPECT_NE(result.verdict.state, VerdictState::slow) << result.verdict.reason;
@@ -77,7 +78,7 @@ TEST(Failsafe, NoValidDepthAfterTheFiltersIsStop) {
   Frame frame;
   FrameResult result;
   fill_frame(0, 0.0F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.invalid_pixels, 0U);  // the source frame itself is complete
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_EQ(result.verdict.reason, "no valid depth after filters");
@@ -95,7 +96,7 @@ TEST(Failsafe, TooFewValidPixelsIsStop) {
   fill_frame(3, 0.0F, frame);
   std::fill(frame.depth.pixels.begin(), frame.depth.pixels.end(), uint16_t{0});
   frame.depth.pixels[100] = 2000;
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_NE(result.verdict.reason.find("min_valid_share"), std::string::npos) << result.verdict.reason;
   EXPECT_FLOAT_EQ(result.valid_share, 1.0F / 4800.0F);
@@ -106,7 +107,7 @@ TEST(Failsafe, TooFewValidPixelsIsStop) {
   for (size_t i = 0; i < frame.depth.pixels.size(); ++i) {
     if (frame.depth.pixels[i] == 2000) frame.depth.pixels[i] = 0;  // the wall is gone
   }
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_TRUE(result.valid) << result.verdict.reason;
   EXPECT_FLOAT_EQ(result.valid_share, 1600.0F / 4800.0F);
   EXPECT_EQ(result.verdict.state, VerdictState::run);  // 1.5 m is beyond slow_distance_m 1.0 m
@@ -124,7 +125,7 @@ TEST(Failsafe, InsideTheRobotIsStopWhateverTheZones) {
   FrameResult result;
   ASSERT_TRUE(test::learn_wall(pipeline, frame, result));
   fill_frame(3, 1.5F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   ASSERT_TRUE(result.contact.valid);
   EXPECT_TRUE(result.contact.inside);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
@@ -143,15 +144,15 @@ TEST(Failsafe, LoadedBackgroundThatMatchesIsUsedAfterTheCheck) {
   FrameResult result;
   // A person in front of the wall only makes pixels nearer: no reason to doubt the file.
   fill_frame(0, 1.5F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_EQ(result.verdict.reason, "checking loaded background (1/2 frames)");
   EXPECT_EQ(result.verdict.code, ReasonCode::checking_background);
   fill_frame(1, 1.5F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.verdict.reason, "checking loaded background (2/2 frames)");
   fill_frame(2, 0.8F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_TRUE(result.valid);
   EXPECT_EQ(result.verdict.state, VerdictState::slow);
 }
@@ -172,11 +173,11 @@ TEST(Failsafe, LoadedBackgroundNearerThanTheSceneIsRefused) {
   Frame frame;
   FrameResult result;
   fill_frame(0, 0.0F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   fill_frame(1, 0.0F, frame);
   try {
-    pipeline.process(frame, fixed_robot_state({}), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
     FAIL() << "a background 1 m nearer than the whole scene was accepted";
   } catch (const BackgroundMismatch& e) {
     EXPECT_NE(std::string(e.what()).find("100.0 %"), std::string::npos) << e.what();

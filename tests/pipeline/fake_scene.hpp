@@ -4,6 +4,7 @@
 // a sink that tests can hold back, and a fake clock that tells the run's threads apart.
 #pragma once
 
+#include "../support/decide.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/robot_state.hpp"
 
@@ -174,28 +175,27 @@ class WatchedClock : public RunClock {
   int64_t now_ns() const override {
     const std::thread::id reader = std::this_thread::get_id();
     std::lock_guard<std::mutex> lock(mutex_);
-    if (reader == output_thread_) {
-      ++output_reads_;
-    } else if (reader != capture_thread_ && processing_reads_++ == slow_frame_) {
-      fake.advance(slow_frame_ns_);
-      slow_frame_done_ = true;
-    }
+    if (reader == output_thread_) ++output_reads_;
     read_.notify_all();
     return fake.now_ns();
   }
   void sleep_until(int64_t t_ns, const std::atomic<bool>* stop_requested) override {
     fake.sleep_until(t_ns, stop_requested);
   }
-  void capture_thread_is(std::thread::id id) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    capture_thread_ = id;
-  }
-  /// Processing frame `frame` (the frame-th one processed, from 0) takes `cost_ns` of fake
-  /// time: the processing thread's read at its end moves the clock on by that first.
+  /// Frame `frame` takes `cost_ns` of fake time between its measurement and its decision
+  /// (slow processing, or the whole process stalled): processed() moves the clock on then.
   void slow_processing(int64_t frame, int64_t cost_ns) {
     std::lock_guard<std::mutex> lock(mutex_);
     slow_frame_ = frame;
     slow_frame_ns_ = cost_ns;
+  }
+  /// RunOptions::on_processed's hook, on the processing thread once frame `index` is measured.
+  void processed(int64_t index) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (index != slow_frame_) return;
+    fake.advance(slow_frame_ns_);
+    slow_frame_done_ = true;
+    read_.notify_all();
   }
   /// Waits (real time, at most `timeout_s`) until the slow frame has taken its time.
   bool wait_slow_frame(double timeout_s = kTestWaitS) const {
@@ -218,9 +218,7 @@ class WatchedClock : public RunClock {
   mutable std::mutex mutex_;
   mutable std::condition_variable read_;
   std::thread::id output_thread_ = std::this_thread::get_id();
-  std::thread::id capture_thread_;
   mutable int64_t output_reads_ = 0;
-  mutable int64_t processing_reads_ = 0;
   int64_t slow_frame_ = -1;
   int64_t slow_frame_ns_ = 0;
   mutable bool slow_frame_done_ = false;
@@ -232,7 +230,7 @@ class WatchedClock : public RunClock {
 inline bool learn_wall(Pipeline& pipeline, Frame& frame, FrameResult& result) {
   for (int i = 0; i < kLearnFrames; ++i) {
     fill_frame(i, 0.0F, frame);
-    pipeline.process(frame, fixed_robot_state({}), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   }
   return pipeline.background_ready();
 }
@@ -243,7 +241,7 @@ inline BackgroundModel learn_empty_background() {
   FrameResult result;
   for (int i = 0; i < kLearnFrames; ++i) {
     fill_frame(i, 0.0F, frame);
-    learner.process(frame, fixed_robot_state({}), result);
+    test::process_and_decide(learner, frame, fixed_robot_state({}), result);
   }
   return learner.background();
 }

@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tests of Pipeline::process on hand-built frames, one frame at a time.
 
+#include "../support/decide.hpp"
 #include "fake_scene.hpp"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 namespace hrcsense {
@@ -16,13 +18,42 @@ using test::fill_frame;
 
 using test::learn_empty_background;
 
+// Each point of robot.model points is a link, measured on its own: a second point 1 m behind the
+// camera (link 7) has its own closest pair, 1 m farther along z. The overall pair is link 2's.
+TEST(Pipeline, MeasuresEveryLinkOnItsOwn) {
+  PipelineParams params = fake_params();
+  Capsule behind;
+  behind.a = behind.b = {0.0F, 0.0F, -1.0F};
+  behind.link = 7;
+  params.robot.points.capsules.push_back(behind);
+  Pipeline pipeline(params);
+  Frame frame;
+  FrameResult result;
+  ASSERT_TRUE(test::learn_wall(pipeline, frame, result));
+  fill_frame(3, 0.8F, frame);
+  pipeline.process(frame, fixed_robot_state({}), result);
+  ASSERT_TRUE(result.valid);
+  ASSERT_EQ(result.links.size(), 2U);
+  EXPECT_EQ(result.links[0].link, 2);
+  EXPECT_EQ(result.links[1].link, 7);
+  EXPECT_NEAR(result.links[0].contact.distance_m, expected_distance_m(0.8), 1e-4);
+  // The nearest pixel centres are half a pixel off the axis: x = y = 0.5 / fx · 0.8 m.
+  const double off = 0.5 / 100.0 * 0.8;
+  EXPECT_NEAR(result.links[1].contact.distance_m, std::sqrt(2.0 * off * off + 1.8 * 1.8), 1e-4);
+  EXPECT_EQ(result.contact.robot_link, 2);
+  for (const LinkContact& link : result.links) {
+    EXPECT_EQ(link.speed_towards_mps, 0.0F);  // fixed points do not move
+    EXPECT_GT(link.distance_uncertainty_m, 0.0F);
+  }
+}
+
 TEST(Pipeline, LearnsThenMeasuresTheObject) {
   Pipeline pipeline(fake_params());
   Frame frame;
   FrameResult result;
   for (int i = 0; i < test::kLearnFrames; ++i) {
     fill_frame(i, 0.0F, frame);
-    pipeline.process(frame, fixed_robot_state({}), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
     EXPECT_FALSE(result.valid);
     EXPECT_EQ(result.verdict.state, VerdictState::stop);
     EXPECT_EQ(result.verdict.reason,
@@ -33,7 +64,7 @@ TEST(Pipeline, LearnsThenMeasuresTheObject) {
   EXPECT_TRUE(pipeline.background_ready());
 
   fill_frame(3, 0.8F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_TRUE(result.valid);
   EXPECT_EQ(result.frame, 3);
   EXPECT_EQ(result.timestamp_ns, 3 * 33'333'333);
@@ -54,7 +85,7 @@ TEST(Pipeline, LearnsThenMeasuresTheObject) {
 
   // The wall alone again: nothing in the cell, run.
   fill_frame(4, 0.0F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_TRUE(result.valid);
   EXPECT_FALSE(result.contact.valid);
   EXPECT_EQ(result.foreground_points, 0U);
@@ -66,7 +97,7 @@ TEST(Pipeline, NoValidDepthIsStop) {
   Frame frame;
   FrameResult result;
   fill_frame(0, -1.0F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_FALSE(result.valid);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_EQ(result.verdict.reason, "no valid depth");
@@ -80,7 +111,7 @@ TEST(Pipeline, CountsInvalidPixels) {
   FrameResult result;
   fill_frame(0, 0.0F, frame);
   for (int i = 0; i < 17; ++i) frame.depth.pixels[static_cast<size_t>(i * 7)] = 0;
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.invalid_pixels, 17U);
 }
 
@@ -92,11 +123,11 @@ TEST(Pipeline, CopiesTruthAndClearsItAgain) {
   frame.truth.emplace();
   frame.truth->contact.valid = true;
   frame.truth->contact.distance_m = 1.25F;
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   ASSERT_TRUE(result.truth.has_value());
   EXPECT_EQ(result.truth->distance_m, 1.25F);
   frame.truth.reset();
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_FALSE(result.truth.has_value());
 }
 
@@ -112,7 +143,7 @@ TEST(Pipeline, PresetBackgroundSkipsLearning) {
   pipeline.set_background(background);
   EXPECT_TRUE(pipeline.background_ready());
   fill_frame(0, 0.3F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_TRUE(result.valid);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_NEAR(result.contact.distance_m, expected_distance_m(0.3), 1e-4);
@@ -129,7 +160,7 @@ TEST(Pipeline, EmptyRobotModelIsStop) {
   Pipeline pipeline(params);
   pipeline.set_background(background);
   fill_frame(0, 0.0F, frame);  // an empty cell: without the rule this would be run
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_FALSE(result.valid);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_EQ(result.verdict.reason, "no robot model");
@@ -147,7 +178,7 @@ TEST(Pipeline, BackgroundOfAnotherSizeIsStop) {
   Frame frame;
   FrameResult result;
   fill_frame(0, 0.5F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_FALSE(result.valid);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_FALSE(result.verdict.reason.empty());
@@ -161,7 +192,7 @@ TEST(Pipeline, MovingSceneRestartsLearningWithTheLearnersMessage) {
   const float batch[] = {0.0F, 1.0F, 0.0F};
   for (int i = 0; i < 3; ++i) {
     fill_frame(i, batch[i], frame);
-    pipeline.process(frame, fixed_robot_state({}), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   }
   EXPECT_FALSE(pipeline.background_ready());
   ASSERT_FALSE(pipeline.background_message().empty());

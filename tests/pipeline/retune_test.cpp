@@ -2,6 +2,7 @@
 // Tests of what changes while the cell runs: Pipeline::retune, relearn_background and
 // RunOptions::before_process (hrcsense-view's panels reach the pipeline through them).
 
+#include "../support/decide.hpp"
 #include "fake_scene.hpp"
 
 #include <gtest/gtest.h>
@@ -20,7 +21,7 @@ using test::fill_frame;
 bool learn_then_see_the_object(Pipeline& pipeline, Frame& frame, FrameResult& result) {
   if (!test::learn_wall(pipeline, frame, result)) return false;
   fill_frame(3, 0.8F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   return result.verdict.state == VerdictState::slow;
 }
 
@@ -36,7 +37,7 @@ TEST(Retune, ForegroundChangeTakesEffectOnTheNextFrame) {
   pipeline.retune(tuning);
   EXPECT_EQ(pipeline.params().foreground.min_object_mm, 1e6F);
   fill_frame(4, 0.8F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_TRUE(result.valid);
   EXPECT_EQ(result.foreground_points, 0U);
   EXPECT_EQ(result.verdict.code, ReasonCode::no_foreground);
@@ -44,7 +45,7 @@ TEST(Retune, ForegroundChangeTakesEffectOnTheNextFrame) {
   tuning.foreground.min_object_mm = 40.0F;  // back: 320 mm is an object again
   pipeline.retune(tuning);
   fill_frame(5, 0.8F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.foreground_points, 40U * 40U);
   EXPECT_EQ(result.verdict.state, VerdictState::slow);
 }
@@ -64,14 +65,14 @@ TEST(Retune, FilterParameterChangeTakesEffect) {
   tuning.filters.threshold.max_m = 1.5F;
   pipeline.retune(tuning);
   fill_frame(3, 0.8F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.invalid_pixels, 0U);  // counted on the source frame, before the filters
   EXPECT_NEAR(result.valid_share, 1600.0F / 4800.0F, 1e-6F);
   // With max 0.5 m nothing is left at all: a stop.
   tuning.filters.threshold.max_m = 0.5F;
   pipeline.retune(tuning);
   fill_frame(4, 0.8F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_FALSE(result.valid);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_EQ(result.verdict.code, ReasonCode::no_valid_depth);
@@ -87,7 +88,7 @@ TEST(Retune, BackendChangeKeepsTheExactDistance) {
     tuning.backend = backend;
     pipeline.retune(tuning);
     fill_frame(3, 0.8F, frame);
-    pipeline.process(frame, fixed_robot_state({}), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
     ASSERT_TRUE(result.contact.valid) << backend;
     EXPECT_NEAR(result.contact.distance_m, expected_distance_m(0.8), 1e-4) << backend;
     EXPECT_STREQ(result.backend, backend);
@@ -129,18 +130,18 @@ TEST(Relearn, TheObjectPresentWhileRelearningBecomesBackground) {
   EXPECT_FALSE(pipeline.background_ready());
   for (int i = 0; i < test::kLearnFrames; ++i) {
     fill_frame(4 + i, 0.8F, frame);  // the object stands still: it is part of the scene now
-    pipeline.process(frame, fixed_robot_state({}), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
     EXPECT_FALSE(result.valid);
     EXPECT_EQ(result.verdict.code, ReasonCode::learning_background);
   }
   EXPECT_TRUE(pipeline.background_ready());
   fill_frame(7, 0.8F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_TRUE(result.valid);
   EXPECT_EQ(result.verdict.code, ReasonCode::no_foreground);
   // And where the object stood, the wall behind it is farther than the background: not foreground.
   fill_frame(8, 0.0F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.foreground_points, 0U);
 }
 
@@ -153,7 +154,7 @@ TEST(Relearn, ALoadedBackgroundIsForgottenToo) {
   Frame frame;
   FrameResult result;
   fill_frame(0, 0.0F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.verdict.code, ReasonCode::learning_background);
 }
 

@@ -3,6 +3,7 @@
 // given, an invalid or non-finite state is a stop, and run_pipeline asks the robot state source
 // for every frame.
 
+#include "../support/decide.hpp"
 #include "fake_scene.hpp"
 
 #include "hrcsense/clock.hpp"
@@ -44,7 +45,7 @@ void learn(Pipeline& pipeline) {
   RobotState none;
   for (int i = 0; i < test::kLearnFrames; ++i) {
     fill_frame(i, 0.0F, frame);
-    pipeline.process(frame, none, result);
+    test::process_and_decide(pipeline, frame, none, result);
     ASSERT_EQ(result.verdict.code, ReasonCode::learning_background);
   }
   ASSERT_TRUE(pipeline.background_ready());
@@ -71,7 +72,7 @@ TEST(RobotStatePerFrame, ArmCapsulesFollowTheJointState) {
   const double expected_m = std::sqrt(0.344 * 0.344 + 0.004 * 0.004 + 0.8 * 0.8);
 
   fill_frame(3, 0.8F, frame);
-  pipeline.process(frame, joints(0.0), result);
+  test::process_and_decide(pipeline, frame, joints(0.0), result);
   ASSERT_TRUE(result.valid) << result.verdict.reason;
   ASSERT_TRUE(result.contact.valid);
   EXPECT_NEAR(result.contact.distance_m, expected_m, 1e-5);
@@ -82,7 +83,7 @@ TEST(RobotStatePerFrame, ArmCapsulesFollowTheJointState) {
   EXPECT_NEAR(pipeline.robot().capsules[0].b.x(), 1.0F, 1e-6F);
 
   fill_frame(4, 0.8F, frame);
-  pipeline.process(frame, joints(kPi / 2.0), result);
+  test::process_and_decide(pipeline, frame, joints(kPi / 2.0), result);
   ASSERT_TRUE(result.contact.valid);
   EXPECT_NEAR(result.contact.distance_m, expected_m, 1e-5);
   EXPECT_NEAR(result.contact.closest_robot_base.x(), 0.0F, 1e-6F);
@@ -100,12 +101,12 @@ TEST(RobotStatePerFrame, InvalidStateIsStop) {
     Frame frame;
     FrameResult result;
     fill_frame(3, 0.0F, frame);  // the empty cell: with a state this is run
-    pipeline.process(frame, joints(0.0), result);
+    test::process_and_decide(pipeline, frame, joints(0.0), result);
     ASSERT_EQ(result.verdict.state, VerdictState::run) << arm;
     RobotState none = joints(0.0);
     none.valid = false;
     fill_frame(4, 0.0F, frame);
-    pipeline.process(frame, none, result);
+    test::process_and_decide(pipeline, frame, none, result);
     EXPECT_EQ(result.verdict.state, VerdictState::stop) << arm;
     EXPECT_EQ(result.verdict.code, ReasonCode::no_robot_state) << arm;
     EXPECT_EQ(result.verdict.reason, "no robot state");
@@ -122,7 +123,7 @@ TEST(RobotStatePerFrame, NonFiniteJointIsStop) {
     RobotState state = joints(0.0);
     state.q_rad[4] = bad;
     fill_frame(3, 0.0F, frame);
-    pipeline.process(frame, state, result);
+    test::process_and_decide(pipeline, frame, state, result);
     EXPECT_EQ(result.verdict.state, VerdictState::stop);
     EXPECT_EQ(result.verdict.code, ReasonCode::non_finite_input);
   }
@@ -191,7 +192,7 @@ TEST(RobotStatePerFrame, StaleStateSaysHowOld) {
   RobotState stale = joints(0.0);
   stale.valid = false;
   stale.sample_time_ns = 1'000'000'000;
-  pipeline.process(frame, stale, result);
+  test::process_and_decide(pipeline, frame, stale, result);
   EXPECT_EQ(result.verdict.state, VerdictState::stop);
   EXPECT_EQ(result.verdict.code, ReasonCode::robot_state_stale);
   EXPECT_EQ(result.verdict.reason, "robot state stale (80.0 ms old)");
@@ -200,7 +201,7 @@ TEST(RobotStatePerFrame, StaleStateSaysHowOld) {
   // A valid state 4 ms old: measured, with its age.
   RobotState fresh = joints(0.0);
   fresh.sample_time_ns = 1'076'000'000;
-  pipeline.process(frame, fresh, result);
+  test::process_and_decide(pipeline, frame, fresh, result);
   EXPECT_EQ(result.verdict.code, ReasonCode::no_foreground);
   EXPECT_DOUBLE_EQ(result.robot_state_age_ms, 4.0);
 }

@@ -2,6 +2,7 @@
 // Every proximity backend against a double-precision brute-force reference on random clouds,
 // and against the brute backend on simulated scenes.
 
+#include "../support/decide.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/robot_state.hpp"
@@ -349,7 +350,7 @@ void expect_backends_agree_on_scene(const char* config_name, int first_frame, in
   FrameResult result;
   int compared = 0;
   while (source->next(frame) == Source::Status::frame) {
-    pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state(config.robot_state.joints_rad), result);
     if (frame.index < first_frame || !result.valid || !result.contact.valid) continue;
     ASSERT_STREQ(result.backend, "brute");
     const PointCloud& base = pipeline.foreground().points_base;
@@ -377,7 +378,7 @@ TEST(ProximityScenes, PipelineReportsTheBackendItUsed) {
     Pipeline pipeline(config.pipeline);
     Frame frame;
     FrameResult result;
-    while (source->next(frame) == Source::Status::frame) pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
+    while (source->next(frame) == Source::Status::frame) test::process_and_decide(pipeline, frame, fixed_robot_state(config.robot_state.joints_rad), result);
     ASSERT_TRUE(result.valid) << backend;
     ASSERT_TRUE(result.contact.valid) << backend;
     // auto names its pick, never "auto".

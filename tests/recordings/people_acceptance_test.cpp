@@ -2,6 +2,7 @@
 // Acceptance (issue C1): the whole pipeline on a real depth camera's recording of people
 // walking through a room (../shared/data/ist_piv_lab_people, frames seconds apart), without
 // depth filters and with the default (SDK) preset.
+#include "../support/decide.hpp"
 #include "recordings_test_util.hpp"
 
 #include "common/assembly.hpp"
@@ -23,6 +24,7 @@ namespace hrcsense {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr int kEdgePx = 8;  // source pixels: a sliver of a person entering or leaving the view
 
 struct FrameStats {
   double foreground_share = 0.0;  ///< foreground pixels / all pixels
@@ -31,6 +33,7 @@ struct FrameStats {
   std::string reason;             ///< the verdict's reason
   double closest_depth_m = kNaN;
   double closest_blob_share = 0.0;  ///< size of the foreground blob holding the closest pixel
+  bool closest_at_edge = false;     ///< the closest pixel lies within kEdgePx source pixels of the border
   /// How far the closest point is in front of the empty room: the nearest valid depth of the
   /// recording's frames 0-2 (unfiltered) at its pixel or, where they have none (about 20 % of
   /// the room: windows, dark screens), within the first of 8, 16, 32 source pixels around it
@@ -105,6 +108,11 @@ FrameStats frame_stats(const Pipeline& pipeline, const Frame& processed, const F
   s.closest_depth_m = result.contact.closest_camera.z();
   s.closest_blob_share = static_cast<double>(blob_size(mask, processed.depth.width, processed.depth.height, pixel)) /
                          static_cast<double>(mask.size());
+  const int scale = room.width / processed.depth.width;  // decimation: source pixels per filtered pixel
+  const int u = pixel % processed.depth.width * scale, v = pixel / processed.depth.width * scale;
+  const int source_height = static_cast<int>(room.nearest_m.size()) / room.width;
+  s.closest_at_edge = u < kEdgePx || v < kEdgePx || u + scale > room.width - kEdgePx ||
+                      v + scale > source_height - kEdgePx;
   float room_m = 0.0F;
   for (int margin_px = 0; margin_px <= 32 && room_m == 0.0F; margin_px = std::max(2 * margin_px, 8)) {
     room_m = room.nearest_at(pixel, processed.depth.width, margin_px);
@@ -133,7 +141,7 @@ std::vector<FrameStats> run_people(const std::string& path, const std::vector<st
   std::vector<FrameStats> stats;
   while (source->next(frame) == Source::Status::frame) {
     if (stats.size() < 3) room.add(frame.depth);
-    pipeline.process(frame, fixed_robot_state(config.robot_state.joints_rad), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state(config.robot_state.joints_rad), result);
     const Frame* processed = &frame;
     if (!chain.params.order.empty()) {
       chain.start(frame, filtered);
@@ -185,19 +193,30 @@ void check_acceptance(const std::vector<FrameStats>& stats, const char* label) {
   ASSERT_EQ(stats.size(), 108U);
   // Three learning frames (the empty room), then every frame is processed.
   for (size_t i = 0; i < stats.size(); ++i) EXPECT_EQ(stats[i].valid, i >= 3) << label << ": frame " << i;
+  // Empty: at most 1 % of the image. The speckle threshold, 32 mm = 0.8 of the detection
+  // capability d (a 40 mm test piece measures 35-45 mm, docs/SAFETY.md), keeps some of this
+  // structured-light camera's noise blobs 2.7-3.5 m away: up to 0.69 % without filters (0.41 %
+  // with the old rule, a square of side 40 mm); their closest point stays at least 2.7 m from
+  // the camera and every empty frame says run.
   for (size_t i = 8; i <= 25; ++i) {
-    EXPECT_LE(stats[i].foreground_share, 0.005) << label << ": empty frame " << i;
+    EXPECT_LE(stats[i].foreground_share, 0.01) << label << ": empty frame " << i;
   }
   for (size_t i = 30; i <= 99; ++i) {
     EXPECT_GE(stats[i].foreground_share, 0.02) << label << ": frame " << i << " with people";
     EXPECT_TRUE(stats[i].contact) << label << ": frame " << i;
     // On a person: the closest point lies in a foreground blob of at least 0.25 % of the image
-    // (noise blobs in the empty frames stay below 0.15 %; a person half out of the image, as in
-    // frame 83, is 0.46 %), stands at least 0.25 m in front of everything the recording showed
-    // there in the empty frames 0-2 (the dataset README's criterion for people, checked on the
-    // unfiltered data, independently of the learnt model), and at a depth where the README
-    // finds people (0.8-2.6 m, with some slack).
-    EXPECT_GE(stats[i].closest_blob_share, 0.0025) << label << ": frame " << i;
+    // (noise blobs in the empty frames stayed below 0.15 % with the old speckle rule; a person
+    // half out of the image, as in frame 83, is 0.46 %) or, at the image's edge, in a sliver of
+    // a person entering or leaving the view (frame 42: an arm at the left edge 0.97 m away, 0.10 %; with `sdk` also frames
+    // 83-85, the left edge of frame 83's person, held by the temporal filter's persistence; the
+    // 32 mm speckle threshold keeps such slivers, the old 40 mm square rule removed them and
+    // took a farther person's point), stands at least 0.25 m in front of everything the
+    // recording showed there in the empty frames 0-2 (the dataset README's criterion for
+    // people, checked on the unfiltered data, independently of the learnt model), and at a
+    // depth where the README finds people (0.8-2.6 m, with some slack).
+    EXPECT_TRUE(stats[i].closest_blob_share >= 0.0025 || stats[i].closest_at_edge)
+        << label << ": frame " << i << ": closest point in a blob of " << 100.0 * stats[i].closest_blob_share
+        << " % away from the image's edge";
     EXPECT_GE(stats[i].closest_gap_m, 0.25) << label << ": frame " << i;  // NaN (no data) fails
     EXPECT_GT(stats[i].closest_depth_m, 0.6) << label << ": frame " << i;
     EXPECT_LT(stats[i].closest_depth_m, 4.0) << label << ": frame " << i;

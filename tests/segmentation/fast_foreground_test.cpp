@@ -5,6 +5,7 @@
 // rules themselves are checked on hand-worked frames (foreground_hand_test.cpp). Also the
 // fail-safe side of preparing.
 
+#include "../support/decide.hpp"
 #include "../../src/segmentation/foreground_tables.hpp"
 #include "synthetic_frames.hpp"
 
@@ -325,13 +326,13 @@ TEST(FastExtractor, PipelineUsesTheBackgroundSetLast) {
   fill_rect(frame, 20, 15, 10, 10, 1700);
   FrameResult result;
   pipeline.set_background(wall_background());
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   ASSERT_TRUE(result.valid) << result.verdict.reason;
   EXPECT_EQ(result.foreground_points, 100U);
   BackgroundModel nearer_wall = wall_background();
   nearer_wall.mean_m.assign(nearer_wall.mean_m.size(), 1.5F);
   pipeline.set_background(nearer_wall);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   ASSERT_TRUE(result.valid) << result.verdict.reason;
   EXPECT_EQ(result.foreground_points, 0U);
 }

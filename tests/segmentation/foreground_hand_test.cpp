@@ -8,8 +8,9 @@
 //   z² · s / (fx · B) only when the baseline B is known, z the pixel's measured depth;
 // - where the background is unknown (mean 0: never valid), a valid pixel counts only inside
 //   workspace_base, a box in the base frame (default: everywhere);
-// - 8-connected blobs whose size sqrt(pixels) · mean z / fx is below min_object_mm are removed
-//   (neighbours a few cm apart in depth join: the jump limit is 5 cm without a baseline);
+// - 8-connected blobs whose size, the diameter of the disc of their pixel area at their mean
+//   depth, 2 · sqrt(pixels / π) · mean z / fx, is below min_object_mm are removed (neighbours a
+//   few cm apart in depth join: the jump limit is 5 cm without a baseline);
 // - the rest is deprojected with the pinhole formula x = (u − ppx) / fx · z, y = (v − ppy) / fy · z
 //   in raster order, and mapped into the base frame by T_base_camera.
 // Masks are written as rows of text, '#' foreground and '.' not, so that a failure shows the
@@ -88,6 +89,14 @@ std::vector<std::string> rows(const std::vector<uint8_t>& mask, int width) {
 ForegroundParams no_speckle_removal() {
   ForegroundParams params;
   params.min_object_mm = 0.0F;
+  return params;
+}
+
+/// Default parameters with speckle removal at `min_object_mm`: the tests of the size rule name
+/// their threshold rather than lean on the default.
+ForegroundParams speckle_removal_at(float min_object_mm) {
+  ForegroundParams params;
+  params.min_object_mm = min_object_mm;
   return params;
 }
 
@@ -272,29 +281,34 @@ TEST(ForegroundByHand, WorkspaceBoxInTheBaseFrame) {
             static_cast<size_t>(kW * kH));
 }
 
-// Speckle removal by physical size sqrt(pixels) · mean z / fx, at min_object_mm 40 (default),
-// fx 100 px, on a 12x8 frame over a wall at 2 m (margin 20 mm, every blob is candidate):
-//   A, 3x3 at 1.333 m: 3 · 1333 mm / 100 = 39.99 mm → removed
-//   B, 3x3 at 1.334 m: 3 · 1334 mm / 100 = 40.02 mm → kept
-//   C, 3x3, eight pixels at 1.330 m and its last one at 1.370 m (a 40 mm step, one blob): mean
-//      12010 / 9 = 1334.44 mm → 40.03 mm → kept, although at 1.330 m alone it would be 39.9 mm
-//   D, one pixel at 0.5 m: 5 mm → removed
+// Speckle removal by physical size, the disc diameter 2 · sqrt(pixels / π) · mean z / fx, at
+// min_object_mm 40, fx 100 px, on a 12x8 frame over a wall at 2 m (margin 20 mm, every
+// blob is candidate). A 3x3 blob is 2 · sqrt(9 / π) = 3.38514 px across, so the boundary lies at
+// z = 40 · 100 / 3.38514 = 1181.64 mm. (Recomputed by hand for the disc rule; under the old
+// square rule, 3 · z / fx, the boundary was at 1333.3 mm and these depths were 1333 / 1334.)
+//   A, 3x3 at 1.181 m: 3.38514 · 1181 / 100 = 39.978 mm → removed
+//   B, 3x3 at 1.182 m: 3.38514 · 1182 / 100 = 40.012 mm → kept
+//   C, 3x3, eight pixels at 1.178 m and its last one at 1.218 m (a 40 mm step, one blob): mean
+//      (8 · 1178 + 1218) / 9 = 1182.44 mm → 40.027 mm → kept, although at 1.178 m alone it
+//      would be 39.877 mm
+//   D, one pixel at 0.5 m: 2 · sqrt(1 / π) · 500 / 100 = 5.64 mm → removed
 TEST(ForegroundByHand, BlobsJustBelowMinObjectSizeAreRemovedJustAboveKept) {
   constexpr int w = 12;
   constexpr int h = 8;
   // clang-format off
   const std::vector<uint16_t> raw = {
       2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000,
-      2000, 1333, 1333, 1333, 2000, 2000, 2000, 1334, 1334, 1334, 2000, 2000,
-      2000, 1333, 1333, 1333, 2000, 2000, 2000, 1334, 1334, 1334, 2000, 2000,
-      2000, 1333, 1333, 1333, 2000, 2000, 2000, 1334, 1334, 1334, 2000, 2000,
+      2000, 1181, 1181, 1181, 2000, 2000, 2000, 1182, 1182, 1182, 2000, 2000,
+      2000, 1181, 1181, 1181, 2000, 2000, 2000, 1182, 1182, 1182, 2000, 2000,
+      2000, 1181, 1181, 1181, 2000, 2000, 2000, 1182, 1182, 1182, 2000, 2000,
       2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000,
-      2000, 1330, 1330, 1330, 2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000,
-      2000, 1330, 1330, 1330, 2000, 2000, 2000, 2000, 2000, 2000,  500, 2000,
-      2000, 1330, 1330, 1370, 2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000};
+      2000, 1178, 1178, 1178, 2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000,
+      2000, 1178, 1178, 1178, 2000, 2000, 2000, 2000, 2000, 2000,  500, 2000,
+      2000, 1178, 1178, 1218, 2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000};
   // clang-format on
   const Foreground fg =
-      extract(frame_of(w, h, raw, 100.0F, 100.0F, 5.5F, 3.5F), uniform_background(w, h, 2.0F, 0.001F), {});
+      extract(frame_of(w, h, raw, 100.0F, 100.0F, 5.5F, 3.5F), uniform_background(w, h, 2.0F, 0.001F),
+              speckle_removal_at(40.0F));
   EXPECT_EQ(rows(fg.mask, w), (std::vector<std::string>{"............",  //
                                                         ".......###..",  //
                                                         ".......###..",  //
@@ -306,19 +320,57 @@ TEST(ForegroundByHand, BlobsJustBelowMinObjectSizeAreRemovedJustAboveKept) {
   EXPECT_EQ(fg.points_camera.size(), 18U);
 }
 
-// A blob of exactly min_object_mm is kept ("below" is removed). Binary units make it exact:
-// 1/1024 m per raw unit and fx 125 px, so a raw unit at the blob's depth is 1000 / 1024 / 125 =
-// 1/128 mm per pixel; a 4x4 blob at raw 1280 (1.25 m) is sqrt(16) · 1280 / 128 = 40 mm exactly,
-// at raw 1279 it is 39.97 mm.
-TEST(ForegroundByHand, BlobOfExactlyMinObjectSizeIsKept) {
+// At the boundary itself (min_object_mm 40) one raw unit decides. Binary units: 1/1024 m per raw unit and fx
+// 125 px, so a raw unit at the blob's depth is 1000 / 1024 / 125 = 1/128 mm per pixel; a 4x4
+// blob is 2 · sqrt(16 / π) = 8 / sqrt(π) = 4.51352 px across, 4.51352 · raw / 128 mm: raw 1135
+// (1.108 m) gives 40.022 mm (kept), raw 1134 gives 39.987 mm (removed). (Recomputed by hand for
+// the disc rule: under the old square rule a 4x4 blob at raw 1280 was 40 mm exactly; a disc's
+// diameter, with its factor 2 / sqrt(π), can never come out exactly 40 mm at an integer depth.)
+TEST(ForegroundByHand, BlobOneRawUnitAboveMinObjectSizeIsKeptOneBelowRemoved) {
   const BackgroundModel background = uniform_background(kW, kH, 2.0F, 0.001F);
-  for (const uint16_t blob_raw : {uint16_t{1280}, uint16_t{1279}}) {
+  for (const uint16_t blob_raw : {uint16_t{1135}, uint16_t{1134}}) {
     std::vector<uint16_t> raw(kW * kH, 2048);  // the wall, 2 m
     for (int v = 1; v < 5; ++v) {
       for (int u = 2; u < 6; ++u) raw[static_cast<size_t>(v * kW + u)] = blob_raw;
     }
     const Frame frame = frame_of(kW, kH, raw, 125.0F, 125.0F, 3.5F, 2.5F, 1.0F / 1024.0F);
-    EXPECT_EQ(extract(frame, background, {}).points_camera.size(), blob_raw == 1280 ? 16U : 0U) << "raw " << blob_raw;
+    EXPECT_EQ(extract(frame, background, speckle_removal_at(40.0F)).points_camera.size(), blob_raw == 1135 ? 16U : 0U)
+        << "raw " << blob_raw;
+  }
+}
+
+// The disc rule on a disc: the 13 pixels within 2 px of a centre pixel (u² + v² ≤ 4: rows of
+// 1, 3, 5, 3 and 1 pixels), the pixel picture of a 40 mm test piece seen 1 m away at fx 100 px
+// (4 px across, π · 2² = 12.6 px). Its disc diameter is 2 · sqrt(13 / π) = 4.06843 px, so at
+// min_object_mm 40 the boundary lies at z = 40 · 100 / 4.06843 = 983.18 mm:
+//   at 1.000 m: 4.06843 · 1000 / 100 = 40.684 mm → kept (the old square rule, sqrt(13) · 10 =
+//               36.06 mm, removed it: a 40 mm ball measured 35-36 mm)
+//   at 0.984 m: 40.033 mm → kept
+//   at 0.983 m: 39.993 mm → removed
+// Wall at 2 m (margin 20 mm), 9x7 frame, the disc centred at (4, 3).
+TEST(ForegroundByHand, DiscOfFortyMillimetresIsKeptJustSmallerRemoved) {
+  constexpr int w = 9;
+  constexpr int h = 7;
+  const BackgroundModel background = uniform_background(w, h, 2.0F, 0.001F);
+  for (const uint16_t disc_raw : {uint16_t{1000}, uint16_t{984}, uint16_t{983}}) {
+    std::vector<uint16_t> raw(static_cast<size_t>(w * h), 2000);
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        if ((u - 4) * (u - 4) + (v - 3) * (v - 3) <= 4) raw[static_cast<size_t>(v * w + u)] = disc_raw;
+      }
+    }
+    const Foreground fg = extract(frame_of(w, h, raw, 100.0F, 100.0F, 4.0F, 3.0F), background, speckle_removal_at(40.0F));
+    const bool kept = disc_raw >= 984;
+    EXPECT_EQ(rows(fg.mask, w), kept ? (std::vector<std::string>{".........",  //
+                                                                  "....#....",  //
+                                                                  "...###...",  //
+                                                                  "..#####..",  //
+                                                                  "...###...",  //
+                                                                  "....#....",  //
+                                                                  "........."})
+                                     : (std::vector<std::string>(h, std::string(w, '.'))))
+        << "disc at raw " << disc_raw;
+    EXPECT_EQ(fg.points_camera.size(), kept ? 13U : 0U) << "disc at raw " << disc_raw;
   }
 }
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Foreground extraction on hand-built frames: the background test, speckle removal by physical
-// size, the workspace rule for unknown background, deprojection and the base frame.
+// size (disc diameter), the workspace rule for unknown background, deprojection and the base frame.
 
 #include "synthetic_frames.hpp"
 
@@ -65,18 +65,22 @@ TEST(ForegroundExtractor, MarginFollowsNoiseModel) {
   EXPECT_EQ(extract(frame, sensitive).mask, rect_mask(20, 15, 10, 10));
 }
 
-// Size of a blob = sqrt(pixels) · mean z / fx. At 1 m with fx = 200 px: a single pixel is
-// 5 mm, 2x2 is 10 mm, 7x7 is 35 mm (all below min_object_mm = 40 → removed) and 9x9 is
-// 45 mm (kept).
+// Size of a blob = the diameter of the disc of its area, 2 · sqrt(pixels / π) · mean z / fx. At
+// 1 m with fx = 200 px (5 mm per pixel): a single pixel is 2 · sqrt(1 / π) · 5 = 5.6 mm, 2x2 is
+// 11.3 mm, 7x7 is 2 · sqrt(49 / π) · 5 = 39.5 mm (all below min_object_mm = 40 → removed) and
+// 9x9 is 50.8 mm (kept). (Recomputed by hand for the disc rule; the square rule gave 5, 10, 35
+// and 45 mm, the same verdicts. min_object_mm 40 named here: the default is 32.)
 TEST(ForegroundExtractor, SpecklesBelowMinObjectSizeAreRemoved) {
   Frame frame = wall_frame(5);
   fill_rect(frame, 2, 2, 1, 1, 1000);
   fill_rect(frame, 10, 2, 2, 2, 1000);
   fill_rect(frame, 20, 2, 7, 7, 1000);
   fill_rect(frame, 40, 30, 9, 9, 1000);
-  EXPECT_EQ(extract(frame).mask, rect_mask(40, 30, 9, 9));
+  ForegroundParams at_40;
+  at_40.min_object_mm = 40.0F;
+  EXPECT_EQ(extract(frame, at_40).mask, rect_mask(40, 30, 9, 9));
 
-  // With min_object_mm = 30 the 7x7 blob (35 mm) survives too; the speckles do not.
+  // With min_object_mm = 30 the 7x7 blob (39.5 mm) survives too; the speckles do not.
   ForegroundParams lenient;
   lenient.min_object_mm = 30.0F;
   const Foreground fg = extract(frame, lenient);
@@ -85,25 +89,28 @@ TEST(ForegroundExtractor, SpecklesBelowMinObjectSizeAreRemoved) {
   EXPECT_EQ(fg.mask[static_cast<size_t>(2) * kWidth + 10], 0);
 }
 
-// Blobs are 8-connected but split at depth jumps over max(5 cm, 4 σ_model(z)).
+// Blobs are 8-connected but split at depth jumps over max(5 cm, 4 σ_model(z)); min_object_mm 40.
 TEST(ForegroundExtractor, BlobsAreEightConnectedAndSplitAtDepthJumps) {
-  // Two 6x6 squares at 1 m touching only at a corner: one blob of sqrt(72) · 5 mm = 42.4 mm.
+  ForegroundParams at_40;
+  at_40.min_object_mm = 40.0F;
+  // Two 6x6 squares at 1 m touching only at a corner: one blob of 2 · sqrt(72 / π) · 5 mm =
+  // 47.9 mm (alone, each would be 2 · sqrt(36 / π) · 5 = 33.9 mm and removed).
   Frame diagonal = wall_frame(6);
   fill_rect(diagonal, 10, 10, 6, 6, 1000);
   fill_rect(diagonal, 16, 16, 6, 6, 1000);
-  EXPECT_EQ(count_ones(extract(diagonal).mask), 72U);
+  EXPECT_EQ(count_ones(extract(diagonal, at_40).mask), 72U);
 
-  // A 14x7 strip at 1 m is one blob of sqrt(98) · 5 mm = 49.5 mm (kept). With its right half at
-  // 1.2 m the step (0.2 m) exceeds max(0.05, 4 · 1.2² · 0.08 / 10 = 46 mm): two blobs of
-  // 35 mm and 7 · 1.2 / 200 = 42 mm, so only the farther half survives.
+  // A 14x7 strip at 1 m is one blob of 2 · sqrt(98 / π) · 5 mm = 55.9 mm (kept). With its right
+  // half at 1.2 m the step (0.2 m) exceeds max(0.05, 4 · 1.2² · 0.08 / 10 = 46 mm): two blobs of
+  // 39.5 mm and 2 · sqrt(49 / π) · 1.2 / 200 = 47.4 mm, so only the farther half survives.
   Frame strip = wall_frame(7);
   fill_rect(strip, 20, 20, 14, 7, 1000);
-  EXPECT_EQ(extract(strip).mask, rect_mask(20, 20, 14, 7));
+  EXPECT_EQ(extract(strip, at_40).mask, rect_mask(20, 20, 14, 7));
   fill_rect(strip, 27, 20, 7, 7, 1200);
-  EXPECT_EQ(extract(strip).mask, rect_mask(27, 20, 7, 7));
-  // A 4 cm step stays within one blob (jump limit 5 cm): 49.5 mm again, all kept.
+  EXPECT_EQ(extract(strip, at_40).mask, rect_mask(27, 20, 7, 7));
+  // A 4 cm step stays within one blob (jump limit 5 cm): mean 1.02 m, 57.0 mm, all kept.
   fill_rect(strip, 27, 20, 7, 7, 1040);
-  EXPECT_EQ(extract(strip).mask, rect_mask(20, 20, 14, 7));
+  EXPECT_EQ(extract(strip, at_40).mask, rect_mask(20, 20, 14, 7));
 }
 
 // Where the background was never valid, a valid pixel counts only inside workspace_base.
@@ -116,11 +123,12 @@ TEST(ForegroundExtractor, UnknownBackgroundCountsOnlyInsideWorkspace) {
   fill_rect(frame, 26, 18, 12, 12, 1500);
   fill_rect(frame, 0, 0, 5, 5, 0);  // invalid raw depth is never foreground
 
-  // Default workspace: everything, so the unknown pixels count (sqrt(144) · 1.5 / 200 = 90 mm).
+  // Default workspace: everything, so the unknown pixels count (2 · sqrt(144 / π) · 1.5 / 200 =
+  // 101.6 mm).
   EXPECT_EQ(extract(frame, {}, background).mask, rect_mask(26, 18, 12, 12));
 
   // Only x >= 0 (base = camera frame here): x = (u − 31.5) / 200 · z >= 0 for u >= 32,
-  // i.e. columns 32..37 (6x12 px, sqrt(72) · 7.5 mm = 64 mm, kept).
+  // i.e. columns 32..37 (6x12 px, 2 · sqrt(72 / π) · 7.5 mm = 71.8 mm, kept).
   ForegroundParams right_half;
   right_half.workspace_base.min.x() = 0.0F;
   EXPECT_EQ(extract(frame, right_half, background).mask, rect_mask(32, 18, 6, 12));

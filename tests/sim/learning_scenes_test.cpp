@@ -15,6 +15,7 @@
 // 848x480) and 30 learning frames keep each test to a few hundred small frames. No depth
 // filters: these tests are about the learner and its motion region; the sdk chain's effect on
 // what counts as motion is described in docs/ARCHITECTURE.md ("Background and foreground").
+#include "../support/decide.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/pipeline.hpp"
@@ -140,7 +141,7 @@ LearningRun learn(const Config& config, int64_t max_frames, bool robot_state = t
     }
     if (frame.truth->contact.valid) run.min_distance_m = std::min(run.min_distance_m, frame.truth->contact.distance_m);
     if (!learning) continue;
-    pipeline.process(frame, state, result);
+    test::process_and_decide(pipeline, frame, state, result);
     EXPECT_EQ(result.verdict.code, ReasonCode::learning_background) << "frame " << i;
     if (pipeline.background_ready()) run.ready_frame = i;
     // A batch ends every kLearnFrames frames; ending without a model means it was refused.

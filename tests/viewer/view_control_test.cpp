@@ -2,6 +2,7 @@
 // The panels' requests to the running pipeline: relearning is refused while the robot moves
 // or anything is near it, and nothing reaches the pipeline but between frames.
 
+#include "../support/decide.hpp"
 #include "viewer/view_control.hpp"
 
 #include <gtest/gtest.h>
@@ -47,48 +48,78 @@ PipelineParams point_robot_params() {
   return params;
 }
 
+// The safety distances of point_robot_params(): slow 1 m, stop 0.5 m.
+SafetyParams test_safety() { return point_robot_params().safety; }
+
+// A measurement as the processing thread has it before each frame: not decided (the verdict
+// is the default stop), still robot, nothing in the cell.
 FrameResult still_and_clear() {
   FrameResult result;
   result.frame = 7;
   result.valid = true;
   result.robot_state = fixed_robot_state({});
-  result.verdict.state = VerdictState::run;
-  result.verdict.code = ReasonCode::clear;
   return result;
 }
 
-TEST(RelearnRefusal, AllowedWhenStillAndClear) { EXPECT_EQ(relearn_refusal(still_and_clear()), ""); }
+TEST(RelearnRefusal, AllowedWhenStillAndClear) { EXPECT_EQ(relearn_refusal(still_and_clear(), test_safety()), ""); }
 
 TEST(RelearnRefusal, RefusedWhileTheRobotMoves) {
   FrameResult result = still_and_clear();
   result.robot_state.qd_rad_s[2] = 0.05F;
-  const std::string why = relearn_refusal(result);
+  const std::string why = relearn_refusal(result, test_safety());
   EXPECT_NE(why.find("moving"), std::string::npos) << why;
   EXPECT_NE(why.find("joint 3"), std::string::npos) << why;
   result.robot_state.qd_rad_s[2] = -0.05F;  // either direction
-  EXPECT_NE(relearn_refusal(result), "");
+  EXPECT_NE(relearn_refusal(result, test_safety()), "");
   result.robot_state.qd_rad_s[2] = std::nanf("");  // unknown speed is no proof of standing still
-  EXPECT_NE(relearn_refusal(result), "");
+  EXPECT_NE(relearn_refusal(result, test_safety()), "");
   result.robot_state.qd_rad_s[2] = 0.0005F;  // below kRobotMovingRadS: still
-  EXPECT_EQ(relearn_refusal(result), "");
+  EXPECT_EQ(relearn_refusal(result, test_safety()), "");
 }
 
 TEST(RelearnRefusal, RefusedWhileAnythingIsNear) {
-  for (const ReasonCode code : {ReasonCode::in_slow_zone, ReasonCode::in_stop_zone, ReasonCode::inside_robot}) {
+  struct Near {
+    float distance_m;
+    bool inside;
+    const char* code;
+  };
+  for (const Near& near : {Near{0.42F, false, "in_stop_zone"}, Near{0.8F, false, "in_slow_zone"},
+                           Near{0.0F, true, "inside_robot"}}) {
     FrameResult result = still_and_clear();
-    result.verdict.code = code;
     result.contact.valid = true;
-    result.contact.distance_m = 0.42F;
-    const std::string why = relearn_refusal(result);
-    EXPECT_NE(why.find("0.42 m"), std::string::npos) << why;
+    result.contact.distance_m = near.distance_m;
+    result.contact.inside = near.inside;
+    result.foreground_points = 12;
+    const std::string why = relearn_refusal(result, test_safety());
+    char distance[16];
+    std::snprintf(distance, sizeof distance, "%.2f m", static_cast<double>(near.distance_m));
+    EXPECT_NE(why.find(distance), std::string::npos) << why;
+    EXPECT_NE(why.find(near.code), std::string::npos) << why;
   }
+}
+
+TEST(RelearnRefusal, JudgedOnTheMeasurementNotAnUndecidedVerdict) {
+  // On the processing thread `previous` is not decided: whatever its verdict field holds (a
+  // reused buffer's old verdict) must not let a relearn through while someone is near.
+  FrameResult near = still_and_clear();
+  near.contact.valid = true;
+  near.contact.distance_m = 0.7F;
+  near.foreground_points = 12;
+  near.verdict.state = VerdictState::run;
+  near.verdict.code = ReasonCode::clear;
+  EXPECT_NE(relearn_refusal(near, test_safety()), "");
+  FrameResult far = near;
+  far.contact.distance_m = 1.5F;
+  far.verdict.state = VerdictState::slow;
+  far.verdict.code = ReasonCode::in_slow_zone;
+  EXPECT_EQ(relearn_refusal(far, test_safety()), "");
 }
 
 TEST(RelearnRefusal, RefusedWithoutARobotState) {
   FrameResult result = still_and_clear();
   result.robot_state.valid = false;
-  EXPECT_NE(relearn_refusal(result), "");
-  EXPECT_NE(relearn_refusal(FrameResult{}), "");  // before the first frame
+  EXPECT_NE(relearn_refusal(result, test_safety()), "");
+  EXPECT_NE(relearn_refusal(FrameResult{}, test_safety()), "");  // before the first frame
 }
 
 TEST(ControlInbox, NothingPostedLeavesThePipelineAlone) {
@@ -137,11 +168,11 @@ TEST(ControlInbox, RelearnRefusedNearTheRobotThenDoneWhenClear) {
   FrameResult result;
   for (int i = 0; i < 2; ++i) {
     wall_frame(i, 0.0F, frame);
-    pipeline.process(frame, fixed_robot_state({}), result);
+    test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   }
   ASSERT_TRUE(pipeline.background_ready());
   wall_frame(2, 0.7F, frame);  // a block 0.7 m from the robot point: slow
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   ASSERT_EQ(result.verdict.code, ReasonCode::in_slow_zone);
 
   ControlInbox inbox;
@@ -153,7 +184,7 @@ TEST(ControlInbox, RelearnRefusedNearTheRobotThenDoneWhenClear) {
   EXPECT_TRUE(pipeline.background_ready());  // still the old background
   // The request is not kept for later: a refused relearn must be asked for again.
   wall_frame(3, 0.0F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   ASSERT_EQ(result.verdict.state, VerdictState::run);
   inbox.apply(pipeline, result);
   EXPECT_TRUE(inbox.take_events().empty());
@@ -166,7 +197,7 @@ TEST(ControlInbox, RelearnRefusedNearTheRobotThenDoneWhenClear) {
   EXPECT_FALSE(events[0].refused);
   EXPECT_FALSE(pipeline.background_ready());
   wall_frame(4, 0.0F, frame);
-  pipeline.process(frame, fixed_robot_state({}), result);
+  test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   EXPECT_EQ(result.verdict.code, ReasonCode::learning_background);
 }
 

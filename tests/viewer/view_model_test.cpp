@@ -2,7 +2,8 @@
 // The viewer's CPU side without a display: the colour map and its equalisation against hand
 // values, the robot's pixels against hand-solved ray-capsule geometry, the markers at their
 // pinhole projections, the shown state (NO DATA) on injected times, the layout rule, and the
-// view tap's mailbox (drops counted, snapshot frames waited for).
+// view tap (each picture published with its own decided verdict, drops counted, snapshot
+// frames waited for).
 #include "viewer/view_model.hpp"
 #include "viewer/view_tap.hpp"
 
@@ -264,34 +265,173 @@ Pipeline walk_pipeline() {
   return Pipeline(config.pipeline);
 }
 
+// A source frame whose depth image is `index + 1` pixels wide, so that a published view shows
+// which frame its picture came from.
+Frame numbered_frame(int64_t index) {
+  Frame frame;
+  frame.index = index;
+  frame.depth.resize(static_cast<int>(index) + 1, 1);
+  return frame;
+}
+
+// The measurement of frame `index` as processing hands it over: not decided yet, its verdict
+// field whatever the buffer held (here a run that the monitor will not confirm).
+FrameResult measured(int64_t index, int64_t delivered_ns = 0) {
+  FrameResult result;
+  result.frame = index;
+  result.timestamp_ns = index * 33'333'333;
+  result.delivered_ns = delivered_ns;
+  result.verdict.state = VerdictState::run;
+  result.verdict.code = ReasonCode::clear;
+  return result;
+}
+
+// The same result as the SafetyMonitor decided it on the output thread.
+FrameResult decided_as(FrameResult result, VerdictState state, ReasonCode code) {
+  result.verdict.state = state;
+  result.verdict.code = code;
+  result.verdict.reason = reason_code_name(code);
+  return result;
+}
+
+// Processing and output of one frame in step, as in an unpaced run whose output keeps up.
+void offer_and_decide(ViewTap& tap, const Pipeline& pipeline, int64_t index,
+                      VerdictState state = VerdictState::stop, ReasonCode code = ReasonCode::in_stop_zone) {
+  const FrameResult result = measured(index);
+  tap.offer(numbered_frame(index), pipeline, result);
+  tap.decided(decided_as(result, state, code));
+}
+
 TEST(ViewTap, NeverWaitsAndCountsWhatTheRendererMissed) {
   const Pipeline pipeline = walk_pipeline();
   ViewTap tap;
-  Frame frame;
-  frame.depth.resize(4, 2);
-  FrameResult result;
-  for (int64_t i = 0; i < 5; ++i) {
-    result.frame = i;
-    tap.offer(frame, pipeline, result);  // nobody takes: each replaces the last
-  }
+  for (int64_t i = 0; i < 5; ++i) offer_and_decide(tap, pipeline, i);  // nobody takes: each replaces the last
   EXPECT_EQ(tap.dropped(), 4);
   ViewFrame newest;
   ASSERT_TRUE(tap.take(newest, 1.0));
   EXPECT_EQ(newest.frame, 4);
-  EXPECT_EQ(newest.depth.width, 4);
+  EXPECT_EQ(newest.depth.width, 5);
   EXPECT_FALSE(tap.take(newest, 0.0));
 }
 
-TEST(ViewTap, CountsTheSourceFramesProcessingSkipped) {
+TEST(ViewTap, ShowsTheVerdictTheMonitorDecidedNotTheMeasurementsField) {
   const Pipeline pipeline = walk_pipeline();
   ViewTap tap;
-  Frame frame;
-  FrameResult result;
-  // Processed: 0, 1, 4, 5, 9 (2, 3, 6, 7, 8 dropped), then 2 after a seek back: no gap.
-  for (const int64_t i : {0, 1, 4, 5, 9, 2, 3}) {
-    result.frame = i;
-    tap.offer(frame, pipeline, result);
+  // Its verdict field says run; the monitor decides slow (neither that nor a ViewFrame's
+  // default stop).
+  const FrameResult result = measured(3);
+  tap.offer(numbered_frame(3), pipeline, result);
+  ViewFrame shown;
+  EXPECT_FALSE(tap.take(shown, 0.0));  // nothing is published before its verdict is decided
+  tap.decided(decided_as(result, VerdictState::slow, ReasonCode::in_slow_zone));
+  ASSERT_TRUE(tap.take(shown, 1.0));
+  EXPECT_EQ(shown.frame, 3);
+  EXPECT_EQ(shown.depth.width, 4);
+  EXPECT_EQ(shown.verdict.state, VerdictState::slow);
+  EXPECT_EQ(shown.verdict.code, ReasonCode::in_slow_zone);
+  EXPECT_EQ(shown.verdict.reason, "in_slow_zone");
+  EXPECT_EQ(shown_state(shown, shown.made_ns, 0.5), ShownState::slow);  // the border: amber, not green
+  std::vector<TimelinePoint> timeline;
+  tap.timeline(timeline);
+  ASSERT_EQ(timeline.size(), 1U);
+  EXPECT_EQ(timeline[0].state, VerdictState::slow);
+  EXPECT_EQ(timeline[0].made_ns, shown.made_ns);
+}
+
+TEST(ViewTap, ProcessingAheadOfTheOutputPairsEachPictureWithItsOwnVerdict) {
+  const Pipeline pipeline = walk_pipeline();
+  ViewTap tap;
+  // Unpaced: processing offers up to 3 frames before the output decides the first.
+  const VerdictState states[] = {VerdictState::run, VerdictState::slow, VerdictState::stop};
+  for (int64_t i = 0; i < 3; ++i) tap.offer(numbered_frame(i), pipeline, measured(i));
+  for (int64_t i = 0; i < 3; ++i) {
+    tap.decided(decided_as(measured(i), states[i], ReasonCode::holding));
+    ViewFrame shown;
+    ASSERT_TRUE(tap.take(shown, 1.0));
+    EXPECT_EQ(shown.frame, i);
+    EXPECT_EQ(shown.depth.width, i + 1);
+    EXPECT_EQ(shown.verdict.state, states[i]);
   }
+  EXPECT_EQ(tap.dropped(), 0);
+}
+
+TEST(ViewTap, ADecidedFrameWhoseViewWasReplacedPublishesNothing) {
+  const Pipeline pipeline = walk_pipeline();
+  ViewTap tap;
+  // Processing runs 6 frames ahead (a paced run with a slow output): frames 0 and 1's views
+  // are forgotten, the ring keeping the newest ViewTap::kPendingFrames.
+  static_assert(ViewTap::kPendingFrames == 4);
+  for (int64_t i = 0; i < 6; ++i) tap.offer(numbered_frame(i), pipeline, measured(i));
+  tap.decided(decided_as(measured(1), VerdictState::stop, ReasonCode::in_stop_zone));
+  ViewFrame shown;
+  EXPECT_FALSE(tap.take(shown, 0.0));  // no picture rather than frame 2's with frame 1's stop
+  EXPECT_EQ(shown.frame, -1);
+  EXPECT_EQ(tap.dropped(), 1);  // decided, never drawn
+  // Frame 3 (2 was dropped by the pipeline undecided) still finds its own picture.
+  tap.decided(decided_as(measured(3), VerdictState::slow, ReasonCode::in_slow_zone));
+  ASSERT_TRUE(tap.take(shown, 1.0));
+  EXPECT_EQ(shown.frame, 3);
+  EXPECT_EQ(shown.depth.width, 4);
+  EXPECT_EQ(shown.verdict.state, VerdictState::slow);
+  EXPECT_EQ(tap.index_gaps(), 1);  // frame 2 never written
+  // Frame 2's view, offered before 3's, was forgotten with the decision of 3: a late result of
+  // frame 2 cannot pair with anything.
+  tap.decided(decided_as(measured(2), VerdictState::run, ReasonCode::clear));
+  EXPECT_FALSE(tap.take(shown, 0.0));
+  EXPECT_EQ(shown.frame, 3);
+  EXPECT_EQ(shown.verdict.state, VerdictState::slow);
+}
+
+TEST(ViewTap, AFrameIndexSeenAgainAfterASeekBackPairsByItsDelivery) {
+  const Pipeline pipeline = walk_pipeline();
+  ViewTap tap;
+  Frame first = numbered_frame(5);
+  Frame again = numbered_frame(5);
+  again.depth.resize(9, 1);  // another picture of the same index
+  tap.offer(first, pipeline, measured(5, 1'000));
+  tap.offer(again, pipeline, measured(5, 2'000));
+  tap.decided(decided_as(measured(5, 2'000), VerdictState::slow, ReasonCode::in_slow_zone));
+  ViewFrame shown;
+  ASSERT_TRUE(tap.take(shown, 1.0));
+  EXPECT_EQ(shown.depth.width, 9);
+  EXPECT_EQ(shown.verdict.state, VerdictState::slow);
+}
+
+TEST(ViewTap, AStopForNoSourceFrameTakesThePlaceOfTheShownVerdict) {
+  const Pipeline pipeline = walk_pipeline();
+  ViewTap tap;
+  offer_and_decide(tap, pipeline, 7, VerdictState::run, ReasonCode::clear);
+  ViewFrame shown;
+  ASSERT_TRUE(tap.take(shown, 1.0));
+  ASSERT_EQ(shown.verdict.state, VerdictState::run);
+  const int64_t made_ns = shown.made_ns;
+  // The watchdog's stop repeats frame 7's index and stands for no source frame.
+  FrameResult watchdog = decided_as(measured(7), VerdictState::stop, ReasonCode::no_frame);
+  watchdog.source_frame = false;
+  tap.decided(watchdog);
+  EXPECT_FALSE(tap.take(shown, 0.0));  // no new picture...
+  EXPECT_EQ(shown.frame, 7);
+  EXPECT_EQ(shown.verdict.state, VerdictState::stop);  // ...but the stop is shown
+  EXPECT_EQ(shown.verdict.code, ReasonCode::no_frame);
+  EXPECT_EQ(shown.made_ns, made_ns);  // the data's age, so NO DATA once it is old
+  EXPECT_EQ(shown_state(shown, made_ns + 100'000'000, 0.5), ShownState::stop);
+  EXPECT_EQ(shown_state(shown, made_ns + 600'000'000, 0.5), ShownState::no_data);
+  std::vector<TimelinePoint> timeline;
+  tap.timeline(timeline);
+  EXPECT_EQ(timeline.size(), 1U);  // no point for a result without a frame
+  // The next frame's own verdict replaces it.
+  offer_and_decide(tap, pipeline, 8, VerdictState::run, ReasonCode::clear);
+  ASSERT_TRUE(tap.take(shown, 1.0));
+  EXPECT_EQ(shown.verdict.state, VerdictState::run);
+  EXPECT_FALSE(tap.take(shown, 0.0));
+  EXPECT_EQ(shown.verdict.state, VerdictState::run);
+}
+
+TEST(ViewTap, CountsTheSourceFramesTheOutputNeverWrote) {
+  const Pipeline pipeline = walk_pipeline();
+  ViewTap tap;
+  // Written: 0, 1, 4, 5, 9 (2, 3, 6, 7, 8 dropped), then 2 after a seek back: no gap.
+  for (const int64_t i : {0, 1, 4, 5, 9, 2, 3}) offer_and_decide(tap, pipeline, i);
   EXPECT_EQ(tap.index_gaps(), 5);
 }
 
@@ -299,24 +439,22 @@ TEST(ViewTap, WaitsAtASnapshotFrameUntilDrawn) {
   const Pipeline pipeline = walk_pipeline();
   ViewTap tap({3});
   std::atomic<bool> passed{false};
-  std::thread processing([&] {
-    Frame frame;
-    FrameResult result;
+  std::thread run([&] {
     for (int64_t i = 0; i < 5; ++i) {
-      result.frame = i;
-      tap.offer(frame, pipeline, result);
+      offer_and_decide(tap, pipeline, i);  // the output thread waits in decided()
       if (i == 3) passed.store(true);
     }
   });
-  // Frame 3 reaches the mailbox and the processing thread waits there.
+  // Frame 3 reaches the mailbox, decided, and the output waits there.
   ViewFrame taken;
   for (int i = 0; i < 500 && !(tap.take(taken, 0.01) && taken.frame == 3); ++i) {
   }
   ASSERT_EQ(taken.frame, 3);
+  EXPECT_EQ(taken.verdict.state, VerdictState::stop);
   EXPECT_FALSE(passed.load());
   EXPECT_EQ(tap.snapshots_pending(), 1U);
   tap.rendered(3);
-  processing.join();
+  run.join();
   EXPECT_TRUE(passed.load());
   EXPECT_EQ(tap.snapshots_pending(), 0U);
 }

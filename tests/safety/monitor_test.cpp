@@ -1,0 +1,242 @@
+// SPDX-License-Identifier: Apache-2.0
+// The SafetyMonitor: a measurement decided once, per link, at its age when it is decided, with
+// the hold, the watchdog's stop and the stops a mailbox replaced; values worked by hand.
+
+#include "hrcsense/mailbox.hpp"
+#include "hrcsense/safety.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <string>
+
+namespace hrcsense {
+namespace {
+
+// The ssm defaults: v_h 1.6 m/s beyond 0.5 m; controller latency 0.05 s; T_s 0.5 s without a
+// deceleration (S_s = v·T_s/2); C = 8·(40 − 14) mm = 0.208 m; Z_r 0.01 m. At an age of 0 T_r is
+// 0.05 s, so with Z_d 0.02 m S_p(v) = 1.6·0.55 + 0.208 + 0.02 + 0.01 + v·(0.05 + 0.25)
+// = 1.118 + 0.3·v.
+SafetyParams ssm_params() {
+  SafetyParams p;
+  p.mode = SafetyParams::Mode::ssm;
+  return p;
+}
+
+LinkContact link(int index, float distance_m, float speed_towards_mps) {
+  LinkContact l;
+  l.link = index;
+  l.contact.valid = true;
+  l.contact.distance_m = distance_m;
+  l.contact.robot_link = index;
+  l.contact.closest_base = {distance_m, 0.0F, 0.0F};
+  l.contact.closest_robot_base = {0.0F, 0.0F, 0.0F};
+  l.speed_towards_mps = speed_towards_mps;
+  l.distance_uncertainty_m = 0.02F;
+  return l;
+}
+
+// A valid measurement with the given links; the overall contact is the closest of them.
+FrameResult measured(std::initializer_list<LinkContact> links) {
+  FrameResult m;
+  m.valid = true;
+  m.foreground_points = 100;
+  for (const LinkContact& l : links) {
+    m.links.push_back(l);
+    if (!m.contact.valid || l.contact.distance_m < m.contact.distance_m) m.contact = l.contact;
+  }
+  return m;
+}
+
+// The case: a still base closest (1.3 m) and a fast wrist a little farther (1.5 m,
+// 1.5 m/s towards the person). Base: S_p = 1.118 m, cleared: run. Wrist: S_p = 1.118 + 0.45 =
+// 1.568 m > 1.5 m, but at rest 1.118 m < 1.5 m: slow, allowed speed (1.5 − 1.118) / 0.3 =
+// 1.27333 m/s, scale 1.27333 / 1.5 = 0.848889. The wrist governs; the overall pair stays the base's.
+TEST(SafetyMonitor, AFastFartherLinkGovernsOverAStillCloserOne) {
+  SafetyMonitor monitor(ssm_params());
+  FrameResult r = measured({link(0, 1.3F, 0.0F), link(5, 1.5F, 1.5F)});
+  monitor.decide(r, 0);
+  EXPECT_EQ(r.verdict.state, VerdictState::slow);
+  EXPECT_EQ(r.verdict.code, ReasonCode::speed_limited);
+  EXPECT_NEAR(r.verdict.speed_scale, 0.848889, 1e-5);
+  EXPECT_EQ(r.governing_link, 5);
+  EXPECT_NEAR(r.verdict.protective_distance_m, 1.568, 1e-5);
+  EXPECT_FLOAT_EQ(r.robot_speed_towards_mps, 1.5F);
+  EXPECT_EQ(r.contact.robot_link, 0);  // distance_m and the closest pair stay the overall ones
+  ASSERT_EQ(r.link_protective_distance_m.size(), 2U);
+  EXPECT_NEAR(r.link_protective_distance_m[0], 1.118, 1e-5);
+  EXPECT_NEAR(r.link_protective_distance_m[1], 1.568, 1e-5);
+  ASSERT_TRUE(r.ssm.has_value());
+  EXPECT_NEAR(r.ssm->s_r_m, 1.5 * 0.05, 1e-6);
+}
+
+// When every link clears its S_p the verdict is run, and the link with the least slack
+// (d_i − S_p,i) is named: base 1.3 − 1.118 = 0.182 m, wrist 1.8 − (1.118 + 0.15) = 0.532 m.
+TEST(SafetyMonitor, TheLinkWithTheLeastSlackIsNamedWhenAllRun) {
+  SafetyMonitor monitor(ssm_params());
+  FrameResult r = measured({link(0, 1.3F, 0.0F), link(5, 1.8F, 0.5F)});
+  monitor.decide(r, 0);
+  EXPECT_EQ(r.verdict.state, VerdictState::run);
+  EXPECT_EQ(r.governing_link, 0);
+  EXPECT_NEAR(r.verdict.protective_distance_m, 1.118, 1e-5);
+}
+
+// Zones mode: the closest link's distance decides (0.8 m: slow, scale (0.8 − 0.5) / 0.5 = 0.6).
+TEST(SafetyMonitor, ZonesDecideOnTheClosestLink) {
+  SafetyMonitor monitor(SafetyParams{});
+  FrameResult r = measured({link(1, 1.2F, 3.0F), link(3, 0.8F, 0.0F)});
+  monitor.decide(r, 0);
+  EXPECT_EQ(r.verdict.state, VerdictState::slow);
+  EXPECT_NEAR(r.verdict.speed_scale, 0.6, 1e-6);
+  EXPECT_EQ(r.governing_link, 3);
+}
+
+// A link whose speed could not be computed (NaN) is a stop in ssm mode, whatever the others say.
+TEST(SafetyMonitor, ALinkWithoutASpeedStops) {
+  SafetyMonitor monitor(ssm_params());
+  FrameResult r = measured({link(0, 3.0F, 0.0F), link(4, 3.5F, std::numeric_limits<float>::quiet_NaN())});
+  monitor.decide(r, 0);
+  EXPECT_EQ(r.verdict.state, VerdictState::stop);
+  EXPECT_EQ(r.verdict.code, ReasonCode::non_finite_input);
+  EXPECT_EQ(r.governing_link, 4);
+}
+
+TEST(SafetyMonitor, AWithheldMeasurementIsAStopWithItsReason) {
+  SafetyMonitor monitor(ssm_params());
+  FrameResult r;
+  r.valid = false;
+  r.withheld_code = ReasonCode::robot_state_stale;
+  r.withheld_reason = "robot state stale (80.0 ms old)";
+  monitor.decide(r, 0);
+  EXPECT_EQ(r.verdict.state, VerdictState::stop);
+  EXPECT_EQ(r.verdict.code, ReasonCode::robot_state_stale);
+  EXPECT_EQ(r.verdict.reason, "robot state stale (80.0 ms old)");
+  EXPECT_EQ(r.governing_link, -1);
+}
+
+// The frame's age is taken when it is decided: seen at 0.9 s, decided at 1.1 s: 0.2 s old, so
+// T_r = 0.25 s and S_p at rest = 1.6·(0.25 + 0.5) + 0.238 = 1.438 m: a person at 1.3 m, clear
+// of S_p had the frame been decided at once (1.118 m), is now inside it.
+TEST(SafetyMonitor, AgeCountsUntilTheDecision) {
+  SafetyMonitor monitor(ssm_params());
+  FrameResult r = measured({link(0, 1.3F, 0.0F)});
+  r.clocked = true;
+  r.delivered_ns = 950'000'000;
+  r.seen_ns = 900'000'000;
+  monitor.decide(r, 1'100'000'000);
+  EXPECT_NEAR(r.frame_age_s, 0.2, 1e-12);
+  ASSERT_TRUE(r.ssm.has_value());
+  EXPECT_NEAR(r.ssm->reaction_time_s, 0.25, 1e-12);
+  EXPECT_EQ(r.verdict.state, VerdictState::stop);
+  EXPECT_EQ(r.verdict.code, ReasonCode::below_protective_distance);
+  EXPECT_NEAR(r.verdict.protective_distance_m, 1.438, 1e-5);
+}
+
+// Delivered longer ago than the no-frame limit: stale. A live 30 frames/s source's limit is two
+// periods, 66.7 ms; a frame delivered 70 ms ago is a stop, one delivered 60 ms ago is not.
+TEST(SafetyMonitor, OlderThanTheWatchdogLimitIsStale) {
+  SafetyMonitor monitor(SafetyParams{}, 30.0, true);
+  EXPECT_EQ(monitor.watchdog_after_ns(), 66'666'667);
+  for (const int64_t age_ms : {60, 70}) {
+    FrameResult r = measured({link(0, 3.0F, 0.0F)});
+    r.clocked = true;
+    r.delivered_ns = r.seen_ns = 1'000'000'000;
+    monitor.reset();
+    monitor.decide(r, 1'000'000'000 + age_ms * 1'000'000);
+    EXPECT_EQ(r.verdict.code == ReasonCode::stale_frame, age_ms == 70) << age_ms << " ms: " << r.verdict.reason;
+  }
+}
+
+// A stop that a mailbox replaced before it was decided is carried: the run that replaced it is
+// written as that stop, with its reason, and the replacement is counted.
+TEST(SafetyMonitor, AReplacedStopIsCarriedIntoTheNextResult) {
+  SafetyMonitor monitor(ssm_params());
+  const FrameResult stop = measured({link(2, 0.4F, 0.0F)});  // below S_p at rest: stop
+  FrameResult next;  // nobody in the cell: run
+  next.valid = true;
+  carry_replaced(monitor, stop, 0, next);
+  EXPECT_EQ(next.replaced.count, 1);
+  monitor.decide(next, 0);
+  EXPECT_EQ(next.verdict.state, VerdictState::stop);
+  EXPECT_EQ(next.verdict.code, ReasonCode::below_protective_distance);
+
+  // A run that replaced a slow: written as that slow, at its scale.
+  SafetyMonitor second(ssm_params());
+  const FrameResult slow = measured({link(5, 1.5F, 1.5F)});  // scale 0.848889, as above
+  FrameResult run;
+  run.valid = true;
+  carry_replaced(second, slow, 0, run);
+  second.decide(run, 0);
+  EXPECT_EQ(run.verdict.state, VerdictState::slow);
+  EXPECT_NEAR(run.verdict.speed_scale, 0.848889, 1e-5);
+}
+
+// The strictest of several replaced measurements wins, whichever came first, and what a
+// replaced one carried itself is carried on.
+TEST(SafetyMonitor, TheStrictestOfSeveralReplacedWins) {
+  SafetyMonitor monitor(ssm_params());
+  FrameResult first = measured({link(2, 0.4F, 0.0F)});  // stop
+  FrameResult second;                                    // run, replaces first
+  second.valid = true;
+  carry_replaced(monitor, first, 0, second);
+  FrameResult third = measured({link(5, 1.5F, 1.5F)});  // slow, replaces second
+  carry_replaced(monitor, second, 0, third);
+  EXPECT_EQ(third.replaced.count, 2);
+  monitor.decide(third, 0);
+  EXPECT_EQ(third.verdict.state, VerdictState::stop);
+  EXPECT_EQ(third.verdict.code, ReasonCode::below_protective_distance);
+}
+
+// The mailbox hands the value it replaces to the merge, under its lock, and counts the drop.
+TEST(SafetyMonitor, MailboxMergesWhatItReplaces) {
+  Mailbox<FrameResult> box;
+  SafetyMonitor monitor(ssm_params());
+  const auto carry = [&](const FrameResult& replaced, FrameResult& next) { carry_replaced(monitor, replaced, 0, next); };
+  FrameResult a = measured({link(2, 0.4F, 0.0F)});
+  FrameResult b;
+  b.valid = true;
+  ASSERT_TRUE(box.put(a, carry));
+  ASSERT_TRUE(box.put(b, carry));
+  EXPECT_EQ(box.dropped(), 1);
+  FrameResult out;
+  ASSERT_TRUE(box.take_for(out, 1.0));
+  EXPECT_EQ(out.replaced.count, 1);
+  monitor.decide(out, 0);
+  EXPECT_EQ(out.verdict.state, VerdictState::stop);
+}
+
+// The watchdog's stop is held: with min_hold_s 0.1 s the frame after a silence, though clear,
+// says `holding` stop; 0.1 s of frame time later it runs again.
+TEST(SafetyMonitor, TheFrameAfterASilenceHoldsTheWatchdogsStop) {
+  SafetyParams params = ssm_params();
+  params.min_hold_s = 0.1;
+  SafetyMonitor monitor(params);
+  const Verdict silence = monitor.silence(ReasonCode::no_frame, "no frame for 0.600 s (max_frame_age_s 0.500)");
+  EXPECT_EQ(silence.state, VerdictState::stop);
+  EXPECT_EQ(silence.code, ReasonCode::no_frame);
+  FrameResult r = measured({link(0, 3.0F, 0.0F)});
+  r.host_time_ns = 2'000'000'000;
+  monitor.decide(r, 0);
+  EXPECT_EQ(r.verdict.state, VerdictState::stop);
+  EXPECT_EQ(r.verdict.code, ReasonCode::holding);
+  FrameResult later = measured({link(0, 3.0F, 0.0F)});
+  later.host_time_ns = 2'100'000'000;
+  monitor.decide(later, 0);
+  EXPECT_EQ(later.verdict.state, VerdictState::run);
+}
+
+// The unknown-space policy applies once, to the decided verdict; the governing link is kept.
+TEST(SafetyMonitor, UnknownSpaceStopsOnce) {
+  SafetyParams params = ssm_params();
+  params.unknown_policy = SafetyParams::UnknownPolicy::stop_within_m;
+  SafetyMonitor monitor(params);
+  FrameResult r = measured({link(0, 3.0F, 0.0F), link(5, 3.2F, 0.2F)});
+  r.unknown_distance_m = 0.05F;
+  monitor.decide(r, 0);
+  EXPECT_EQ(r.verdict.state, VerdictState::stop);
+  EXPECT_EQ(r.verdict.code, ReasonCode::unknown_space);
+  EXPECT_GE(r.governing_link, 0);
+}
+
+}  // namespace
+}  // namespace hrcsense
