@@ -163,14 +163,11 @@ struct CollectingSink : Sink {
   std::condition_variable kept_;
 };
 
-/// A FakeClock that tells the run's threads apart by who reads it. run_pipeline writes the
-/// output on the caller's thread (the one that built this clock) and reads the source on the
-/// capture thread (name it with capture_thread_is(), from FakeSource::before_step); any other
-/// reader is the processing thread, which reads the clock once per frame, at the end of
-/// processing it (the age check).
+/// A FakeClock that counts the output thread's reads: run_pipeline writes the output (and
+/// decides each frame there) on the caller's thread, the one that built this clock.
 class WatchedClock : public RunClock {
  public:
-  mutable FakeClock fake;  ///< the time; the test moves it (and a slow frame's read does)
+  mutable FakeClock fake;  ///< the time; the test moves it
 
   int64_t now_ns() const override {
     const std::thread::id reader = std::this_thread::get_id();
@@ -181,26 +178,6 @@ class WatchedClock : public RunClock {
   }
   void sleep_until(int64_t t_ns, const std::atomic<bool>* stop_requested) override {
     fake.sleep_until(t_ns, stop_requested);
-  }
-  /// Frame `frame` takes `cost_ns` of fake time between its measurement and its decision
-  /// (slow processing, or the whole process stalled): processed() moves the clock on then.
-  void slow_processing(int64_t frame, int64_t cost_ns) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    slow_frame_ = frame;
-    slow_frame_ns_ = cost_ns;
-  }
-  /// RunOptions::on_processed's hook, on the processing thread once frame `index` is measured.
-  void processed(int64_t index) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (index != slow_frame_) return;
-    fake.advance(slow_frame_ns_);
-    slow_frame_done_ = true;
-    read_.notify_all();
-  }
-  /// Waits (real time, at most `timeout_s`) until the slow frame has taken its time.
-  bool wait_slow_frame(double timeout_s = kTestWaitS) const {
-    std::unique_lock<std::mutex> lock(mutex_);
-    return read_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return slow_frame_done_; });
   }
   /// How often the output thread has read the clock.
   int64_t output_reads() const {
@@ -219,9 +196,6 @@ class WatchedClock : public RunClock {
   mutable std::condition_variable read_;
   std::thread::id output_thread_ = std::this_thread::get_id();
   mutable int64_t output_reads_ = 0;
-  int64_t slow_frame_ = -1;
-  int64_t slow_frame_ns_ = 0;
-  mutable bool slow_frame_done_ = false;
 };
 
 /// The background a pipeline learns from the empty fake scene (the wall at 2 m).

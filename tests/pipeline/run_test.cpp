@@ -8,7 +8,9 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <functional>
+#include <mutex>
 #include <string>
 #include <thread>
 
@@ -359,20 +361,42 @@ TEST(RunPipeline, WatchdogOnTheSteadyClockStopsWhenTheSourceStalls) {
   EXPECT_EQ(frames[4].verdict.state, VerdictState::run) << frames[4].verdict.reason;
 }
 
-// Frame 4 is measured, then 0.2 s of fake time pass before the output takes it (slow
-// processing, or the whole process stopped by SIGSTOP or a VM pause right after processing):
-// it is decided at its age as it is then, 0.2 s > max_frame_age_s 0.1 s, and becomes a stop.
-// (Before S1 the verdict was made when processing ended and a 1 s old `run` could be written.)
+// Frame 4 is measured, then 0.2 s of fake time pass before the output takes it (a slow output,
+// or the whole process stopped by SIGSTOP or a VM pause right after processing): it is decided
+// at its age as it is then, 0.2 s > max_frame_age_s 0.1 s, and becomes a stop. (Before S1 the
+// verdict was made when processing ended, and a 1 s old `run` could be written after a freeze.)
 // The capture of frame 5 waits for the stall, so frame 5 is fresh again.
 TEST(RunPipeline, MeasurementThatWaitsBeforeItsDecisionIsStale) {
   test::WatchedClock clock;
-  clock.slow_processing(4, 200'000'000);
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool measured_4 = false, stalled = false;
+  const auto wait_for = [&](const bool& flag) {
+    std::unique_lock<std::mutex> lock(mutex);
+    return changed.wait_for(lock, std::chrono::duration<double>(test::kTestWaitS), [&] { return flag; });
+  };
   FakeSource source(after_learning({{1.5F}, {1.5F}, {1.5F}}));
-  source.before_step = [&](size_t step) { return step != 5 || clock.wait_slow_frame(); };
+  source.before_step = [&](size_t step) { return step != 5 || wait_for(stalled); };
   CollectingSink sink;
+  // The output thread, writing frame 3, waits until frame 4 is measured, then 0.2 s pass: frame
+  // 4 is in the mailbox (or about to be) while the clock moves, and the output's wait for it
+  // starts after the move, so the watchdog has nothing to say; only frame 4's age does.
+  sink.before_frame = [&](const FrameResult& r) {
+    if (r.frame != 3) return;
+    EXPECT_TRUE(wait_for(measured_4));
+    clock.fake.advance(200'000'000);
+    std::lock_guard<std::mutex> lock(mutex);
+    stalled = true;
+    changed.notify_all();
+  };
   RunOptions options;
   options.clock = &clock;
-  options.on_processed = [&](const Frame& frame, const Pipeline&, const FrameResult&) { clock.processed(frame.index); };
+  options.on_processed = [&](const Frame& frame, const Pipeline&, const FrameResult&) {
+    if (frame.index != 4) return;
+    std::lock_guard<std::mutex> lock(mutex);
+    measured_4 = true;
+    changed.notify_all();
+  };
   const RunSummary summary = run(source, sink, fake_params(0.1), options);
 
   ASSERT_EQ(sink.results.size(), 7U);  // no watchdog stop
