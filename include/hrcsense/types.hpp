@@ -237,7 +237,7 @@ enum class ReasonCode : uint16_t {
   no_frame = 16,            ///< stop: the watchdog saw no frame for safety.max_frame_age_s
   source_ended = 17,        ///< stop: end of the run, the source ended
   frame_limit_reached = 18, ///< stop: end of the run, --frames reached
-  stop_requested = 19,      ///< stop: end of the run, SIGINT, SIGTERM or SIGHUP
+  stop_requested = 19,      ///< stop: end of the run, SIGINT, SIGTERM, SIGHUP or SIGTSTP
   source_error = 20,        ///< stop: end of the run, the source failed
   processing_error = 21,    ///< stop: end of the run, processing failed
   output_error = 22,        ///< stop: end of the run, the output failed
