@@ -13,7 +13,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace hrcsense::rtde;
   OutputRecipe recipe;
   std::string error;
-  SetupReply own{1, {"DOUBLE", "VECTOR6D", "VECTOR6D", "INT32", "INT32", "DOUBLE", "VECTOR6D"}};
+  SetupReply own{1, {"DOUBLE", "VECTOR6D", "VECTOR6D", "INT32", "INT32", "DOUBLE", "DOUBLE", "VECTOR6D"}};
   if (!make_output_recipe(own, kOutputVariables, recipe, error)) __builtin_trap();
   size_t at = 0;
   while (at < size) {

@@ -47,7 +47,12 @@ std::optional<SceneObject> robot_scene_object(const Config& config) {
   return arm;
 }
 
-Simulator make_simulator(const Config& config) {
+std::shared_ptr<TrajectoryClock> make_trajectory_clock(const Config& config) {
+  const bool follows = config.robot_state.trajectory && config.robot_state.trajectory->follow_link;
+  return follows ? std::make_shared<TrajectoryClock>() : nullptr;
+}
+
+Simulator make_simulator(const Config& config, std::shared_ptr<TrajectoryClock> trajectory_clock) {
   Simulator simulator;
   simulator.params = config.sim;
   simulator.params.seed = config.source.seed;
@@ -56,7 +61,7 @@ Simulator make_simulator(const Config& config) {
   simulator.robot = fixed_robot_model(config);
   if (config.robot_state.trajectory) {
     // A moving arm: rendered at each frame's time with its own label (robot.trajectory).
-    simulator.arm = SimArm{config.pipeline.robot, *config.robot_state.trajectory, std::nullopt};
+    simulator.arm = SimArm{config.pipeline.robot, *config.robot_state.trajectory, std::nullopt, std::move(trajectory_clock)};
     return simulator;
   }
   // A fixed arm is part of the static scene: rendered, learnt as background, never foreground.
@@ -97,7 +102,7 @@ std::unique_ptr<Source> make_ros2_source([[maybe_unused]] const Config& config,
 
 std::unique_ptr<Source> make_source(const Config& config, const SourceOptions& options) {
   const std::string where = config.file.empty() ? std::string("configuration") : config.file;
-  if (config.source.type == "sim") return std::make_unique<SimSource>(make_simulator(config));
+  if (config.source.type == "sim") return std::make_unique<SimSource>(make_simulator(config, options.trajectory_clock));
   if (config.source.type == "folder" || config.source.type == "bag") {
     if (config.source.path.empty()) {
       throw ConfigError(where + ": source.path: required for source.type " + config.source.type);
@@ -128,7 +133,8 @@ std::vector<DeviceDescriptor> list_cameras() {
 #endif
 }
 
-std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock) {
+std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock,
+                                                          std::shared_ptr<TrajectoryClock> trajectory_clock) {
   const RobotStateConfig& state = config.robot_state;
   const std::string& source = state.source;
   if (source == "fixed") return std::make_unique<FixedRobotState>(state.joints_rad);
@@ -141,6 +147,7 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
     params.jitter_s = config.robot_state.sim_jitter_s;
     params.seed = config.source.seed;
     params.history = config.robot_state.history;
+    params.clock = std::move(trajectory_clock);
     return std::make_unique<SimRobotState>(*config.robot_state.trajectory, params);
   }
   // Arrival times on the run's clock: the steady clock, run_pipeline's default (RunOptions::clock
@@ -171,8 +178,9 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
   throw ConfigError(where + ": robot.state.source '" + source + "': not built into this hrcsense");
 }
 
-std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, Source& source, RunClock* clock) {
-  if (config.robot_state.source != "recorded") return make_robot_state_source(config, clock);
+std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, Source& source, RunClock* clock,
+                                                          std::shared_ptr<TrajectoryClock> trajectory_clock) {
+  if (config.robot_state.source != "recorded") return make_robot_state_source(config, clock, std::move(trajectory_clock));
   const std::string where = config.file.empty() ? std::string("configuration") : config.file;
   const auto* bag = dynamic_cast<const BagSource*>(&source);
   if (bag == nullptr) {

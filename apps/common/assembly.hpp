@@ -29,9 +29,15 @@ namespace hrcsense {
 /// points.
 std::optional<SceneObject> robot_scene_object(const Config& config);
 
+/// robot.trajectory.follow_link: a new clock for the simulated arm that obeys the link, to share
+/// between make_simulator, make_source and make_robot_state_source (and to tell what was sent:
+/// TrajectoryClock::sent). Null without it.
+std::shared_ptr<TrajectoryClock> make_trajectory_clock(const Config& config);
+
 /// The simulator described by a configuration (sim.*, scene.*, camera pose, robot). With
-/// robot.trajectory the arm is the simulator's moving arm (Simulator::arm), not a scene object.
-Simulator make_simulator(const Config& config);
+/// robot.trajectory the arm is the simulator's moving arm (Simulator::arm), not a scene object;
+/// with `trajectory_clock` it follows that clock (follow_link), else the frame time.
+Simulator make_simulator(const Config& config, std::shared_ptr<TrajectoryClock> trajectory_clock = nullptr);
 
 /// The source the configuration names (source.type); throws ConfigError for a type this
 /// build does not have (naming it: realsense without the SDK says how to get it) or a recorded
@@ -40,6 +46,7 @@ Simulator make_simulator(const Config& config);
 struct SourceOptions {
   bool with_color = false;  ///< recorded sources decode their colour frames too (the pipeline does not need them)
   const std::atomic<bool>* stop_requested = nullptr;  ///< ends a live camera's waits while it is unplugged (null: never)
+  std::shared_ptr<TrajectoryClock> trajectory_clock;  ///< sim: the arm follows it (make_trajectory_clock)
 };
 std::unique_ptr<Source> make_source(const Config& config, const SourceOptions& options = {});
 
@@ -51,14 +58,17 @@ std::vector<DeviceDescriptor> list_cameras();
 /// with robot.state.sim_latency_s / sim_jitter_s, seeded by source.seed); rtde; udp_json.
 /// Throws ConfigError for one this build does not have, for rtde without robot.state.host, and
 /// for recorded (it needs the source: the overload below). A live source (rtde, udp_json) stamps arrivals with `clock` (null: the
-/// steady clock, run_pipeline's default); it must outlive the source.
-std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock = nullptr);
+/// steady clock, run_pipeline's default); it must outlive the source. `sim` reads the arm's
+/// joints at `trajectory_clock`'s time when given (the simulator's, follow_link).
+std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock = nullptr,
+                                                          std::shared_ptr<TrajectoryClock> trajectory_clock = nullptr);
 
 /// As above, and `recorded`: the joint states of `source`, the BagSource make_source built for
 /// the configuration (it reads them as it plays). Throws ConfigError when `source` is no
 /// BagSource, IoError naming the file and the topic when the bag has no joint states.
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, Source& source,
-                                                          RunClock* clock = nullptr);
+                                                          RunClock* clock = nullptr,
+                                                          std::shared_ptr<TrajectoryClock> trajectory_clock = nullptr);
 
 /// Loads background.path into `pipeline` when the file exists (checked against the filtered
 /// resolution: after decimation); false when there is nothing to load. Throws IoError for a

@@ -36,9 +36,12 @@ void log_recording(const RecorderStats& stats) {
 }
 
 RecordStateLookup record_state_lookup(const Config& config, Source& source, RobotStateSource& run_states, bool paced,
-                                      std::unique_ptr<RobotStateSource>& own) {
+                                      std::unique_ptr<RobotStateSource>& own,
+                                      std::shared_ptr<TrajectoryClock> trajectory_clock) {
   const RobotStateOrigin origin = run_states.origin();
-  if (origin == RobotStateOrigin::sim || origin == RobotStateOrigin::fixed) own = make_robot_state_source(config, source);
+  if (origin == RobotStateOrigin::sim || origin == RobotStateOrigin::fixed) {
+    own = make_robot_state_source(config, source, nullptr, std::move(trajectory_clock));
+  }
   RecordStateLookup lookup;
   lookup.states = own ? own.get() : &run_states;
   lookup.host_time_is_source_time = host_time_is_source_time(origin, paced);

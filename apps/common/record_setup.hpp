@@ -5,6 +5,7 @@
 
 #include "hrcsense/config.hpp"
 #include "hrcsense/recorder.hpp"
+#include "hrcsense/sim.hpp"
 
 #include <memory>
 #include <string>
@@ -19,8 +20,10 @@ void log_recording(const RecorderStats& stats);
 /// looks it up in `run_states` (paced or not). A `sim` or `fixed` state is asked of a second
 /// source of the configuration, made into `own` (the same answers; a late simulated state
 /// keeps a history that the recorder's lookups, a frame ahead of processing's, would reset);
-/// live and recorded ones are shared (one connection; their lookups change nothing).
+/// live and recorded ones are shared (one connection; their lookups change nothing). A `sim`
+/// state follows `trajectory_clock` when given (follow_link), as the run's does.
 RecordStateLookup record_state_lookup(const Config& config, Source& source, RobotStateSource& run_states, bool paced,
-                                      std::unique_ptr<RobotStateSource>& own);
+                                      std::unique_ptr<RobotStateSource>& own,
+                                      std::shared_ptr<TrajectoryClock> trajectory_clock = nullptr);
 
 }  // namespace hrcsense::app

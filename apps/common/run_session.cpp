@@ -5,6 +5,7 @@
 #include "common/app_errors.hpp"
 #include "common/assembly.hpp"
 #include "common/console_sink.hpp"
+#include "common/follow_link_sink.hpp"
 #include "common/record_setup.hpp"
 #include "common/tee_sink.hpp"
 #include "common/truth_label_sink.hpp"
@@ -112,8 +113,12 @@ int run_session(const Config& config, const SessionOptions& args) {
   SourceOptions source_options;
   source_options.stop_requested = &g_stop_requested;
   source_options.with_color = args.with_color;
+  // robot.trajectory.follow_link: the simulated arm, its state and its truth obey what is sent.
+  const std::shared_ptr<TrajectoryClock> trajectory_clock = make_trajectory_clock(config);
+  if (trajectory_clock) trajectory_clock->set_lockstep(!paced);
+  source_options.trajectory_clock = trajectory_clock;
   std::unique_ptr<Source> source = make_source(config, source_options);
-  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config, *source);
+  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config, *source, nullptr, trajectory_clock);
   const bool recording_source = config.source.type == "bag" || config.source.type == "folder";
   if (args.wrap_recording && recording_source) {
     // The robot states may come from the first source: the wrapper keeps it alive.
@@ -130,7 +135,7 @@ int run_session(const Config& config, const SessionOptions& args) {
     const RecordOnError on_error = params.on_error;
     recorder.emplace(std::move(params));
     const RecordStateLookup lookup =
-        record_state_lookup(config, *source, *robot_states, paced, recorder_states);
+        record_state_lookup(config, *source, *robot_states, paced, recorder_states, trajectory_clock);
     recording.emplace(*source, *recorder, on_error, lookup);
   }
   Source& frames = recording ? static_cast<Source&>(*recording) : *source;
@@ -152,7 +157,7 @@ int run_session(const Config& config, const SessionOptions& args) {
   ConsoleSink console;
   // Simulated runs: truth.contact_label from the simulator's own labels (TruthLabelSink).
   std::optional<TruthLabelSink> labelled;
-  if (config.source.type == "sim") labelled.emplace(make_simulator(config), jsonl);
+  if (config.source.type == "sim") labelled.emplace(make_simulator(config, trajectory_clock), jsonl);
   // link.udp.address: the verdicts to the controller, first, so that no file or console write
   // delays a datagram.
   const std::unique_ptr<UdpLinkSink> link = make_udp_link_sink(config);
@@ -162,9 +167,12 @@ int run_session(const Config& config, const SessionOptions& args) {
   const std::unique_ptr<RtdeLinkSink> rtde_link = make_rtde_link_sink(config);
   if (rtde_link) spdlog::info("link: speed scale to RTDE {}:{} ({})", config.robot_state.host, config.robot_state.port,
                               rtde_link->input_names());
+  // follow_link: the simulated arm takes the scale the links have just sent.
+  std::optional<FollowLinkSink> follow;
+  if (trajectory_clock) follow.emplace(trajectory_clock);
   // A viewer's sink last: the controller, the files and the console have each result first.
-  TeeSink tee{link.get(), rtde_link.get(), labelled ? static_cast<Sink*>(&*labelled) : &jsonl, &console,
-              args.viewer_sink};
+  TeeSink tee{link.get(), rtde_link.get(), follow ? &*follow : nullptr,
+              labelled ? static_cast<Sink*>(&*labelled) : &jsonl, &console, args.viewer_sink};
   std::optional<RecordCountersSink> with_record;
   if (recorder) with_record.emplace(tee, *recorder);
   Sink& recorded = with_record ? static_cast<Sink&>(*with_record) : tee;

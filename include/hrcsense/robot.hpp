@@ -207,6 +207,10 @@ struct RobotTrajectory {
   /// true: time wraps over [first t_s, last t_s); false: the ends are held (qd 0) outside.
   bool loop = false;
   std::vector<TrajectoryWaypoint> waypoints;
+  /// `robot.trajectory.follow_link` (simulator only; a test and demo feature): the arm obeys the
+  /// speed scale hrcsense sends, its trajectory time advancing by each frame step times the
+  /// last scale sent (TrajectoryClock). false: it runs at its programmed speed whatever is sent.
+  bool follow_link = false;
 };
 
 /// Joint angles and velocities of a trajectory at one time.

@@ -43,7 +43,7 @@ const char* package_type_name(uint8_t type);
 constexpr size_t kHeaderSize = 3;  ///< uint16 size (whole package) + uint8 type
 /// The variables hrcsense requests, in this order.
 constexpr const char* kOutputVariables =
-    "timestamp,actual_q,actual_qd,robot_mode,safety_mode,speed_scaling,actual_TCP_pose";
+    "timestamp,actual_q,actual_qd,robot_mode,safety_mode,speed_scaling,target_speed_fraction,actual_TCP_pose";
 
 // ---- The client's packages (complete, header included).
 std::vector<uint8_t> encode_request_protocol_version(uint16_t version);
@@ -99,7 +99,7 @@ struct SetupReply {
 
 /// The variables of a data package hrcsense knows; others are skipped by their type's size.
 enum class OutputField : uint8_t { other, timestamp, actual_q, actual_qd, robot_mode, safety_mode,
-                                   speed_scaling, actual_tcp_pose };
+                                   speed_scaling, target_speed_fraction, actual_tcp_pose };
 
 /// How to decode the output recipe's data packages: each variable's field and byte size.
 struct OutputRecipe {
@@ -121,6 +121,7 @@ struct DataSample {
   int32_t robot_mode = -1;   ///< -1 no controller ... 7 running
   int32_t safety_mode = 0;   ///< 1 normal, 3 protective stop, 5 safeguard stop, ...
   double speed_scaling = 0.0;
+  double target_speed_fraction = std::numeric_limits<double>::quiet_NaN();  ///< the speed slider; NaN: not in the recipe
   std::array<double, 6> tcp_pose{};  ///< actual_TCP_pose: x, y, z (m), rotation vector (rad), base frame
 };
 
@@ -195,6 +196,7 @@ struct RtdeStatus {
   int32_t robot_mode = -1;            ///< of the newest data package (not part of the verdict)
   int32_t safety_mode = 0;            ///< of the newest data package (not part of the verdict)
   double speed_scaling = 0.0;         ///< of the newest data package
+  double target_speed_fraction = std::numeric_limits<double>::quiet_NaN();  ///< the slider, of the newest data package
   int64_t data_packages = 0;          ///< DATA_PACKAGEs read, good or not
   int64_t skipped_packages = 0;       ///< unknown or unexpected package types, skipped by size
   int64_t text_messages = 0;          ///< TEXT_MESSAGEs from the controller

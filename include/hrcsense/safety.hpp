@@ -6,6 +6,7 @@
 #include "hrcsense/ssm.hpp"
 #include "hrcsense/types.hpp"
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -55,16 +56,23 @@ struct VerdictInput {
   /// v_r: the robot's speed towards the contact at its closest point, m/s; ssm mode only.
   float robot_speed_towards_mps = 0.0F;
   float unknown_distance_m = std::numeric_limits<float>::quiet_NaN();  ///< NaN: no unknown space known
-  /// The share of its programmed speed the robot runs at now (the controller's speed_scaling,
-  /// slider times safety scaling, RTDE); 1 when the robot state does not say. The speed scale
-  /// is a fraction of the programmed speed: v_r / robot_speed_scaling.
+  /// The share of its programmed speed the robot runs at now: the robot state's speed_fraction
+  /// (RTDE speed_scaling × target_speed_fraction, udp_json speed_fraction, the simulator's
+  /// rate), else the last speed scale hrcsense sent. The speed scale is a share of the
+  /// programmed speed, v_r / robot_speed_scaling.
   double robot_speed_scaling = 1.0;
   double frame_age_s = 0.0;      ///< the frame's age at the verdict: host time to now
 };
 
+/// The share of its programmed speed the robot runs at for measurement `m`: its state's
+/// speed_fraction when that is a reading in 0..1, else `scale_sent` (the speed scale hrcsense
+/// sent last, which a robot that obeys runs at), else 1.
+double robot_speed_fraction(const Measurement& m, double scale_sent);
+
 /// The VerdictInput of one link of a measurement (`link` null: the overall contact, with no
-/// speed or Z_d known), its age at the verdict `frame_age_s`.
-VerdictInput verdict_input(const Measurement& m, const LinkContact* link, double frame_age_s);
+/// speed or Z_d known), its age at the verdict `frame_age_s`. `scale_sent` (0..1) is the speed
+/// scale hrcsense sent last: the robot's speed fraction when its state does not read one.
+VerdictInput verdict_input(const Measurement& m, const LinkContact* link, double frame_age_s, double scale_sent);
 
 /// The verdict and, in ssm mode with a contact, S_p's terms at the robot's present speed.
 /// For a measurement (decide_measurement): those of the governing link, and which it is.
@@ -93,9 +101,10 @@ void apply_unknown_policy(const SafetyParams& params, float unknown_distance_m, 
 /// link governs: stop before slow before run, then the lowest speed scale, then the smallest
 /// d_i − S_p,i. The unknown-space policy applies once, after. `link_protective_distance_m`
 /// (optional) receives each link's S_p at its present speed, in the order of m.links.
-/// `out`'s buffers are reused.
-void decide_measurement(const SafetyParams& params, const Measurement& m, double frame_age_s, Decision& out,
-                        float distance_margin_m = 0.0F, std::vector<float>* link_protective_distance_m = nullptr);
+/// `scale_sent`: as for verdict_input. `out`'s buffers are reused.
+void decide_measurement(const SafetyParams& params, const Measurement& m, double frame_age_s, double scale_sent,
+                        Decision& out, float distance_margin_m = 0.0F,
+                        std::vector<float>* link_protective_distance_m = nullptr);
 
 /// The verdict's memory over a run: entering a stricter state (run → slow → stop) is
 /// immediate; relaxing waits until min_hold_s has passed since the last frame that asked for
@@ -156,6 +165,10 @@ class SafetyMonitor {
   Verdict silence(ReasonCode code, const std::string& reason);
   /// Forgets the past (a new run).
   void reset();
+  /// The speed scale of the last verdict written (1 before the first, 0 after a silence): what
+  /// the links sent last, which the robot is taken to run at when its state reads no speed
+  /// fraction. Safe to read from another thread (carry_replaced).
+  float scale_sent() const { return scale_sent_.load(std::memory_order_relaxed); }
 
  private:
   SafetyParams params_;
@@ -165,6 +178,7 @@ class SafetyMonitor {
   char watchdog_rule_[64] = {};
   Decision decision_;     ///< scratch: the frame's decision (buffers circulate with the results')
   Decision with_margin_;  ///< scratch: the frame's decision with the hysteresis margin
+  std::atomic<float> scale_sent_{1.0F};
 };
 
 /// Carries `replaced` (a measurement a mailbox is about to drop before anyone decided it) into

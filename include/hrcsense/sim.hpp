@@ -11,7 +11,9 @@
 #include "hrcsense/types.hpp"
 
 #include <array>
+#include <condition_variable>
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -178,16 +180,70 @@ struct SimScratch {
   int64_t label_index = -1;        ///< the frame hit_at() last cast (object_ids, label_z_m hold it); -1: none
 };
 
+/// `robot.trajectory.follow_link` (a test and demo feature): the simulated arm obeys the speed
+/// scale hrcsense sends, as an arm whose speed slider the link sets. The trajectory's own time
+/// then runs at the scale sent last: from each frame time on, at the scale sent when that frame
+/// was rendered (so a decision takes effect at the next frame). The renderer, the `sim` robot
+/// state (joints at the trajectory time, velocities times the rate, speed_fraction the rate)
+/// and the truth all read this one clock. Thread-safe: the capture thread advances it, the
+/// processing thread reads it, the output thread reports what was sent.
+class TrajectoryClock {
+ public:
+  struct Reading {
+    double trajectory_s = 0.0;  ///< the time on the trajectory (joints_at's t_s)
+    double rate = 1.0;          ///< trajectory seconds per frame-time second from then on, 0..1
+  };
+  TrajectoryClock();
+  /// The reading at frame time `t_ns` (the simulator's timeline: a frame's timestamp_ns). A
+  /// time later than all before marks it: the trajectory time up to it at the rate in force,
+  /// and from it the scale sent last. An earlier time reads the marks (between marks, at the
+  /// earlier one's rate). Integer nanoseconds, so that a frame's own time finds its own mark.
+  Reading advance_to(int64_t t_ns);
+  /// The same without marking: after the last mark, on at its rate.
+  Reading at(int64_t t_ns) const;
+  /// The link sent `scale` (0..1; anything else is ignored) for the frame of `frame_timestamp_ns`.
+  void sent(int64_t frame_timestamp_ns, float scale);
+  /// Waits at most `timeout_s` until a scale was sent for a frame at or after
+  /// `frame_timestamp_ns`; false on timeout. SimSource's lockstep for unpaced runs.
+  bool wait_sent(int64_t frame_timestamp_ns, double timeout_s) const;
+  /// The scale sent last (1 before any).
+  double scale() const;
+  /// Unpaced runs render each frame after the previous one was decided (set_lockstep(true)), so
+  /// the loop's delay is one frame however fast the run; paced runs have real time for it.
+  void set_lockstep(bool lockstep) { lockstep_ = lockstep; }
+  bool lockstep() const { return lockstep_; }
+
+ private:
+  struct Mark {
+    int64_t t_ns = 0;           ///< frame time
+    double trajectory_s = 0.0;  ///< trajectory time then
+    double rate = 1.0;          ///< from then on
+  };
+  Reading read(int64_t t_ns) const;  ///< with mutex_ held
+
+  mutable std::mutex mutex_;
+  mutable std::condition_variable sent_changed_;
+  std::vector<Mark> marks_;  ///< in frame time order, the oldest dropped in long runs
+  double scale_ = 1.0;
+  int64_t sent_for_ns_ = -1;
+  bool lockstep_ = false;
+};
+
 /// An arm the simulator moves along a trajectory (`robot.trajectory`): rendered at each frame's
-/// time t = index / fps from joints_at(trajectory, t), with the label kRobotLabel.
+/// time t = index / fps from joints_at(trajectory, t), with the label kRobotLabel (with a
+/// `clock`, at the clock's trajectory time for t instead).
 struct SimArm {
   RobotParams robot;           ///< the arm (required), padding and base frame, as the pipeline's
   RobotTrajectory trajectory;  ///< the motion, on the simulator's timeline (index / fps)
   /// Flat colour in the colour image; unset: kSimPalette[scene object count % size].
   std::optional<std::array<uint8_t, 3>> color_rgb;
+  /// follow_link: the trajectory time the arm is at (shared with the `sim` robot state); null:
+  /// the frame time itself (open loop, full programmed speed).
+  std::shared_ptr<TrajectoryClock> clock;
 };
 
-/// Renders frames of a scene. Deterministic: frame i depends only on (params, scene, i).
+/// Renders frames of a scene. Deterministic: frame i depends only on (params, scene, i), except
+/// for an arm that follows the link (SimArm::clock), which depends on the scales sent.
 struct Simulator {
   SimParams params;
   Scene scene;
@@ -228,7 +284,11 @@ struct Simulator {
   /// A label's name: "static", "robot" (kRobotLabel), or the name of the non-static scene
   /// object with that label; "" for a label no object has.
   const std::string& label_name(uint16_t label) const;
-  /// The moving arm's joints at frame `index` (joints_at at index / fps); requires `arm`.
+  /// The moving arm's trajectory time and rate at frame `index` (index / fps and 1 without a
+  /// clock); requires `arm`.
+  TrajectoryClock::Reading arm_time(int64_t index) const;
+  /// The moving arm's joints at frame `index` (joints_at at arm_time, velocities times its
+  /// rate); requires `arm`.
   TrajectorySample arm_joints(int64_t index) const;
 };
 
@@ -237,7 +297,10 @@ struct Simulator {
 /// time on the host clock. (The run loop is to pass the frame's host time, which for unpaced
 /// sim runs is that timestamp.) Origin `sim`.
 ///
-/// Without latency and jitter the state is exact: joints_at(trajectory, t), stamped t. With
+/// Without latency and jitter the state is exact: joints_at(trajectory, t), stamped t, with
+/// speed_fraction 1 (the arm runs at its programmed speed whatever is sent). With a clock
+/// (follow_link): joints_at the clock's trajectory time for t, velocities times its rate, and
+/// speed_fraction the rate, as a controller reports its slider. With
 /// them, samples are taken every `period_s` of the timeline (sample k holds k · period_s and is
 /// stamped with that true time, as a controller clock mapped to the host would stamp it) and
 /// each becomes known `latency_s` + a jitter later, the jitter uniform in [0, jitter_s) from
@@ -254,6 +317,8 @@ class SimRobotState final : public RobotStateSource {
     double period_s = 0.002;   ///< sample period with latency or jitter (500 Hz, an e-Series' rate)
     uint64_t seed = 1;         ///< jitter seed (source.seed)
     RobotStateHistoryParams history;  ///< `robot.state.max_age_s`
+    /// follow_link: the simulator's clock (the same object its SimArm has); null: open loop.
+    std::shared_ptr<TrajectoryClock> clock;
   };
   SimRobotState(RobotTrajectory trajectory, Params params);
   RobotStateOrigin origin() const override { return RobotStateOrigin::sim; }
@@ -292,10 +357,13 @@ class SimSource : public Source {
   explicit SimSource(Simulator simulator) : sim_(std::move(simulator)) {}
   SourceInfo info() const override;
   Status next(Frame& out) override;
+  /// follow_link in lockstep: frames rendered without the previous frame's scale (the wait ran out).
+  int64_t lockstep_timeouts() const { return lockstep_timeouts_; }
 
  private:
   Simulator sim_;
   int64_t next_index_ = 0;
+  int64_t lockstep_timeouts_ = 0;
 };
 
 }  // namespace hrcsense

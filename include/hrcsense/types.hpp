@@ -178,14 +178,17 @@ using JointAngles = std::array<double, kJointCount>;
 enum class RobotStateOrigin { fixed, sim, rtde, udp_json, recorded };
 
 /// What the robot controller says of itself at a robot state's time: UR RTDE's robot_mode,
-/// safety_mode and speed_scaling (../shared/specs/ur-rtde.md) and the check of its
-/// actual_TCP_pose. Reported in the output, never part of the verdict: the robot's own safety
-/// system acts on these modes, and hrcsense's verdict is about the people in the cell.
+/// safety_mode, speed_scaling and target_speed_fraction (../shared/specs/ur-rtde.md) and the
+/// check of its actual_TCP_pose. The modes are reported only: the robot's own safety system acts
+/// on them, and hrcsense's verdict is about the people in the cell. The two speed readings
+/// become RobotState::speed_fraction, which the ssm speed scale is computed against.
 struct RobotStatus {
   bool known = false;          ///< the source reports it (rtde) for this state; else the rest is unset
   int32_t robot_mode = -1;     ///< UR robot_mode: 7 running, 5 idle, 3 power off...; robot_mode_name()
   int32_t safety_mode = 0;     ///< UR safety_mode: 1 normal, 3 protective stop, 5 safeguard stop...; safety_mode_name()
   double speed_scaling = 0.0;  ///< the controller's trajectory speed scaling, 0..1
+  /// The speed slider's value, 0..1 (RTDE target_speed_fraction); NaN: not read.
+  double target_speed_fraction = std::numeric_limits<double>::quiet_NaN();
   /// actual_TCP_pose disagrees with the forward kinematics of actual_q (a wrong robot.model, or
   /// a base frame turned; docs/ROBOT.md, "TCP pose check"). False when not checked.
   bool tcp_pose_mismatch = false;
@@ -204,6 +207,11 @@ struct RobotState {
   bool valid = false;         ///< false: no state (never measured, lost, rejected); the frame is a stop
   RobotStateOrigin origin = RobotStateOrigin::fixed;
   RobotStatus status;         ///< the controller's report at this time, where the source has one (rtde)
+  /// The share of its programmed speed the arm runs at, as the source reads it, 0..1: RTDE
+  /// speed_scaling × target_speed_fraction, udp_json's `speed_fraction`, the simulator's
+  /// trajectory clock rate. NaN: the source does not say (the monitor then takes the last
+  /// speed scale hrcsense sent). The ssm speed scale is a share of the programmed speed.
+  double speed_fraction = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// The robot as the proximity search sees it: capsules in the base frame.
@@ -362,6 +370,9 @@ struct FrameResult : Measurement {
   /// Measurement::links.
   std::vector<float> link_protective_distance_m;
   double frame_age_s = 0.0;      ///< the frame's age when it was decided (host time to then)
+  /// The share of its programmed speed the robot was taken to run at (`robot_speed_fraction`):
+  /// the state's speed_fraction, else the last scale sent; ssm's speed scale is against it.
+  double robot_speed_fraction = 1.0;
   ReplacedVerdicts replaced;     ///< measurements replaced before decision; merged into verdict
 };
 

@@ -11,6 +11,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -35,14 +36,17 @@ struct UdpJsonDatagram {
   int64_t t_ns = 0;         ///< `t_ns`: when the state held, on the sender's clock, ns (0..2^62)
   JointAngles q_rad{};      ///< `q`: joint angles, rad, joint 1 first
   JointAngles qd_rad_s{};   ///< `qd`: joint velocities, rad/s
+  /// `speed_fraction` (optional): the share of its programmed speed the robot runs at, 0..1
+  /// (the slider times the controller's own scaling). NaN when the datagram has none.
+  double speed_fraction = std::numeric_limits<double>::quiet_NaN();
   /// When !ok: what is wrong, naming the field and, for syntax, the byte offset, e.g.
   /// "q: expected 6 numbers, got 5", "t_ns: expected an integer", "duplicate key 'q'".
   std::string error;
 };
 
 /// Parses one datagram of `size` bytes. Strict: one JSON object with exactly the keys t_ns (an
-/// integer, no fraction or exponent, 0..2^62), q and qd (arrays of exactly 6 numbers), in any
-/// order, each once; keys spelt without escapes; nothing but whitespace after the object; at
+/// integer, no fraction or exponent, 0..2^62), q and qd (arrays of exactly 6 numbers) and
+/// optionally speed_fraction (a number from 0 to 1), in any order, each once; keys spelt without escapes; nothing but whitespace after the object; at
 /// most kUdpJsonMaxBytes. Anything else is an error, never an exception. Pure; `bytes` may be
 /// null when size is 0.
 UdpJsonDatagram parse_udp_json_state(const char* bytes, size_t size);

@@ -169,8 +169,8 @@ struct TrajectoryReader : YamlTree {
 
   RobotTrajectory trajectory(const YAML::Node& map, const RobotDescription& arm) const {
     const std::string key = "trajectory";
-    if (!map.IsMap()) fail(key, "expected a map {interpolation, loop, waypoints}");
-    only_keys(map, key, {"interpolation", "loop", "waypoints"});
+    if (!map.IsMap()) fail(key, "expected a map {interpolation, loop, waypoints, follow_link}");
+    only_keys(map, key, {"interpolation", "loop", "waypoints", "follow_link"});
     RobotTrajectory out;
     const YAML::Node interpolation = child(map, "interpolation");
     if (interpolation.IsDefined()) {
@@ -183,6 +183,7 @@ struct TrajectoryReader : YamlTree {
     }
     const YAML::Node loop = child(map, "loop");
     if (loop.IsDefined()) out.loop = flag(loop, key + ".loop");
+    // follow_link is read as a key of its own (read_robot), so that --set can reach it.
     const YAML::Node waypoints = required(map, key, "waypoints");
     if (!waypoints.IsSequence() || waypoints.size() < 2) {
       fail(key + ".waypoints", "expected a list of at least 2 waypoints {t_s, joints_rad}");
@@ -219,6 +220,7 @@ YAML::Node trajectory_node(const RobotTrajectory& trajectory) {
   YAML::Node out(YAML::NodeType::Map);
   out["interpolation"] = trajectory.interpolation == TrajectoryInterpolation::cubic ? "cubic" : "linear";
   out["loop"] = trajectory.loop;
+  out["follow_link"] = trajectory.follow_link;
   YAML::Node waypoints(YAML::NodeType::Sequence);
   for (const TrajectoryWaypoint& point : trajectory.waypoints) {
     YAML::Node item(YAML::NodeType::Map);
@@ -339,6 +341,13 @@ void read_robot(KeyReader& r, Config& c) {
   const YAML::Node description = r.raw("robot.description");
   const YAML::Node tool = r.raw("robot.tool");
   const YAML::Node trajectory = r.raw("robot.trajectory");
+  // A key of its own (known to --set); its effective value is part of robot.trajectory's.
+  const YAML::Node follow_link_node = r.raw("robot.trajectory.follow_link");
+  bool follow_link = false;
+  if (follow_link_node.IsDefined() &&
+      (!follow_link_node.IsScalar() || !YAML::convert<bool>::decode(follow_link_node, follow_link))) {
+    r.fail("robot.trajectory.follow_link", "expected true or false");
+  }
   // Default: the 2020 thesis's robot point (-0.5, 0.5, 0.5) m, given there with y up.
   std::vector<Eigen::Vector3f> points_base{Eigen::Vector3f(-0.5F, -0.5F, 0.5F)};
   r.vec3_list("robot.points_base", points_base, kMaxCoordinateM);
@@ -394,6 +403,7 @@ void read_robot(KeyReader& r, Config& c) {
   if (trajectory.IsDefined()) {
     const std::string prefix = "robot.";
     c.robot_state.trajectory = TrajectoryReader{{r.where(), prefix}}.trajectory(trajectory, arm);
+    c.robot_state.trajectory->follow_link = follow_link;
     r.set_effective("robot.trajectory", trajectory_node(*c.robot_state.trajectory));
   } else if (c.robot_state.source == "sim") {
     r.fail("robot.trajectory", "is required for robot.state.source sim: {interpolation: linear | cubic, loop, "

@@ -397,6 +397,7 @@ void RtdeRobotState::on_data(const rtde::Frame& frame, Connection& c) {
   status_.robot_mode = data.robot_mode;
   status_.safety_mode = data.safety_mode;
   status_.speed_scaling = data.speed_scaling;
+  status_.target_speed_fraction = data.target_speed_fraction;
   RobotState state;
   state.host_time_ns = c.clock_map.to_host(to_ns(data.timestamp_s), arrival_ns);
   state.q_rad = data.q;
@@ -407,7 +408,13 @@ void RtdeRobotState::on_data(const rtde::Frame& frame, Connection& c) {
   state.status.robot_mode = data.robot_mode;
   state.status.safety_mode = data.safety_mode;
   state.status.speed_scaling = data.speed_scaling;
+  state.status.target_speed_fraction = data.target_speed_fraction;
   state.status.tcp_pose_mismatch = tcp_mismatch;
+  // The arm runs at the slider times the controller's own scaling of its programmed speed
+  // (specs/ur-rtde.md). A value outside 0..1 is no reading: the monitor falls back to the
+  // last scale it sent.
+  const double fraction = data.speed_scaling * data.target_speed_fraction;
+  if (fraction >= 0.0 && fraction <= 1.0) state.speed_fraction = fraction;
   if (!history_.add(state)) {
     stats_.last_problem = "RTDE: DATA_PACKAGE at controller time " + std::to_string(data.timestamp_s) +
                           " s rejected (non-finite joints, not later than the previous one, or a jump)";

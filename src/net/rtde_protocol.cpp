@@ -78,6 +78,7 @@ constexpr Known kKnown[] = {
     {"timestamp", OutputField::timestamp, "DOUBLE"},       {"actual_q", OutputField::actual_q, "VECTOR6D"},
     {"actual_qd", OutputField::actual_qd, "VECTOR6D"},     {"robot_mode", OutputField::robot_mode, "INT32"},
     {"safety_mode", OutputField::safety_mode, "INT32"},    {"speed_scaling", OutputField::speed_scaling, "DOUBLE"},
+    {"target_speed_fraction", OutputField::target_speed_fraction, "DOUBLE"},
     {"actual_TCP_pose", OutputField::actual_tcp_pose, "VECTOR6D"},
 };
 
@@ -257,6 +258,7 @@ bool parse_data_package(const Frame& frame, const OutputRecipe& recipe, DataSamp
       case OutputField::robot_mode: out.robot_mode = static_cast<int32_t>(get_u32(p)); break;
       case OutputField::safety_mode: out.safety_mode = static_cast<int32_t>(get_u32(p)); break;
       case OutputField::speed_scaling: out.speed_scaling = get_f64(p); break;
+      case OutputField::target_speed_fraction: out.target_speed_fraction = get_f64(p); break;
       case OutputField::actual_tcp_pose: get_vector6(p, out.tcp_pose.data()); break;
       case OutputField::other: break;
     }

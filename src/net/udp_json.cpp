@@ -45,8 +45,8 @@ class Reader {
   bool parse(UdpJsonDatagram& out) {
     skip_ws();
     if (!eat('{')) return fail("expected a JSON object {\"t_ns\": ..., \"q\": [...], \"qd\": [...]}");
-    bool seen[3] = {false, false, false};
-    static const char* const kNames[3] = {"t_ns", "q", "qd"};
+    bool seen[4] = {false, false, false, false};
+    static const char* const kNames[4] = {"t_ns", "q", "qd", "speed_fraction"};
     skip_ws();
     if (!eat('}')) {
       for (;;) {
@@ -57,8 +57,9 @@ class Reader {
         skip_ws();
         if (!eat(':')) return fail_at(std::string(kNames[key]) + ": expected ':'");
         skip_ws();
-        const bool read = key == 0 ? read_time(out.t_ns)
-                                   : read_joints(kNames[key], key == 1 ? out.q_rad : out.qd_rad_s);
+        const bool read = key == 0   ? read_time(out.t_ns)
+                          : key == 3 ? read_fraction(out.speed_fraction)
+                                     : read_joints(kNames[key], key == 1 ? out.q_rad : out.qd_rad_s);
         if (!read) return false;
         skip_ws();
         if (eat('}')) break;
@@ -66,7 +67,7 @@ class Reader {
         skip_ws();
       }
     }
-    for (int key = 0; key < 3; ++key) {
+    for (int key = 0; key < 3; ++key) {  // speed_fraction is optional
       if (!seen[key]) return fail(std::string("missing key '") + kNames[key] + "'");
     }
     skip_ws();
@@ -120,7 +121,7 @@ class Reader {
     }
   }
 
-  // A key: t_ns (0), q (1) or qd (2), spelt plainly.
+  // A key: t_ns (0), q (1), qd (2) or speed_fraction (3), spelt plainly.
   bool read_key(int& key) {
     const char* const start = p_;
     if (!eat('"')) return fail_at("expected a key (\"t_ns\", \"q\" or \"qd\")");
@@ -136,12 +137,13 @@ class Reader {
     if (text == "t_ns") key = 0;
     else if (text == "q") key = 1;
     else if (text == "qd") key = 2;
+    else if (text == "speed_fraction") key = 3;
     else {
       const bool printable = text.size() <= 32 && std::all_of(text.begin(), text.end(), [](char c) {
                                return c >= 0x20 && c < 0x7F;
                              });
       const std::string shown = printable ? "'" + std::string(text) + "'" : "at byte " + std::to_string(start - begin_);
-      return fail("unknown key " + shown + " (expected t_ns, q, qd)");
+      return fail("unknown key " + shown + " (expected t_ns, q, qd, speed_fraction)");
     }
     return true;
   }
@@ -188,6 +190,23 @@ class Reader {
                   std::string(p_, std::min<size_t>(32, static_cast<size_t>(number_end - p_))));
     }
     t_ns = value;
+    p_ = number_end;
+    return true;
+  }
+
+  // speed_fraction: a plain JSON number from 0 to 1 (a non-finite or larger one says nothing
+  // a scale could be computed against: the datagram is malformed).
+  bool read_fraction(double& fraction) {
+    const char* number_end = nullptr;
+    bool integer = false;
+    double value = 0.0;
+    if (!scan_number(number_end, integer)) return fail(std::string("speed_fraction: expected a number, got ") + kind());
+    const std::from_chars_result r = std::from_chars(p_, number_end, value);
+    if (r.ec != std::errc() || r.ptr != number_end || !(value >= 0.0 && value <= 1.0)) {
+      return fail("speed_fraction: expected a number from 0 to 1, got " +
+                  std::string(p_, std::min<size_t>(32, static_cast<size_t>(number_end - p_))));
+    }
+    fraction = value;
     p_ = number_end;
     return true;
   }
@@ -402,9 +421,12 @@ void UdpJsonRobotState::read_loop() {
 
 void UdpJsonRobotState::handle(const char* bytes, size_t size, int64_t arrival_ns, const sockaddr_storage& peer) {
   // The parse runs outside the lock: state_at must not wait for it.
-  const UdpJsonDatagram datagram =
-      size > kUdpJsonMaxBytes ? UdpJsonDatagram{false, false, 0, {}, {}, size_error(size)}
-                              : parse_udp_json_state(bytes, size);
+  UdpJsonDatagram datagram;
+  if (size > kUdpJsonMaxBytes) {
+    datagram.error = size_error(size);
+  } else {
+    datagram = parse_udp_json_state(bytes, size);
+  }
   const std::lock_guard<std::mutex> lock(mutex_);
   if (!datagram.ok && !datagram.non_finite) {
     ++malformed_;
@@ -414,6 +436,7 @@ void UdpJsonRobotState::handle(const char* bytes, size_t size, int64_t arrival_n
   RobotState sample;
   sample.q_rad = datagram.q_rad;
   sample.qd_rad_s = datagram.qd_rad_s;
+  sample.speed_fraction = datagram.speed_fraction;
   sample.valid = true;
   sample.origin = RobotStateOrigin::udp_json;
   const auto reorder_ns = static_cast<int64_t>(history_.params.max_age_s * 1e9);

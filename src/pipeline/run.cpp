@@ -238,6 +238,7 @@ void write_stop(Sink& sink, FrameResult& scratch, const FrameResult& last, Verdi
   scratch.link_protective_distance_m.clear();
   scratch.distance_uncertainty_m = std::numeric_limits<float>::quiet_NaN();
   scratch.robot_speed_towards_mps = std::numeric_limits<float>::quiet_NaN();
+  scratch.robot_speed_fraction = std::numeric_limits<double>::quiet_NaN();
   scratch.unknown_distance_m = std::numeric_limits<float>::quiet_NaN();
   scratch.truth_links.clear();
   scratch.foreground_points = 0;

@@ -75,12 +75,14 @@ RobotStateLookup RobotStateHistory::at(int64_t host_time_ns) const {
     state.q_rad = last.q_rad;
     state.qd_rad_s = last.qd_rad_s;
     state.status = last.status;
+    state.speed_fraction = last.speed_fraction;
     for (size_t j = 0; j < kJointCount; ++j) state.q_rad[j] += last.qd_rad_s[j] * dt_s;
     out.extrapolated = dt_s > 0.0;
   } else if (host_time_ns <= sample(0).host_time_ns) {
     state.q_rad = sample(0).q_rad;
     state.qd_rad_s = sample(0).qd_rad_s;
     state.status = sample(0).status;
+    state.speed_fraction = sample(0).speed_fraction;
   } else {
     // The first sample later than the frame; the one before it is not later.
     size_t lo = 0, hi = size_ - 1;
@@ -91,6 +93,7 @@ RobotStateLookup RobotStateHistory::at(int64_t host_time_ns) const {
     const RobotState& a = sample(lo);
     const RobotState& b = sample(hi);
     state.status = a.status;  // modes do not interpolate: the one in force at the frame's time
+    state.speed_fraction = a.speed_fraction;  // nor does the slider: it steps
     const double w = static_cast<double>(host_time_ns - a.host_time_ns) /
                      static_cast<double>(b.host_time_ns - a.host_time_ns);
     for (size_t j = 0; j < kJointCount; ++j) {

@@ -59,8 +59,8 @@ void merge_replaced(const ReplacedVerdicts& replaced, Verdict& verdict) {
 
 }  // namespace
 
-void decide_measurement(const SafetyParams& params, const Measurement& m, double frame_age_s, Decision& out,
-                        float distance_margin_m, std::vector<float>* link_protective_distance_m) {
+void decide_measurement(const SafetyParams& params, const Measurement& m, double frame_age_s, double scale_sent,
+                        Decision& out, float distance_margin_m, std::vector<float>* link_protective_distance_m) {
   if (link_protective_distance_m != nullptr) link_protective_distance_m->clear();
   out.ssm.reset();
   out.governing_link = -1;
@@ -82,14 +82,14 @@ void decide_measurement(const SafetyParams& params, const Measurement& m, double
   if (!m.contact.valid || m.links.empty()) {
     // No contact: nothing in the cell (run), or foreground the search could not place (stop);
     // a valid contact without any link's would have no speed and no Z_d, which ssm stops on.
-    const Decision d = decide_verdict(params, verdict_input(m, nullptr, frame_age_s), distance_margin_m);
+    const Decision d = decide_verdict(params, verdict_input(m, nullptr, frame_age_s, scale_sent), distance_margin_m);
     assign_verdict(verdict, d.verdict);
     out.ssm = d.ssm;
     return;
   }
   float governing_slack_m = 0.0F;
   for (const LinkContact& link : m.links) {
-    VerdictInput input = verdict_input(m, &link, frame_age_s);
+    VerdictInput input = verdict_input(m, &link, frame_age_s, scale_sent);
     input.unknown_distance_m = std::numeric_limits<float>::quiet_NaN();  // the policy applies once, below
     const Decision d = decide_verdict(params, input, distance_margin_m);
     if (link_protective_distance_m != nullptr) link_protective_distance_m->push_back(d.verdict.protective_distance_m);
@@ -129,7 +129,8 @@ void SafetyMonitor::decide(FrameResult& result, int64_t now_ns) {
   const double frame_age_s = age_s(result, now_ns);
   result.frame_age_s = frame_age_s;
   Decision& decision = decision_;
-  decide_measurement(params_, result, frame_age_s, decision, 0.0F, &result.link_protective_distance_m);
+  const double scale_sent = scale_sent_.load(std::memory_order_relaxed);
+  decide_measurement(params_, result, frame_age_s, scale_sent, decision, 0.0F, &result.link_protective_distance_m);
   if (is_stale(watchdog_after_ns_, result, now_ns)) set_stale(decision.verdict);
   merge_replaced(result.replaced, decision.verdict);
   if (silence_pending_) {
@@ -137,28 +138,32 @@ void SafetyMonitor::decide(FrameResult& result, int64_t now_ns) {
     silence_pending_ = false;
   }
   // The hold relaxes only as far as the frame's decision with the distance less the hysteresis.
-  decide_measurement(params_, result, frame_age_s, with_margin_, params_.hysteresis_m);
+  decide_measurement(params_, result, frame_age_s, scale_sent, with_margin_, params_.hysteresis_m);
   hold_.apply(params_, with_margin_, result.host_time_ns, decision);
   assign_verdict(result.verdict, decision.verdict);
   result.ssm = decision.ssm;
   result.governing_link = decision.governing_link;
   result.distance_uncertainty_m = decision.distance_uncertainty_m;
   result.robot_speed_towards_mps = decision.robot_speed_towards_mps;
+  result.robot_speed_fraction = robot_speed_fraction(result, scale_sent);
+  scale_sent_.store(result.verdict.speed_scale, std::memory_order_relaxed);  // what every link sends now
 }
 
 Verdict SafetyMonitor::silence(ReasonCode code, const std::string& reason) {
   silence_pending_ = true;
+  scale_sent_.store(0.0F, std::memory_order_relaxed);
   return stop_verdict(code, reason);
 }
 
 void SafetyMonitor::reset() {
   hold_.reset();
   silence_pending_ = false;
+  scale_sent_.store(1.0F, std::memory_order_relaxed);
 }
 
 void carry_replaced(const SafetyMonitor& monitor, const FrameResult& replaced, int64_t now_ns, FrameResult& next) {
   Decision decision;
-  decide_measurement(monitor.params(), replaced, age_s(replaced, now_ns), decision);
+  decide_measurement(monitor.params(), replaced, age_s(replaced, now_ns), monitor.scale_sent(), decision);
   if (is_stale(monitor.watchdog_after_ns(), replaced, now_ns)) set_stale(decision.verdict);
   merge_replaced(replaced.replaced, decision.verdict);  // what the replaced one itself carried
   ReplacedVerdicts& carried = next.replaced;

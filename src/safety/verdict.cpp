@@ -84,9 +84,9 @@ Verdict ssm_verdict(const SafetyParams& params, const VerdictInput& input, float
                         bad ? "invalid ssm input" : "below S_p");
   }
   float scale = ssm_speed_scale(params.ssm, ssm);
-  // The scale is of the programmed speed: the robot runs at robot_speed_scaling of it now (a
-  // slider we set earlier, the controller's own reduction). Below 1 % the present speed says
-  // too little about the programmed one, and the present speed counts as programmed.
+  // The scale is of the programmed speed: the robot runs at robot_speed_scaling of it now (the
+  // slider we set earlier times the controller's own reduction). Below 1 % the present speed
+  // says too little about the programmed one, and the present speed counts as programmed.
   const double running = input.robot_speed_scaling;
   if (running > 0.01 && running < 1.0 && input.robot_speed_towards_mps > 0.0F) {
     const double allowed = allowed_robot_speed_mps(params.ssm, ssm);
@@ -102,7 +102,15 @@ Verdict ssm_verdict(const SafetyParams& params, const VerdictInput& input, float
 
 }  // namespace
 
-VerdictInput verdict_input(const Measurement& m, const LinkContact* link, double frame_age_s) {
+double robot_speed_fraction(const Measurement& m, double scale_sent) {
+  // What the robot says of its speed, else what it was told last (a robot that obeys runs at
+  // the last scale sent; one that does not runs faster, and the scale then comes out lower).
+  const double read = m.robot_state.speed_fraction;
+  if (read >= 0.0 && read <= 1.0) return read;
+  return scale_sent >= 0.0 && scale_sent <= 1.0 ? scale_sent : 1.0;
+}
+
+VerdictInput verdict_input(const Measurement& m, const LinkContact* link, double frame_age_s, double scale_sent) {
   VerdictInput input;
   input.contact = link != nullptr ? link->contact : m.contact;
   input.foreground_points = m.foreground_points;
@@ -117,10 +125,7 @@ VerdictInput verdict_input(const Measurement& m, const LinkContact* link, double
   }
   input.unknown_distance_m = m.unknown_distance_m;
   input.frame_age_s = frame_age_s;
-  const RobotStatus& status = m.robot_state.status;
-  if (status.known && status.speed_scaling > 0.0 && status.speed_scaling <= 1.0) {
-    input.robot_speed_scaling = status.speed_scaling;
-  }
+  input.robot_speed_scaling = robot_speed_fraction(m, scale_sent);
   return input;
 }
 

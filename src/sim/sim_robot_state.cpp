@@ -21,12 +21,15 @@ uint64_t mix(uint64_t x) {
   return x ^ (x >> 31);
 }
 
-RobotState sample_state(const RobotTrajectory& trajectory, int64_t time_ns) {
-  const TrajectorySample sample = joints_at(trajectory, static_cast<double>(time_ns) * 1e-9);
+RobotState sample_state(const RobotTrajectory& trajectory, const TrajectoryClock* clock, int64_t time_ns) {
+  const TrajectoryClock::Reading time =
+      clock != nullptr ? clock->at(time_ns) : TrajectoryClock::Reading{static_cast<double>(time_ns) * 1e-9, 1.0};
+  const TrajectorySample sample = joints_at(trajectory, time.trajectory_s);
   RobotState state;
   state.host_time_ns = time_ns;
   state.q_rad = sample.q_rad;
-  state.qd_rad_s = sample.qd_rad_s;
+  for (size_t j = 0; j < kJointCount; ++j) state.qd_rad_s[j] = sample.qd_rad_s[j] * time.rate;
+  state.speed_fraction = time.rate;
   state.valid = true;
   state.origin = RobotStateOrigin::sim;
   return state;
@@ -47,7 +50,7 @@ int64_t SimRobotState::raw_known_ns(int64_t k) const {
 
 bool SimRobotState::state_at(int64_t time_ns, RobotState& out) {
   if (params_.latency_s <= 0.0 && params_.jitter_s <= 0.0) {
-    out = sample_state(trajectory_, time_ns);
+    out = sample_state(trajectory_, params_.clock.get(), time_ns);
     return true;
   }
   const std::lock_guard<std::mutex> lock(mutex_);
@@ -67,7 +70,7 @@ bool SimRobotState::state_at(int64_t time_ns, RobotState& out) {
   for (;;) {
     const int64_t known_ns = std::max(last_known_ns_, raw_known_ns(next_sample_));
     if (known_ns > time_ns) break;
-    history_.add(sample_state(trajectory_, next_sample_ * period_ns_));
+    history_.add(sample_state(trajectory_, params_.clock.get(), next_sample_ * period_ns_));
     last_known_ns_ = known_ns;
     ++next_sample_;
   }

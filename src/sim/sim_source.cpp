@@ -3,6 +3,7 @@
 
 #include "hrcsense/sim.hpp"
 
+#include <cmath>
 #include <string>
 
 namespace hrcsense {
@@ -24,6 +25,14 @@ SourceInfo SimSource::info() const {
 
 Source::Status SimSource::next(Frame& out) {
   if (next_index_ >= sim_.params.frames) return Status::end;
+  const TrajectoryClock* clock = sim_.arm ? sim_.arm->clock.get() : nullptr;
+  if (clock != nullptr && clock->lockstep() && next_index_ > 0) {
+    // Closed loop, unpaced: the arm moves on at the scale sent for the previous frame. A run
+    // whose output ended sends nothing more; a bounded wait then lets the source end too.
+    constexpr double kWaitS = 1.0;
+    const int64_t previous_ns = std::llround(static_cast<double>(next_index_ - 1) * 1e9 / sim_.params.fps);
+    if (!clock->wait_sent(previous_ns, kWaitS)) ++lockstep_timeouts_;
+  }
   sim_.render(next_index_, out);
   ++next_index_;
   return Status::frame;

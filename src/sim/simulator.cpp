@@ -171,7 +171,9 @@ double link_distance_m(const RobotModel& link, const Eigen::Vector3f& p_f) {
 // The link's capsules (index `i` of the split) `dt_s` after frame `index`'s time.
 const RobotModel& link_at(const Simulator& sim, int64_t index, double dt_s, size_t i) {
   SimScratch& scratch = sim.scratch;
-  const double t_s = static_cast<double>(index) / sim.params.fps + dt_s;
+  // The arm's pose dt_s later at the rate in force from the frame on: the speed it moves at.
+  const TrajectoryClock::Reading time = sim.arm_time(index);
+  const double t_s = time.trajectory_s + dt_s * time.rate;
   robot_model_at(sim.arm->robot, joints_at(sim.arm->trajectory, t_s).q_rad, scratch.arm_nearby);
   split_by_link(scratch.arm_nearby, scratch.nearby_links);
   return scratch.nearby_links[i];
@@ -362,8 +364,17 @@ const std::string& Simulator::label_name(uint16_t label) const {
   return none;
 }
 
+TrajectoryClock::Reading Simulator::arm_time(int64_t index) const {
+  const double t_s = static_cast<double>(index) / params.fps;
+  if (!arm->clock) return {t_s, 1.0};
+  return arm->clock->advance_to(std::llround(static_cast<double>(index) * 1e9 / params.fps));  // the frame's timestamp_ns
+}
+
 TrajectorySample Simulator::arm_joints(int64_t index) const {
-  return joints_at(arm->trajectory, static_cast<double>(index) / params.fps);
+  const TrajectoryClock::Reading time = arm_time(index);
+  TrajectorySample sample = joints_at(arm->trajectory, time.trajectory_s);
+  for (double& qd : sample.qd_rad_s) qd *= time.rate;
+  return sample;
 }
 
 }  // namespace hrcsense

@@ -303,6 +303,9 @@ void JsonLinesSink::frame(const FrameResult& result) {
                    result.distance_uncertainty_m);
   m.number_or_null("robot_speed_towards_mps", std::isfinite(result.robot_speed_towards_mps),
                    result.robot_speed_towards_mps);
+  // The share of the programmed speed the speed scale was computed against (null on stop lines
+  // that stand for no frame).
+  m.number_or_null("robot_speed_fraction", std::isfinite(result.robot_speed_fraction), result.robot_speed_fraction);
   m.number_or_null("unknown_distance_m", std::isfinite(result.unknown_distance_m), result.unknown_distance_m);
   put_links(m, result);
   m.point_or_null("closest_camera", contact.valid, contact.closest_camera);
@@ -346,6 +349,8 @@ void JsonLinesSink::frame(const FrameResult& result) {
     m.integer("safety_mode", status.safety_mode);
     m.text("safety_mode_name", safety_mode_name(status.safety_mode));
     m.number("speed_scaling", status.speed_scaling);
+    m.number_or_null("target_speed_fraction", std::isfinite(status.target_speed_fraction),
+                     status.target_speed_fraction);
     m.boolean("tcp_pose_mismatch", status.tcp_pose_mismatch);
     m.close();
   } else if (robot_status_announced_) {

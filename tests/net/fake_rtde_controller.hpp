@@ -59,6 +59,7 @@ struct FakeModes {
   int32_t robot_mode = 7;   ///< running
   int32_t safety_mode = 1;  ///< normal
   double speed_scaling = 1.0;
+  double target_speed_fraction = 1.0;  ///< the speed slider
 };
 
 struct FakeRtdeScript {
@@ -276,7 +277,7 @@ class FakeRtdeController {
     }
     bool not_found = false;
     for (const std::string& name : names) {
-      std::string t = name == "timestamp" || name == "speed_scaling" ? "DOUBLE"
+      std::string t = name == "timestamp" || name == "speed_scaling" || name == "target_speed_fraction" ? "DOUBLE"
                       : name == "robot_mode" || name == "safety_mode" ? "INT32"
                       : name == "actual_q" || name == "actual_qd" || name == "actual_TCP_pose" ? "VECTOR6D"
                                                                                               : "NOT_FOUND";
@@ -415,6 +416,7 @@ class FakeRtdeController {
       for (const std::string& name : names) {
         if (name == "timestamp") be_double(payload, t_s);
         if (name == "speed_scaling") be_double(payload, modes.speed_scaling);
+        if (name == "target_speed_fraction") be_double(payload, modes.target_speed_fraction);
         if (name == "robot_mode") be32(payload, static_cast<uint32_t>(modes.robot_mode));
         if (name == "safety_mode") be32(payload, static_cast<uint32_t>(modes.safety_mode));
         for (size_t j = 0; j < 6; ++j) {

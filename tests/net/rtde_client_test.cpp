@@ -177,7 +177,7 @@ TEST_P(RtdeInStreamFault, IsCountedAndTheStreamGoesOn) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Faults, RtdeInStreamFault,
-                         ::testing::Values(InStream{RtdeFault::oversized, "DATA_PACKAGE: payload of 177 bytes"},
+                         ::testing::Values(InStream{RtdeFault::oversized, "DATA_PACKAGE: payload of 185 bytes"},
                                            InStream{RtdeFault::wrong_recipe, "recipe id 7, expected 1"},
                                            InStream{RtdeFault::unknown_type, "skipped package type 88 (unknown package type, 8 bytes)"},
                                            InStream{RtdeFault::nan_joints, "rejected (non-finite"}));

@@ -24,12 +24,16 @@ using test::Rig;
 // ---- robot_mode, safety_mode, speed_scaling
 
 // Packages 0-59 running and normal at full speed; 60-119 a protective stop (speed 0); from 120
-// idle (robot_mode 5) and normal at half speed.
+// idle (robot_mode 5) and normal at half speed with the speed slider at 0.4: the arm runs at
+// 0.5 × 0.4 = 0.2 of its programmed speed.
 FakeModes modes_of(int64_t k) {
-  if (k < 60) return FakeModes{7, 1, 1.0};
-  if (k < 120) return FakeModes{7, 3, 0.0};
-  return FakeModes{5, 1, 0.5};
+  if (k < 60) return FakeModes{7, 1, 1.0, 1.0};
+  if (k < 120) return FakeModes{7, 3, 0.0, 1.0};
+  return FakeModes{5, 1, 0.5, 0.4};
 }
+
+// 0.5 × 0.4 and the others, worked by hand.
+double programmed_share(int64_t k) { return k < 60 ? 1.0 : k < 120 ? 0.0 : 0.2; }
 
 TEST(RtdeStatus, EachStateCarriesTheModesInForceAtItsTime) {
   FakeRtdeScript script;
@@ -59,6 +63,8 @@ TEST(RtdeStatus, EachStateCarriesTheModesInForceAtItsTime) {
     EXPECT_EQ(status.robot_mode, expected.robot_mode) << k;
     EXPECT_EQ(status.safety_mode, expected.safety_mode) << k;
     EXPECT_EQ(status.speed_scaling, expected.speed_scaling) << k;
+    EXPECT_EQ(status.target_speed_fraction, expected.target_speed_fraction) << k;
+    EXPECT_DOUBLE_EQ(seen[k].speed_fraction, programmed_share(static_cast<int64_t>(k))) << k;
     EXPECT_FALSE(status.tcp_pose_mismatch) << k;  // no arm configured: not checked
     EXPECT_TRUE(seen[k].valid) << k;             // whatever the modes, the joints are valid
   }
@@ -67,6 +73,7 @@ TEST(RtdeStatus, EachStateCarriesTheModesInForceAtItsTime) {
   for (size_t i = 0; i < between.size(); ++i) {
     EXPECT_EQ(between[i].status.safety_mode, modes_of(static_cast<int64_t>(i)).safety_mode) << i;
     EXPECT_EQ(between[i].status.robot_mode, modes_of(static_cast<int64_t>(i)).robot_mode) << i;
+    EXPECT_DOUBLE_EQ(between[i].speed_fraction, programmed_share(static_cast<int64_t>(i))) << i;  // the slider steps
   }
 }
 

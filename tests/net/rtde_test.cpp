@@ -35,13 +35,14 @@ TEST(RtdeEncode, ClientPackagesByteForByte) {
   EXPECT_EQ(encode_pause(), (Bytes{0x00, 0x03, 0x50}));
 }
 
-// 125 Hz is 0x405F400000000000; the 81 bytes of names make the size 3 + 8 + 81 = 92 (0x5C).
+// 125 Hz is 0x405F400000000000; the 103 bytes of names make the size 3 + 8 + 103 = 114 (0x72).
 TEST(RtdeEncode, SetupOutputsHasFrequencyThenNames) {
-  const std::string names = "timestamp,actual_q,actual_qd,robot_mode,safety_mode,speed_scaling,actual_TCP_pose";
+  const std::string names =
+      "timestamp,actual_q,actual_qd,robot_mode,safety_mode,speed_scaling,target_speed_fraction,actual_TCP_pose";
   EXPECT_EQ(names, kOutputVariables);
   const Bytes out = encode_setup_outputs(125.0, names);
-  ASSERT_EQ(out.size(), 92U);
-  EXPECT_EQ(Bytes(out.begin(), out.begin() + 11), (Bytes{0x00, 0x5C, 0x4F, 0x40, 0x5F, 0x40, 0, 0, 0, 0, 0}));
+  ASSERT_EQ(out.size(), 114U);
+  EXPECT_EQ(Bytes(out.begin(), out.begin() + 11), (Bytes{0x00, 0x72, 0x4F, 0x40, 0x5F, 0x40, 0, 0, 0, 0, 0}));
   EXPECT_EQ(std::string(out.begin() + 11, out.end()), names);
   EXPECT_THROW(encode_setup_outputs(125.0, std::string(2049, 'a')), std::invalid_argument);
 }
@@ -102,24 +103,26 @@ TEST(RtdeParse, SpecDataPackage) {
       << error;
   EXPECT_EQ(sample.recipe_id, 1);
   EXPECT_NEAR(sample.timestamp_s, 16412.206, 1e-3);
+  EXPECT_EQ(sample.target_speed_fraction, 1.0);  // 3F F0 00 .. 00
 }
 
 // hrcsense's own recipe, a package built by hand: timestamp 12.5, q_j = 0.25 j − 1, qd_j = 0.5 j,
-// robot_mode 7, safety_mode 3 (protective stop), speed_scaling 0.75, TCP pose 0.1 j.
+// robot_mode 7, safety_mode 3 (protective stop), speed_scaling 0.75, slider 0.5, TCP pose 0.1 j.
 TEST(RtdeParse, OwnRecipeDataPackage) {
   SetupReply reply;
   reply.recipe_id = 4;
-  reply.types = {"DOUBLE", "VECTOR6D", "VECTOR6D", "INT32", "INT32", "DOUBLE", "VECTOR6D"};
+  reply.types = {"DOUBLE", "VECTOR6D", "VECTOR6D", "INT32", "INT32", "DOUBLE", "DOUBLE", "VECTOR6D"};
   OutputRecipe recipe;
   std::string error;
   ASSERT_TRUE(make_output_recipe(reply, kOutputVariables, recipe, error)) << error;
-  EXPECT_EQ(recipe.payload_size, 1U + 8 + 48 + 48 + 4 + 4 + 8 + 48);
+  EXPECT_EQ(recipe.payload_size, 1U + 8 + 48 + 48 + 4 + 4 + 8 + 8 + 48);
   Bytes b{0x00, 0x00, 0x55, 0x04};
   put_double(b, 12.5);
   for (int j = 0; j < 6; ++j) put_double(b, 0.25 * j - 1.0);
   for (int j = 0; j < 6; ++j) put_double(b, 0.5 * j);
   for (uint8_t v : {0, 0, 0, 7, 0, 0, 0, 3}) b.push_back(v);
   put_double(b, 0.75);
+  put_double(b, 0.5);
   for (int j = 0; j < 6; ++j) put_double(b, 0.1 * j);
   b[0] = static_cast<uint8_t>(b.size() >> 8);
   b[1] = static_cast<uint8_t>(b.size() & 0xFF);
@@ -134,6 +137,7 @@ TEST(RtdeParse, OwnRecipeDataPackage) {
   EXPECT_EQ(s.robot_mode, 7);
   EXPECT_EQ(s.safety_mode, 3);
   EXPECT_EQ(s.speed_scaling, 0.75);
+  EXPECT_EQ(s.target_speed_fraction, 0.5);
 
   // Another recipe id, or 8 bytes the recipe does not explain: rejected, naming the package.
   Bytes wrong_id = b;
@@ -144,22 +148,22 @@ TEST(RtdeParse, OwnRecipeDataPackage) {
   oversized.insert(oversized.end(), 8, 0);
   oversized[1] = static_cast<uint8_t>(oversized[1] + 8);
   EXPECT_FALSE(parse_data_package(only_frame(oversized), recipe, s, error));
-  EXPECT_NE(error.find("DATA_PACKAGE: payload of 177 bytes, expected 169"), std::string::npos) << error;
+  EXPECT_NE(error.find("DATA_PACKAGE: payload of 185 bytes, expected 177"), std::string::npos) << error;
 }
 
 TEST(RtdeParse, RecipeProblemsNameTheVariable) {
   OutputRecipe recipe;
   std::string error;
-  SetupReply reply{1, {"DOUBLE", "VECTOR6D", "VECTOR6D", "INT32", "INT32", "DOUBLE", "NOT_FOUND"}};
+  SetupReply reply{1, {"DOUBLE", "VECTOR6D", "VECTOR6D", "INT32", "INT32", "DOUBLE", "DOUBLE", "NOT_FOUND"}};
   EXPECT_FALSE(make_output_recipe(reply, kOutputVariables, recipe, error));
   EXPECT_NE(error.find("'actual_TCP_pose' NOT_FOUND"), std::string::npos) << error;
-  reply.types[6] = "VECTOR6D";
+  reply.types[7] = "VECTOR6D";
   reply.types[1] = "DOUBLE";
   EXPECT_FALSE(make_output_recipe(reply, kOutputVariables, recipe, error));
   EXPECT_NE(error.find("'actual_q' is DOUBLE, expected VECTOR6D"), std::string::npos) << error;
   reply.types.pop_back();
   EXPECT_FALSE(make_output_recipe(reply, kOutputVariables, recipe, error));
-  EXPECT_NE(error.find("6 types for 7 requested variables"), std::string::npos) << error;
+  EXPECT_NE(error.find("7 types for 8 requested variables"), std::string::npos) << error;
 }
 
 TEST(RtdeSplit, TruncatedWaitsShortSizeIsMalformedUnknownIsSkippedBySize) {

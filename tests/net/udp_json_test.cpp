@@ -108,7 +108,15 @@ TEST(UdpJsonParse, MalformedDatagramsNameTheField) {
       {"{}", "missing key 't_ns'"},
       {R"({"t_ns":1,)" + q6 + "," + q6 + "," + qd6 + "}", "duplicate key 'q'"},
       {R"({"t_ns":1,"t_ns":2,)" + q6 + "," + qd6 + "}", "duplicate key 't_ns'"},
-      {R"({"t_ns":1,"seq":7,)" + q6 + "," + qd6 + "}", "unknown key 'seq' (expected t_ns, q, qd)"},
+      {R"({"t_ns":1,"seq":7,)" + q6 + "," + qd6 + "}", "unknown key 'seq' (expected t_ns, q, qd, speed_fraction)"},
+      {R"({"t_ns":1,)" + q6 + "," + qd6 + R"(,"speed_fraction":1.5})",
+       "speed_fraction: expected a number from 0 to 1, got 1.5"},
+      {R"({"t_ns":1,)" + q6 + "," + qd6 + R"(,"speed_fraction":-0.25})",
+       "speed_fraction: expected a number from 0 to 1, got -0.25"},
+      {R"({"t_ns":1,)" + q6 + "," + qd6 + R"(,"speed_fraction":"0.5"})", "speed_fraction: expected a number, got a string"},
+      {R"({"t_ns":1,)" + q6 + "," + qd6 + R"(,"speed_fraction":NaN})",
+       "speed_fraction: expected a number, got an invalid token"},
+      {R"({"speed_fraction":1,"t_ns":1,)" + q6 + "," + qd6 + R"(,"speed_fraction":1})", "duplicate key 'speed_fraction'"},
       {R"({"t\u005fns":1,)" + q6 + "," + qd6 + "}",
        "key: escapes and control characters are not accepted in keys at byte 3"},
       {R"({"t_ns":1,"q":[0,0,"0",0,0,0],)" + qd6 + "}", "q[2]: expected a number, got a string"},
@@ -138,6 +146,20 @@ TEST(UdpJsonParse, MalformedDatagramsNameTheField) {
     EXPECT_FALSE(d.non_finite) << c.datagram;
     EXPECT_EQ(d.error, c.error) << c.datagram;
   }
+}
+
+// speed_fraction is optional: absent, the datagram's fraction is NaN (the monitor then takes the
+// scale it sent last); present, the number as sent, 0 and 1 included.
+TEST(UdpJsonParse, OptionalSpeedFraction) {
+  const std::string joints = R"("q":[0,0,0,0,0,0],"qd":[0,0,0,0,0,0])";
+  UdpJsonDatagram d = parse(R"({"t_ns":1,)" + joints + "}");
+  ASSERT_TRUE(d.ok) << d.error;
+  EXPECT_TRUE(std::isnan(d.speed_fraction));
+  d = parse(R"({"speed_fraction": 0.25, "t_ns":1,)" + joints + "}");
+  ASSERT_TRUE(d.ok) << d.error;
+  EXPECT_EQ(d.speed_fraction, 0.25);
+  EXPECT_EQ(parse(R"({"t_ns":1,)" + joints + R"(,"speed_fraction":0})").speed_fraction, 0.0);
+  EXPECT_EQ(parse(R"({"t_ns":1,)" + joints + R"(,"speed_fraction":1})").speed_fraction, 1.0);
 }
 
 // Python's json.dumps writes NaN and Infinity: well-formed, but not a state. The values come
@@ -280,6 +302,30 @@ TEST(UdpJsonRobotState, StatesOnTheHostClockMatchTheSentTrajectory) {
   ASSERT_TRUE(source.state_at(kHostStart + 36 * kMs, state));
   EXPECT_NEAR(state.q_rad[0], 0.136, 1e-9);
   EXPECT_NEAR(state.q_rad[5], -0.218, 1e-9);
+}
+
+// A sender that reports its speed fraction: samples 0-1 at 1, samples 2-3 at 0.4 (a slider set
+// down). Each state carries the fraction of the sample in force at its time (it steps, it does
+// not interpolate); a sender that stops reporting it leaves it unknown (NaN).
+TEST(UdpJsonRobotState, StatesCarryTheSpeedFractionInForce) {
+  FakeClock clock(kHostStart);
+  UdpJsonRobotState source(loopback_params(), clock);
+  Sender sender(source.bound_port());
+  const double fractions[] = {1.0, 1.0, 0.4, 0.4};
+  for (int i = 0; i < 5; ++i) {
+    std::string datagram = trajectory_datagram(i);
+    if (i < 4) datagram.insert(1, "\"speed_fraction\": " + std::to_string(fractions[i]) + ", ");
+    deliver(clock, kHostStart + i * kPeriod, sender, datagram, source, accepted);
+  }
+  RobotState state;
+  ASSERT_TRUE(source.state_at(kHostStart + 4 * kMs, state));
+  EXPECT_EQ(state.speed_fraction, 1.0);
+  ASSERT_TRUE(source.state_at(kHostStart + 12 * kMs, state));  // between samples 1 and 2: sample 1's
+  EXPECT_EQ(state.speed_fraction, 1.0);
+  ASSERT_TRUE(source.state_at(kHostStart + 20 * kMs, state));
+  EXPECT_EQ(state.speed_fraction, 0.4);
+  ASSERT_TRUE(source.state_at(kHostStart + 32 * kMs, state));  // sample 4 says nothing
+  EXPECT_TRUE(std::isnan(state.speed_fraction));
 }
 
 // The sender stops after sample 4 (host 2000.032 s): 38 ms later the state is still valid, 51 ms

@@ -238,5 +238,72 @@ TEST(SafetyMonitor, UnknownSpaceStopsOnce) {
   EXPECT_GE(r.governing_link, 0);
 }
 
+// ---- The speed scale against the programmed speed (S1, defect 2)
+//
+// A link 1.268 m away: S_p(v) = 1.118 + 0.3·v, so the allowed speed is (1.268 − 1.118) / 0.3 =
+// 0.5 m/s. The scale is a share of the *programmed* speed, which is the present speed divided
+// by the share the robot runs at (its speed fraction).
+
+SafetyParams no_hold() {
+  SafetyParams params = ssm_params();
+  params.hysteresis_m = 0.0F;
+  params.min_hold_s = 0.0;
+  return params;
+}
+
+FrameResult moving_at(float present_mps, double speed_fraction) {
+  FrameResult r = measured({link(5, 1.268F, present_mps)});
+  r.robot_state.speed_fraction = speed_fraction;
+  return r;
+}
+
+// The robot reads 0.5 of its programmed speed and moves at 0.5 m/s: programmed 1 m/s, so the
+// scale is 0.5 / 1 = 0.5. Taking the present speed for the programmed one (0.5 / 0.5 = 1, run)
+// was the defect: the robot, back at full speed, would then run at 1 m/s > 0.5 m/s.
+TEST(SafetyMonitor, TheScaleIsOfTheProgrammedSpeedTheStateReads) {
+  SafetyMonitor monitor(no_hold());
+  FrameResult r = moving_at(0.5F, 0.5);
+  monitor.decide(r, 0);
+  EXPECT_EQ(r.verdict.state, VerdictState::slow);
+  EXPECT_NEAR(r.verdict.speed_scale, 0.5, 1e-5);
+  EXPECT_EQ(r.robot_speed_fraction, 0.5);
+}
+
+// No reading (udp_json without speed_fraction): the robot is taken to run at the scale sent
+// last. Frame 1, nothing sent yet (1): 1 m/s → scale 0.5. Frame 2, the robot obeyed and moves
+// at 0.5 m/s: against the 0.5 sent, programmed 1 m/s → the scale stays 0.5 (not run).
+TEST(SafetyMonitor, WithoutAReadingTheLastScaleSentCounts) {
+  SafetyMonitor monitor(no_hold());
+  const double unknown = std::numeric_limits<double>::quiet_NaN();
+  FrameResult first = moving_at(1.0F, unknown);
+  monitor.decide(first, 0);
+  EXPECT_EQ(first.verdict.state, VerdictState::slow);
+  EXPECT_NEAR(first.verdict.speed_scale, 0.5, 1e-5);
+  EXPECT_EQ(first.robot_speed_fraction, 1.0);
+  EXPECT_NEAR(monitor.scale_sent(), 0.5, 1e-6);
+  FrameResult second = moving_at(0.5F, unknown);
+  second.host_time_ns = 33'000'000;
+  monitor.decide(second, 0);
+  EXPECT_EQ(second.verdict.state, VerdictState::slow);
+  EXPECT_NEAR(second.verdict.speed_scale, 0.5, 1e-5);
+  EXPECT_NEAR(second.robot_speed_fraction, 0.5, 1e-6);
+}
+
+// A reading wins over what was sent: the scale sent was 0.5 but the robot reads 1 (someone set
+// the slider back) and moves at 1 m/s: programmed 1 m/s, scale 0.5.
+TEST(SafetyMonitor, AReadingWinsOverTheScaleSent) {
+  SafetyMonitor monitor(no_hold());
+  FrameResult first = moving_at(1.0F, std::numeric_limits<double>::quiet_NaN());
+  monitor.decide(first, 0);
+  ASSERT_NEAR(monitor.scale_sent(), 0.5, 1e-6);
+  FrameResult second = moving_at(1.0F, 1.0);
+  monitor.decide(second, 0);
+  EXPECT_NEAR(second.verdict.speed_scale, 0.5, 1e-5);
+  EXPECT_EQ(second.robot_speed_fraction, 1.0);
+  // After a silence the links sent a stop: 0.
+  monitor.silence(ReasonCode::no_frame, "no frame");
+  EXPECT_EQ(monitor.scale_sent(), 0.0F);
+}
+
 }  // namespace
 }  // namespace hrcsense
