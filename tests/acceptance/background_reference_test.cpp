@@ -157,13 +157,14 @@ TEST_F(BackgroundReference, WithAReferenceTheCellStopsUntilThePersonHasGone) {
   }
   ASSERT_GT(last_close, static_cast<int64_t>(kStandUntilS * 30));
 
-  // Once they have gone, a clean batch is learnt and the cell runs to the end.
+  // Once they have walked away (at 1.6 m/s, out of reach of the arm; the last of them is still
+  // at the image's left edge), a clean batch is learnt and the cell runs to the end.
   const auto first_run = std::find_if(outcomes.begin(), outcomes.end(),
                                       [](const FrameOutcome& o) { return o.verdict == VerdictState::run; });
   ASSERT_NE(first_run, outcomes.end());
   EXPECT_GT(first_run->frame, last_close);
   for (auto o = first_run; o != outcomes.end(); ++o) {
-    EXPECT_FALSE(o->person_seen) << o->frame;
+    EXPECT_TRUE(!o->person_seen || o->truth_distance_m > 2.0F) << o->frame;
     EXPECT_EQ(o->verdict, VerdictState::run) << o->frame << ": " << o->reason;
   }
   std::printf("with a reference: %d frames background_not_empty, the person last within %.1f m at frame %lld, "
@@ -177,7 +178,9 @@ TEST_F(BackgroundReference, TheEmptyCellIsAcceptedAtOnce) {
   const std::vector<FrameOutcome> outcomes = run_cell(standing_person_cell(false), reference_);
   for (const FrameOutcome& o : outcomes) {
     EXPECT_NE(o.code, ReasonCode::background_not_empty) << o.frame << ": " << o.reason;
-    if (o.frame >= kLearningFrames) EXPECT_EQ(o.verdict, VerdictState::run) << o.frame << ": " << o.reason;
+    if (o.frame >= kLearningFrames) {
+      EXPECT_EQ(o.verdict, VerdictState::run) << o.frame << ": " << o.reason;
+    }
   }
 }
 
