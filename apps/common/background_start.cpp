@@ -69,15 +69,15 @@ BackgroundStart start_background(const Config& config, const SourceInfo& info, P
                  config.background_reference, pipeline.reference_distance_m());
     return BackgroundStart::reference;
   }
+  // Loaded first, so that a damaged file's error is the only line a failed start writes.
+  const bool loaded = load_background_file(config, info, pipeline);
   spdlog::warn("no background.reference: a person standing still while the background is learnt becomes "
                "background and is never seen; with the cell confirmed empty, teach one with "
                "hrcsense teach --config FILE --out PATH and set background.reference (docs/SAFETY.md, "
                "\"Commissioning a cell\")");
-  if (load_background_file(config, info, pipeline)) {
-    spdlog::info("background loaded from {}", config.background_path);
-    return BackgroundStart::loaded;
-  }
-  return BackgroundStart::learnt;
+  if (!loaded) return BackgroundStart::learnt;
+  spdlog::info("background loaded from {}", config.background_path);
+  return BackgroundStart::loaded;
 }
 
 // run_pipeline itself, unpaced as the source allows, so that the frames, the filters, the
