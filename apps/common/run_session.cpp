@@ -4,6 +4,7 @@
 
 #include "common/app_errors.hpp"
 #include "common/assembly.hpp"
+#include "common/background_start.hpp"
 #include "common/console_sink.hpp"
 #include "common/follow_link_sink.hpp"
 #include "common/record_setup.hpp"
@@ -141,8 +142,7 @@ int run_session(const Config& config, const SessionOptions& args) {
   Source& frames = recording ? static_cast<Source&>(*recording) : *source;
 
   Pipeline pipeline(config.pipeline);
-  const bool background_loaded = load_background_file(config, info, pipeline);
-  if (background_loaded) spdlog::info("background loaded from {}", config.background_path);
+  const BackgroundStart background_start = start_background(config, info, pipeline);
 
   std::ofstream file;
   if (!args.out.empty()) {
@@ -212,7 +212,8 @@ int run_session(const Config& config, const SessionOptions& args) {
     }
   }
   if (recorder) log_recording(recorder->close());
-  if (!background_loaded) save_learnt_background(config, pipeline);
+  // With a reference, background.path is ignored, so nothing is saved there either.
+  if (background_start == BackgroundStart::learnt) save_learnt_background(config, pipeline);
   const std::string out_name = args.out.empty() ? "stdout" : args.out;
   out.flush();
   if (!out) return report_error(out_name + ": write failed; the run ended there", kExitRuntime);

@@ -49,6 +49,9 @@ int record_command(const CommandArgs& args);
 /// publish: the configured source as realsense-ros topics over Cyclone DDS (publish.*).
 int publish_command(const CommandArgs& args);
 int info_command(const CommandArgs& args);
+/// teach --out PATH: learns the background as a run does and writes it as a reference for
+/// background.reference; exit 1 when the source ends (or --frames) before it is learnt.
+int teach_command(const CommandArgs& args);
 /// devices: the RealSense cameras connected, with their depth profiles (docs/CAMERAS.md); in a
 /// build without the SDK, the error saying how to get it.
 int devices_command();

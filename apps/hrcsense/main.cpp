@@ -59,6 +59,11 @@ int main(int argc, char** argv) {
   add_common_flags(*info, args);
   info->add_option("path", args.input, "a recording: a RealSense .bag file or a folder of depth PNGs");
 
+  CLI::App* teach = app.add_subcommand(
+      "teach", "learn the background with the cell empty and write it for background.reference (docs/SAFETY.md)");
+  add_common_flags(*teach, args);
+  teach->add_option("--out", args.out, "the reference background file (the background.path format)")->required();
+
   CLI::App* devices = app.add_subcommand("devices", "list the RealSense cameras connected and their depth profiles");
 
   CLI::App* bench = app.add_subcommand("bench", "time the processing path on pre-rendered frames");
@@ -89,9 +94,10 @@ int main(int argc, char** argv) {
   // CLI11 would only say "a subcommand is required" for a misspelt one; name it instead.
   const std::string first = argc > 1 ? argv[1] : "";
   if (!first.empty() && first[0] != '-' && first != "run" && first != "record" && first != "publish" && first != "info" &&
-      first != "devices" && first != "bench" && first != "verify-filters" && first != "eval") {
+      first != "devices" && first != "bench" && first != "verify-filters" && first != "eval" && first != "teach") {
     return hrcsense::app::report_error(std::string("unknown command '") + argv[1] +
-                                           "'; expected run, record, publish, info, devices, bench, eval or verify-filters",
+                                           "'; expected run, record, publish, info, teach, devices, bench, eval or "
+                                           "verify-filters",
                                        hrcsense::app::kExitUsage);
   }
   try {
@@ -106,6 +112,7 @@ int main(int argc, char** argv) {
     if (record->parsed()) return hrcsense::app::record_command(args);
     if (publish->parsed()) return hrcsense::app::publish_command(args);
     if (info->parsed()) return hrcsense::app::info_command(args);
+    if (teach->parsed()) return hrcsense::app::teach_command(args);
     if (devices->parsed()) return hrcsense::app::devices_command();
     if (verify_filters->parsed()) return hrcsense::app::verify_filters_command(args);
     if (eval->parsed()) return hrcsense::app::eval_command(eval_args);

@@ -142,6 +142,10 @@ struct Config {
   /// is in pipeline.filters.
   std::string filters_preset = "sdk";
   std::string background_path;     ///< `background.path`: load if it exists, else save after learning
+  /// `background.reference`: a background taught with the cell empty (`hrcsense teach`); each
+  /// start learns afresh and compares the learnt background with it (background_path is then
+  /// ignored). Empty: none.
+  std::string background_reference;
   PipelineParams pipeline;         ///< camera pose, robot, background, foreground, proximity, safety
   /// `robot.model`: points, ur5, ur5e, ur10e or custom. The arm (built in or from
   /// `robot.description`), `robot.padding_m` in effect (an arm's own padding by default) and

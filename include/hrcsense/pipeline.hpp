@@ -75,6 +75,21 @@ class Pipeline {
   /// BackgroundCheck::frames frames are compared with it first (stops); when they contradict
   /// it, process() throws BackgroundMismatch, naming `origin` (e.g. the file it came from).
   void set_background(BackgroundModel model, std::string origin = "the loaded background");
+  /// `background.reference`: every background learnt from now on is compared with `reference`
+  /// (taught with the cell empty, of the filtered frames' size) when its batch completes
+  /// (ReferenceCheck). A batch that holds a blob of at least safety.ssm.detection_mm nearer than
+  /// the reference within reference_distance_m() of the robot is refused and learning goes on;
+  /// until a batch is accepted, every frame is withheld with `background_not_empty`, naming the
+  /// blob. `origin` names the reference in those reasons (e.g. its file). Not for a background
+  /// given to set_background(), which is not learnt.
+  void set_reference(BackgroundModel reference, std::string origin = "the reference background");
+  bool has_reference() const { return reference_check_.has_reference(); }
+  /// How near the robot a blob in the learnt background refuses it: S_p at rest in `ssm` mode
+  /// (a person at walking speed, frame age 0 so T_r is the controller's latency, Z_d 0: the
+  /// protective_distance_m of a frame without foreground), safety.slow_distance_m in `zones`.
+  float reference_distance_m() const;
+  /// What the last comparison with the reference found (nothing before one).
+  const ReferenceFinding& reference_finding() const { return reference_finding_; }
   bool background_ready() const { return learner_.ready() || preset_background_; }
   const BackgroundModel& background() const;
   /// Measures one frame into `m`, reusing its buffers: validity (or why it is withheld), per
@@ -121,6 +136,16 @@ class Pipeline {
   RobotModel robot_;     ///< params_.robot at the current frame's robot state (buffer reused)
   SelfFilter self_filter_;  ///< the arm's remembered poses rendered into the filtered frame
   BackgroundCheck check_;  ///< of a loaded background against the first frames
+  // background.reference: the check of each learnt batch, the robot's distinct poses while the
+  // batch was learnt (their capsules one after another), and whether the last completed batch
+  // was refused as not empty (then every learning frame says so, with not_empty_reason_).
+  ReferenceCheck reference_check_;
+  std::string reference_origin_;
+  RobotModel learning_poses_;
+  size_t last_pose_begin_ = 0;  ///< where the newest pose starts in learning_poses_
+  ReferenceFinding reference_finding_;
+  bool not_empty_ = false;
+  std::string not_empty_reason_;
 
   // The previous frame, for the filters' lag, and per link its previous contact, for the
   // contact's speed (Z_d).
@@ -143,6 +168,12 @@ class Pipeline {
   const Frame* filter(const Frame& source_frame, Measurement& m);
   /// A learning frame: adds it to the learner (withheld).
   void learn(const Frame& frame, const RobotState& robot_state, Measurement& m);
+  /// Adds robot_ to learning_poses_ unless it is the pose added last (a fixed arm adds one).
+  void remember_learning_pose();
+  /// A completed batch against the reference: refuses it when someone is in it.
+  void check_reference(const Frame& frame, const RobotPixels* robot_pixels);
+  /// Withholds a learning frame with `background_not_empty` while the last batch was refused.
+  void withhold_not_empty(Measurement& m) const;
   /// The background fits the frame, a loaded one is checked, and the camera sees the cell.
   bool background_usable(const Frame& frame, Measurement& m);
   /// The robot's capsules at a valid, finite state.

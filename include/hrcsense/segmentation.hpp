@@ -114,6 +114,9 @@ struct BackgroundLearner {
   /// Why learning last restarted; empty if it never did.
   const std::string& message() const { return message_; }
   int frames_seen() const { return count_; }
+  /// Throws the batch just learnt away (a ReferenceCheck found someone in it): learning starts
+  /// over with the next frame, and message() says `why`.
+  void refuse(const std::string& why);
   /// The depth noise σ / z² (1/m) the last completed batch was judged with: the stereo model's
   /// with a baseline, else learnt from the batch; 0 before the first batch.
   double noise_per_z2() const { return noise_per_z2_; }
@@ -236,6 +239,61 @@ struct ForegroundExtractor {
   std::vector<float> ray_x_;
   std::vector<float> ray_y_;
   std::vector<uint8_t> row_states_;
+};
+
+/// What a learnt background holds that the reference does not: one blob of pixels nearer than
+/// the reference (ReferenceCheck::compare). Pixel coordinates are of the filtered image.
+struct ReferenceFinding {
+  bool found = false;       ///< a blob of at least the detection size lies near the robot
+  int blobs = 0;            ///< such blobs; the fields below describe the one nearest the robot
+  int u_min = 0, u_max = 0, v_min = 0, v_max = 0;  ///< its pixel box, inclusive
+  size_t pixels = 0;        ///< its pixels
+  float depth_m = 0.0F;     ///< its mean depth in the learnt background (camera z)
+  float size_mm = 0.0F;     ///< its size: the diameter of the disc of its area at depth_m
+  /// Its nearest point's distance to the robot's capsules (the surface, padding included) over
+  /// the poses given; NaN when no pose was given (every blob then counts as near).
+  float distance_m = 0.0F;
+};
+
+/// Compares a background learnt at start with a reference taught with the cell confirmed empty
+/// (`background.reference`, `hrcsense teach`): someone who stood still while the background was
+/// learnt is in the learnt background and nearer than the reference there, and would otherwise
+/// never be foreground. A learnt pixel is "nearer" by the foreground test itself (the learnt
+/// depth as a frame against the reference as background: ForegroundParams k_sigma, min_margin_m,
+/// the stereo noise model, depth-jump splitting), and a blob counts when its disc diameter at its
+/// depth is at least detection_mm and any of its points lies within max_distance_m of the
+/// robot. Pixels where either background is unknown are not compared: the reference cannot speak
+/// for what it never measured (the arm's own silhouette when it was taught, surfaces the camera
+/// does not measure), and an unknown learnt pixel holds nobody.
+struct ReferenceCheck {
+  ForegroundParams foreground;   ///< the foreground test; its min_object_mm and workspace are not used
+  float detection_mm = 40.0F;    ///< blobs at least this across count (`safety.detection_mm`)
+  /// Blobs count within this distance of the robot (S_p at rest, or `safety.slow_distance_m`).
+  float max_distance_m = 1.0F;
+
+  /// The reference to compare with (a background file taught with the cell empty).
+  void set_reference(BackgroundModel reference);
+  bool has_reference() const { return has_reference_; }
+  const BackgroundModel& reference() const { return reference_; }
+
+  /// Compares `learnt` with the reference, for frames like `frame` (its size, intrinsics, depth
+  /// unit and stereo baseline: the filtered frames the background was learnt from), the camera
+  /// at `T_base_camera`. `robot_poses` holds the robot's capsules (base frame) at every pose the
+  /// distance is taken over; empty: every blob counts. `robot` (the frame's size) removes the
+  /// arm's own pixels. Nothing is found without a reference, or when `learnt` or `frame` is not
+  /// of its size (the caller refuses such a reference first). Allocates on the first call and
+  /// when the camera changes, not after.
+  ReferenceFinding compare(const BackgroundModel& learnt, const Frame& frame, const Pose& T_base_camera,
+                           const RobotModel& robot_poses, const RobotPixels* robot);
+
+ private:
+  BackgroundModel reference_;
+  bool has_reference_ = false;
+  ForegroundExtractor extractor_;   ///< prepared against reference_
+  Frame learnt_frame_;              ///< the learnt background as a depth frame
+  Foreground nearer_;               ///< its pixels nearer than the reference
+  std::vector<float> distance_m_;   ///< per pixel of nearer_: distance to the robot
+  std::vector<int32_t> queue_;      ///< the labelling's flood fill
 };
 
 }  // namespace hrcsense

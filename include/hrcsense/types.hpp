@@ -261,6 +261,9 @@ enum class ReasonCode : uint16_t {
   below_protective_distance = 28,  ///< stop (ssm): closer than S_p with the robot at rest
   speed_limited = 29,        ///< slow (ssm): the speed scale keeps the separation at S_p
   holding = 30,              ///< the verdict holds a stricter state (safety.hysteresis_m, min_hold_s)
+  /// stop: the background learnt at start holds something nearer than background.reference
+  /// within S_p at rest (zones: safety.slow_distance_m) of the robot; learning goes on
+  background_not_empty = 31,
 };
 
 struct Verdict {

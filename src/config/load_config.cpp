@@ -101,6 +101,9 @@ void read_segmentation(KeyReader& r, Config& c) {
   BackgroundParams& bg = c.pipeline.background;
   r.integer("background.frames", bg.frames, 1, std::numeric_limits<int>::max());
   r.text("background.path", c.background_path);
+  // Only named here: the file is read at start (a missing or damaged one is an error there), so
+  // that `hrcsense teach` can write the reference a configuration already names.
+  r.text("background.reference", c.background_reference);
   r.number("background.moving_k_sigma", bg.moving_k_sigma, Bound::positive);
   r.number("background.moving_min_spread_m", bg.moving_min_spread_m, Bound::non_negative);
   r.number("background.max_moving_share", bg.max_moving_share, Bound::non_negative);

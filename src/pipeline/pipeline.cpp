@@ -205,6 +205,7 @@ void Pipeline::retune(const LiveTuning& tuning) {
 
 void Pipeline::relearn_background() {
   moved_reference_ready_ = false;
+  not_empty_ = false;  // the reference stays: the new background is compared with it too
   learner_ = BackgroundLearner{};
   learner_.params = params_.background;
   preset_background_ = false;
@@ -282,19 +283,95 @@ const Frame* Pipeline::filter(const Frame& source_frame, Measurement& m) {
 
 // Motion counts near the robot where it is now, and the robot's own pixels are no samples;
 // without a usable state, motion counts everywhere.
+// With a reference, the batch that completes is compared with it at once (in the same timing),
+// and refused when someone stands in it.
 void Pipeline::learn(const Frame& frame, const RobotState& robot_state, Measurement& m) {
   const bool placed = robot_state.valid && all_finite(robot_state.q_rad);
+  if (learner_.frames_seen() == 0) {  // this frame starts a batch
+    learning_poses_.capsules.clear();
+    last_pose_begin_ = 0;
+  }
   std::optional<RobotPixels> robot_pixels;
   if (placed) {
     robot_model_at(params_.robot, robot_state.q_rad, robot_);
     robot_pixels = render_robot(frame, m);
+    if (has_reference()) remember_learning_pose();
   } else {
     self_filter_.clear_poses();
   }
+  const RobotPixels* pixels = robot_pixels ? &*robot_pixels : nullptr;
   timed(m, "background", [&] {
     const MotionRegion region{params_.T_base_camera, placed ? &robot_ : nullptr, params_.foreground.workspace_base};
-    learn_background(learner_, frame, &region, robot_pixels ? &*robot_pixels : nullptr, m);
+    learn_background(learner_, frame, &region, pixels, m);
+    if (learner_.ready() && has_reference()) check_reference(frame, pixels);
   });
+  if (not_empty_) withhold_not_empty(m);
+}
+
+void Pipeline::remember_learning_pose() {
+  const std::vector<Capsule>& now = robot_.capsules;
+  std::vector<Capsule>& poses = learning_poses_.capsules;
+  const size_t last_size = poses.size() - last_pose_begin_;
+  const bool same = !poses.empty() && last_size == now.size() &&
+                    std::equal(now.begin(), now.end(), poses.begin() + static_cast<std::ptrdiff_t>(last_pose_begin_),
+                               [](const Capsule& a, const Capsule& b) {
+                                 return a.a == b.a && a.b == b.b && a.radius_m == b.radius_m;
+                               });
+  if (same) return;
+  last_pose_begin_ = poses.size();
+  poses.insert(poses.end(), now.begin(), now.end());  // grows in the first batches only
+}
+
+// The distance is taken over every pose the robot had while the batch was learnt: a person
+// within reach of the arm at any of them counts, wherever the arm stands when learning ends.
+void Pipeline::check_reference(const Frame& frame, const RobotPixels* robot_pixels) {
+  ReferenceCheck& check = reference_check_;
+  check.foreground = params_.foreground;
+  check.detection_mm = params_.safety.ssm.detection_mm;
+  check.max_distance_m = reference_distance_m();
+  reference_finding_ = check.compare(learner_.model(), frame, params_.T_base_camera, learning_poses_, robot_pixels);
+  not_empty_ = reference_finding_.found;
+  if (!not_empty_) return;
+  const ReferenceFinding& f = reference_finding_;
+  char where[160];
+  if (std::isfinite(f.distance_m)) {
+    std::snprintf(where, sizeof where, "%.2f m from the robot (limit %.2f m)", static_cast<double>(f.distance_m),
+                  static_cast<double>(check.max_distance_m));
+  } else {
+    std::snprintf(where, sizeof where, "distance to the robot unknown (no robot state while learning)");
+  }
+  char text[512];
+  std::snprintf(text, sizeof text,
+                "background not empty: %d object(s) nearer than %s; nearest at pixels u %d..%d, v %d..%d of the "
+                "%dx%d filtered image, %.2f m from the camera, %.0f mm across, %s; clear the cell, learning goes on",
+                f.blobs, reference_origin_.c_str(), f.u_min, f.u_max, f.v_min, f.v_max, frame.depth.width,
+                frame.depth.height, static_cast<double>(f.depth_m), static_cast<double>(f.size_mm), where);
+  not_empty_reason_.assign(text);
+  learner_.refuse(not_empty_reason_);
+}
+
+void Pipeline::withhold_not_empty(Measurement& m) const {
+  withhold(m, ReasonCode::background_not_empty, not_empty_reason_.c_str());
+  char progress[64];
+  std::snprintf(progress, sizeof progress, " (%d/%d frames)", learner_.frames_seen(), learner_.params.frames);
+  m.withheld_reason.append(progress);
+}
+
+void Pipeline::set_reference(BackgroundModel reference, std::string origin) {
+  reference_check_.set_reference(std::move(reference));
+  reference_origin_ = std::move(origin);
+  not_empty_ = false;
+}
+
+float Pipeline::reference_distance_m() const {
+  const SafetyParams& safety = params_.safety;
+  if (safety.mode != SafetyParams::Mode::ssm) return safety.slow_distance_m;
+  SsmInput at_rest;
+  // Beyond human_near_m: the walking speed, as for a frame without foreground. A blob nearer
+  // than human_near_m is within this distance anyway.
+  at_rest.distance_m = std::numeric_limits<float>::max();
+  at_rest.frame_age_s = 0.0;
+  return protective_distance(safety.ssm, at_rest, 0.0F).protective_distance_m;
 }
 
 bool Pipeline::background_usable(const Frame& frame, Measurement& m) {

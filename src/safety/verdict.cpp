@@ -247,6 +247,7 @@ const char* reason_code_name(ReasonCode code) {
     case ReasonCode::below_protective_distance: return "below_protective_distance";
     case ReasonCode::speed_limited: return "speed_limited";
     case ReasonCode::holding: return "holding";
+    case ReasonCode::background_not_empty: return "background_not_empty";
   }
   return "unknown";
 }

@@ -370,6 +370,15 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
   return Status::ready;
 }
 
+void BackgroundLearner::refuse(const std::string& why) {
+  // The batch's sums were already used up (count_ is 0 after a batch); the model keeps its
+  // buffers, so that learning on does not allocate.
+  ready_ = false;
+  count_ = 0;
+  unsettled_ = 0;
+  message_ = why;
+}
+
 int BackgroundCheck::add(const BackgroundModel& model, const DepthImage& depth) {
   const size_t n = model.mean_m.size();
   if (depth.pixels.size() != n) return ++seen_;  // the pipeline refuses a size mismatch itself
