@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The RTDE reader's per-package work: framing (split_frame) and decoding (parse_data_package) of
-// the data packages of hrcsense's output recipe (kOutputVariables: 172 bytes each), as a byte
+// the data packages of hrcsense's output recipe (kOutputVariables: 180 bytes each), as a byte
 // stream of 64 packages is drained from the socket. Packages/s is the figure: a 500 Hz
 // controller needs 500 of them per second.
 #include "hrcsense/rtde.hpp"
@@ -21,7 +21,7 @@ constexpr int kPackagesPerStream = 64;
 rtde::OutputRecipe hrcsense_recipe() {
   rtde::SetupReply reply;
   reply.recipe_id = 1;
-  reply.types = {"DOUBLE", "VECTOR6D", "VECTOR6D", "INT32", "INT32", "DOUBLE", "VECTOR6D"};
+  reply.types = {"DOUBLE", "VECTOR6D", "VECTOR6D", "INT32", "INT32", "DOUBLE", "DOUBLE", "VECTOR6D"};
   rtde::OutputRecipe recipe;
   std::string error;
   if (!rtde::make_output_recipe(reply, rtde::kOutputVariables, recipe, error)) throw std::runtime_error(error);
@@ -49,6 +49,7 @@ std::vector<uint8_t> data_stream(int count) {
     put_be(payload, 7, 4);                                                 // robot_mode: running
     put_be(payload, 1, 4);                                                 // safety_mode: normal
     put_double(payload, 1.0);                                              // speed_scaling
+    put_double(payload, 1.0);                                              // target_speed_fraction
     for (int j = 0; j < 6; ++j) put_double(payload, 0.2 * j);             // actual_TCP_pose
     put_be(stream, payload.size() + rtde::kHeaderSize, 2);
     stream.push_back(static_cast<uint8_t>(rtde::PackageType::data));
@@ -72,7 +73,7 @@ void Rtde_parse_data(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
   state.SetBytesProcessed(state.iterations() * static_cast<int64_t>(bytes.size()));
 }
-BENCHMARK(Rtde_parse_data)->Name("Rtde/parse_data/172B");
+BENCHMARK(Rtde_parse_data)->Name("Rtde/parse_data/180B");
 
 // A received buffer of 64 packages framed and decoded as the reader thread does.
 void Rtde_split_and_parse(benchmark::State& state) {
@@ -95,7 +96,7 @@ void Rtde_split_and_parse(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * kPackagesPerStream);
   state.SetBytesProcessed(state.iterations() * static_cast<int64_t>(bytes.size()));
 }
-BENCHMARK(Rtde_split_and_parse)->Name("Rtde/split_and_parse/stream_64x172B");
+BENCHMARK(Rtde_split_and_parse)->Name("Rtde/split_and_parse/stream_64x180B");
 
 }  // namespace
 }  // namespace hrcsense

@@ -187,6 +187,7 @@ TEST(UdpJsonParse, FuzzSeedsParseAsNamed) {
   EXPECT_TRUE(parse(read("reordered_keys")).ok);
   EXPECT_TRUE(parse(read("non_finite")).non_finite);
   EXPECT_EQ(parse(read("short_q")).error, "q: expected 6 numbers, got 5");
+  EXPECT_EQ(parse(read("speed_fraction")).speed_fraction, 0.4);
 }
 
 // ---- The source, over loopback
