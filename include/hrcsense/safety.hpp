@@ -117,6 +117,7 @@ class VerdictHold {
   void apply(const SafetyParams& params, const VerdictInput& input, int64_t time_ns, Decision& decision);
   /// The same with the frame's decision with the distance less hysteresis_m already made
   /// (`with_margin`; a measurement's: decide_measurement with the margin).
+  /// `with_margin` may be `decision` itself (no hysteresis).
   void apply(const SafetyParams& params, const Decision& with_margin, int64_t time_ns, Decision& decision);
   /// A stop that no frame's verdict shows (the output's watchdog stop while no result came):
   /// held as if a frame of host time `time_ns` had asked for it, so that the frames after a

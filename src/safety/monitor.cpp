@@ -137,9 +137,14 @@ void SafetyMonitor::decide(FrameResult& result, int64_t now_ns) {
     hold_.stop_at(result.host_time_ns);
     silence_pending_ = false;
   }
-  // The hold relaxes only as far as the frame's decision with the distance less the hysteresis.
-  decide_measurement(params_, result, frame_age_s, scale_sent, with_margin_, params_.hysteresis_m);
-  hold_.apply(params_, with_margin_, result.host_time_ns, decision);
+  // The hold relaxes only as far as the frame's decision with the distance less the hysteresis
+  // (without a hysteresis that is the decision itself: not made twice).
+  const Decision* with_margin = &decision;
+  if (params_.hysteresis_m > 0.0F) {
+    decide_measurement(params_, result, frame_age_s, scale_sent, with_margin_, params_.hysteresis_m);
+    with_margin = &with_margin_;
+  }
+  hold_.apply(params_, *with_margin, result.host_time_ns, decision);
   assign_verdict(result.verdict, decision.verdict);
   result.ssm = decision.ssm;
   result.governing_link = decision.governing_link;

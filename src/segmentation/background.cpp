@@ -13,6 +13,8 @@
 #include "hrcsense/camera.hpp"
 #include "hrcsense/segmentation.hpp"
 
+#include "capsule_distance.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -223,17 +225,7 @@ void fill_unreliable(BackgroundModel& model, float min_valid_ratio, int radius_p
 
 namespace {
 
-// Distance from `p` to the surface of the nearest capsule (negative inside), base frame.
-float distance_to_capsules(const RobotModel& robot, const Eigen::Vector3f& p) {
-  float best = std::numeric_limits<float>::infinity();
-  for (const Capsule& c : robot.capsules) {
-    const Eigen::Vector3f ab = c.b - c.a;
-    const float length2 = ab.squaredNorm();
-    const float t = length2 > 0.0F ? std::clamp((p - c.a).dot(ab) / length2, 0.0F, 1.0F) : 0.0F;
-    best = std::min(best, (p - (c.a + t * ab)).norm() - c.radius_m);
-  }
-  return best;
-}
+using segmentation_detail::distance_to_capsules;
 
 // Clears the moving pixels whose batch mean lies outside `region` (farther than
 // max_distance_m from the robot, or outside the workspace) and marks them in `outside`.

@@ -9,6 +9,8 @@
 
 #include "hrcsense/segmentation.hpp"
 
+#include "capsule_distance.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -19,17 +21,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Distance from `p` to the surface of the nearest capsule (negative inside), base frame.
-float distance_to_capsules(const RobotModel& robot, const Eigen::Vector3f& p) {
-  float best = std::numeric_limits<float>::infinity();
-  for (const Capsule& c : robot.capsules) {
-    const Eigen::Vector3f ab = c.b - c.a;
-    const float length2 = ab.squaredNorm();
-    const float t = length2 > 0.0F ? std::clamp((p - c.a).dot(ab) / length2, 0.0F, 1.0F) : 0.0F;
-    best = std::min(best, (p - (c.a + t * ab)).norm() - c.radius_m);
-  }
-  return best;
-}
+using segmentation_detail::distance_to_capsules;
 
 // The learnt background's means as raw depth; unknown (0, NaN) stays 0, "no data".
 void background_as_frame(const BackgroundModel& learnt, const Frame& like, Frame& out) {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // R1 through the executable: the commands, signals, a reader that leaves, flushing,
 // exit codes. Each child process is bounded in time: a test that waits too long kills it.
+#include "../support/child_process.hpp"
 #include "../support/cli_folder.hpp"
 #include "../support/sanitized.hpp"
 #include "hrcsense/io.hpp"
@@ -42,96 +43,17 @@ std::vector<json> json_lines(const std::string& text) {
 
 std::string config(const char* name) { return std::string(HRCSENSE_SOURCE_DIR) + "/config/" + name; }
 
-// `hrcsense` as a child process, its stdout a pipe we read, its stderr a file.
-class Child {
+// `hrcsense ARGS` as a child process, its stdout a pipe we read, its stderr a file.
+class Child : public hrcsense::test::ChildProcess {
  public:
-  Child(const std::vector<std::string>& args, const fs::path& err_path) {
-    int fds[2];
-    if (::pipe(fds) != 0) return;
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::dup2(fds[1], STDOUT_FILENO);
-      const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      ::dup2(err, STDERR_FILENO);
-      ::close(fds[0]);
-      ::close(fds[1]);
-      std::vector<char*> argv;
-      static std::string cli = HRCSENSE_CLI;
-      argv.push_back(cli.data());
-      std::vector<std::string> copy = args;
-      for (std::string& a : copy) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      ::execv(cli.c_str(), argv.data());
-      ::_exit(127);
-    }
-    ::close(fds[1]);
-    out_ = fds[0];
-  }
-  ~Child() {
-    close_output();
-    if (pid_ > 0 && !reaped_) {
-      ::kill(pid_, SIGKILL);
-      ::waitpid(pid_, nullptr, 0);
-    }
-  }
-  pid_t pid() const { return pid_; }
-  void close_output() {
-    if (out_ >= 0) ::close(out_);
-    out_ = -1;
-  }
-  /// The next line of stdout, waiting at most `timeout_s`; false at the end or on timeout.
-  bool read_line(std::string& line, double timeout_s) {
-    const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                          std::chrono::duration<double>(timeout_s));
-    for (;;) {
-      const size_t newline = buffer_.find('\n');
-      if (newline != std::string::npos) {
-        line = buffer_.substr(0, newline);
-        buffer_.erase(0, newline + 1);
-        return true;
-      }
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
-      if (left <= 0) return false;
-      pollfd p{out_, POLLIN, 0};
-      if (::poll(&p, 1, static_cast<int>(left)) <= 0) return false;
-      char chunk[4096];
-      const ssize_t n = ::read(out_, chunk, sizeof chunk);
-      if (n <= 0) return false;
-      buffer_.append(chunk, static_cast<size_t>(n));
-    }
-  }
-  /// Whether the child is still running (not reaped).
-  bool running() {
-    if (reaped_) return false;
-    int status = 0;
-    if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-      reaped_ = true;
-      status_ = status;
-    }
-    return !reaped_;
-  }
-  /// Waits at most `timeout_s` for the child; its wait status, or -1 after killing it.
-  int wait(double timeout_s) {
-    const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                          std::chrono::duration<double>(timeout_s));
-    while (running()) {
-      if (Clock::now() > deadline) {
-        ::kill(pid_, SIGKILL);
-        ::waitpid(pid_, nullptr, 0);
-        reaped_ = true;
-        return -1;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return status_;
-  }
+  Child(const std::vector<std::string>& args, const fs::path& err_path)
+      : ChildProcess(with_cli(args), err_path.string()) {}
 
  private:
-  pid_t pid_ = -1;
-  int out_ = -1;
-  bool reaped_ = false;
-  int status_ = 0;
-  std::string buffer_;
+  static std::vector<std::string> with_cli(std::vector<std::string> args) {
+    args.insert(args.begin(), HRCSENSE_CLI);
+    return args;
+  }
 };
 
 class FailsafeCli : public hrcsense::test::CliFolder {

@@ -6,6 +6,7 @@
 // ephemeral ports, every wait bounded).
 #include "hrcsense/link_receiver.hpp"
 
+#include "../support/child_process.hpp"
 #include "../support/loopback.hpp"
 
 #include <fcntl.h>
@@ -305,84 +306,7 @@ TEST(LinkReceiver, RemembersTheLastSixteenSessionsItLeft) {
 
 // ---- A child process with its standard output on a pipe, killed if still running at the end
 
-class Child {
- public:
-  explicit Child(const std::vector<std::string>& args) {
-    int fds[2];
-    if (::pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe");
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::dup2(fds[1], STDOUT_FILENO);
-      const int null = ::open("/dev/null", O_WRONLY);
-      ::dup2(null, STDERR_FILENO);
-      std::vector<std::string> copy = args;
-      std::vector<char*> argv;
-      for (std::string& a : copy) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      ::execv(argv[0], argv.data());
-      ::_exit(127);
-    }
-    ::close(fds[1]);
-    out_ = fds[0];
-  }
-  ~Child() {
-    if (pid_ > 0 && !reaped_) {
-      ::kill(pid_, SIGKILL);
-      ::waitpid(pid_, nullptr, 0);
-    }
-    ::close(out_);
-  }
-  Child(const Child&) = delete;
-  Child& operator=(const Child&) = delete;
-
-  pid_t pid() const { return pid_; }
-
-  /// The next line of standard output, waiting at most `timeout_ms`; false on timeout or end.
-  bool read_line(std::string& line, int timeout_ms) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
-    for (;;) {
-      const size_t newline = buffer_.find('\n');
-      if (newline != std::string::npos) {
-        line = buffer_.substr(0, newline);
-        buffer_.erase(0, newline + 1);
-        return true;
-      }
-      const auto left =
-          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
-      pollfd p{out_, POLLIN, 0};
-      if (left <= 0 || ::poll(&p, 1, static_cast<int>(left)) <= 0) return false;
-      char chunk[1024];
-      const ssize_t n = ::read(out_, chunk, sizeof chunk);
-      if (n <= 0) return false;
-      buffer_.append(chunk, static_cast<size_t>(n));
-    }
-  }
-
-  /// Sends `signal` and waits at most `timeout_ms` for the exit; the wait status, or -1 when it
-  /// had to be killed.
-  int stop(int signal, int timeout_ms) {
-    ::kill(pid_, signal);
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
-    int status = 0;
-    while (::waitpid(pid_, &status, WNOHANG) == 0) {
-      if (std::chrono::steady_clock::now() > deadline) {
-        ::kill(pid_, SIGKILL);
-        ::waitpid(pid_, nullptr, 0);
-        reaped_ = true;
-        return -1;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    reaped_ = true;
-    return status;
-  }
-
- private:
-  pid_t pid_ = -1;
-  int out_ = -1;
-  bool reaped_ = false;
-  std::string buffer_;
-};
+using Child = test::ChildProcess;
 
 /// Sends `bytes` to 127.0.0.1:port.
 void send_to(uint16_t port, const std::vector<uint8_t>& bytes) {
@@ -403,32 +327,32 @@ TEST(LinkReceiverExample, PrintsTheVerdictPerDatagramAndTheTimeout) {
   // A timeout of 1 s: long enough that the lines below arrive well within it on a loaded machine.
   Child example({HRCSENSE_LINK_RECEIVER, "--port", "0", "--timeout-ms", "1000", "--datagrams", "4"});
   std::string line;
-  ASSERT_TRUE(example.read_line(line, 10000));
+  ASSERT_TRUE(example.read_line(line, 10.0));
   unsigned port = 0;
   ASSERT_EQ(std::sscanf(line.c_str(), "listening on 127.0.0.1:%u", &port), 1) << line;
   ASSERT_GT(port, 0U);
   const auto port16 = static_cast<uint16_t>(port);
   send_to(port16, run_frame(kDead, 4));
-  ASSERT_TRUE(example.read_line(line, 10000));
+  ASSERT_TRUE(example.read_line(line, 10.0));
   EXPECT_EQ(line, "session 195948557 sequence 4 frame first_session: run 1 (frame, reason no_foreground)");
   send_to(port16, run_frame(kDead, 4));
-  ASSERT_TRUE(example.read_line(line, 10000));
+  ASSERT_TRUE(example.read_line(line, 10.0));
   EXPECT_EQ(line, "session 195948557 sequence 4 frame old_sequence: run 1 (frame, reason no_foreground)");
   // Silence: the timeout turns the verdict to stop and is reported (1 s; wait up to 10 s).
-  ASSERT_TRUE(example.read_line(line, 10000));
+  ASSERT_TRUE(example.read_line(line, 10.0));
   EXPECT_EQ(line, "nothing taken for 1000 ms: stop 0 (timed_out, reason no_frame)");
   send_to(port16, heartbeat(kReborn, 0));
-  ASSERT_TRUE(example.read_line(line, 10000));
+  ASSERT_TRUE(example.read_line(line, 10.0));
   EXPECT_EQ(line, "session 1611516670 sequence 0 heartbeat new_session: stop 0 (heartbeat, reason no_frame)");
   send_to(port16, {0x48, 0x52});
-  ASSERT_TRUE(example.read_line(line, 10000));
+  ASSERT_TRUE(example.read_line(line, 10.0));
   EXPECT_EQ(line.rfind("malformed (size: expected 45 bytes, got 2): stop 0 (", 0), 0U) << line;
-  EXPECT_EQ(example.stop(0, 10000), 0) << "ends by itself after --datagrams 4";
+  EXPECT_EQ(example.stop(0, 10.0), 0) << "ends by itself after --datagrams 4";
 }
 
 TEST(LinkReceiverExample, RefusesBadArguments) {
   Child example({HRCSENSE_LINK_RECEIVER, "--port", "70000"});
-  EXPECT_EQ(WEXITSTATUS(example.stop(0, 10000)), 2);
+  EXPECT_EQ(WEXITSTATUS(example.stop(0, 10.0)), 2);
 }
 
 // ---- kill -9 and restart of the real `hrcsense run`
@@ -540,7 +464,7 @@ TEST_F(LinkReceiverKillAndRestart, TheDeadRunEndsWithinTheTimeoutAndTheRestartIs
   ASSERT_GE(dead_runs.runs, 15) << "the first run never said run on the link";
   const uint32_t dead_session = receiver_.session();
   ASSERT_NE(dead_session, 0U);
-  const int killed = dead->stop(SIGKILL, 10000);
+  const int killed = dead->stop(SIGKILL, 10.0);
   const int64_t killed_ns = steady_ns();
   ASSERT_TRUE(WIFSIGNALED(killed) && WTERMSIG(killed) == SIGKILL) << killed;
   drain();
@@ -585,7 +509,7 @@ TEST_F(LinkReceiverKillAndRestart, TheDeadRunEndsWithinTheTimeoutAndTheRestartIs
   EXPECT_EQ(header_session(out_reborn), reborn_session);
 
   // 4. The restarted process ends normally: its final stop is taken and the verdict is stop.
-  const int status = reborn->stop(SIGTERM, 20000);
+  const int status = reborn->stop(SIGTERM, 20.0);
   EXPECT_TRUE(WIFEXITED(status)) << status;
   bool final_taken = false;
   receive(
