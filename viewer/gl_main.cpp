@@ -58,6 +58,7 @@ struct ViewArgs {
   int64_t frames = -1;
   std::string out;
   std::string record;
+  bool overwrite = false;  ///< --overwrite: the recording may replace an existing file
   std::string snapshot_dir;
   std::string snapshot_at;
   std::string pane = "2d";
@@ -283,6 +284,7 @@ app::SessionOptions session_options(const ViewArgs& args, bool snapshots, ViewTa
   options.frames = args.frames;
   options.out = args.out;
   options.record = args.record;
+  options.overwrite = args.overwrite;
   options.unpaced = snapshots;  // snapshots wait for the renderer: a paced clock would drop
   options.on_processed = [&tap](const Frame& frame, const Pipeline& pipeline, const FrameResult& result) {
     tap.offer(frame, pipeline, result);
@@ -437,6 +439,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(int64_t{1}, int64_t{10'000'000'000}));
   app.add_option("--out", args.out, "JSON Lines output file (default: stdout)");
   app.add_option("--record", args.record, "also record the source's frames to this RealSense .bag");
+  app.add_flag("--overwrite", args.overwrite, "with --record: replace an existing recording (never the source itself)");
   app.add_option("--snapshot", args.snapshot_dir, "headless: write DIR/frame_%06d.png (1280x720) at --snapshot-at");
   app.add_option("--snapshot-at", args.snapshot_at, "comma-separated source frame indices for --snapshot");
   app.add_option("--pane", args.pane, "what the window shows: 2d (default), 3d or split (key v cycles)");

@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 namespace hrcsense::app {
 
@@ -27,6 +29,57 @@ RecorderParams recorder_params(const Config& config, const std::string& path, co
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);
   return params;
+}
+
+namespace {
+
+// The files of the set a recording to `out` would write that exist now: `out` itself, or with
+// split_mb every FILE-NNN.bag beside it (the parts need not be numbered without gaps).
+std::vector<std::filesystem::path> existing_outputs(const std::string& out, int64_t split_mb) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> found;
+  std::error_code ignored;
+  if (split_mb <= 0) {
+    if (fs::exists(out, ignored)) found.emplace_back(out);
+    return found;
+  }
+  const std::string first = split_file_name(out, 0);  // "FILE-000.bag": the pattern's prefix and suffix
+  const fs::path folder = fs::path(first).parent_path().empty() ? fs::path(".") : fs::path(first).parent_path();
+  const std::string name = fs::path(first).filename().string();
+  const std::string prefix = name.substr(0, name.size() - std::string("000.bag").size());
+  for (fs::directory_iterator it(folder, ignored), end; !ignored && it != end; it.increment(ignored)) {
+    const std::string entry = it->path().filename().string();
+    if (entry.size() <= prefix.size() + 4 || entry.compare(0, prefix.size(), prefix) != 0 ||
+        entry.compare(entry.size() - 4, 4, ".bag") != 0) {
+      continue;
+    }
+    const std::string digits = entry.substr(prefix.size(), entry.size() - prefix.size() - 4);
+    if (digits.size() >= 3 && std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+      found.push_back(it->path());
+    }
+  }
+  return found;
+}
+
+}  // namespace
+
+void check_record_output(const Config& config, const std::string& out, bool overwrite) {
+  namespace fs = std::filesystem;
+  const std::vector<fs::path> existing = existing_outputs(out, config.record.split_mb);
+  // Never the source being played, --overwrite or not: the recording would destroy what it reads.
+  std::error_code ignored;
+  if (!config.source.path.empty() && fs::exists(config.source.path, ignored)) {
+    for (const fs::path& file : existing) {
+      if (fs::equivalent(file, config.source.path, ignored)) {
+        throw ConfigError("record: " + file.string() + " is the source being played (source.path " +
+                          config.source.path + "); record to another file");
+      }
+    }
+  }
+  if (existing.empty() || overwrite) return;
+  std::string names = existing.front().string();
+  if (existing.size() > 1) names += " and " + std::to_string(existing.size() - 1) + " more part(s) of the set";
+  throw ConfigError("record: " + names + " exists; pass --overwrite to replace it, or record to another file");
 }
 
 void log_recording(const RecorderStats& stats) {

@@ -22,6 +22,13 @@ void log_recording(const RecorderStats& stats);
 /// keeps a history that the recorder's lookups, a frame ahead of processing's, would reset);
 /// live and recorded ones are shared (one connection; their lookups change nothing). A `sim`
 /// state follows `trajectory_clock` when given (follow_link), as the run's does.
+/// Refuses a recording that would destroy a file, before anything is opened: `out` when it
+/// exists (with record.split_mb: any existing part of the set, FILE-000.bag, FILE-001.bag, ...)
+/// unless `overwrite` (--overwrite), and an output that is the configured source itself
+/// (std::filesystem::equivalent: the bag being played) even then. Throws ConfigError (exit 2)
+/// naming the file.
+void check_record_output(const Config& config, const std::string& out, bool overwrite);
+
 RecordStateLookup record_state_lookup(const Config& config, Source& source, RobotStateSource& run_states, bool paced,
                                       std::unique_ptr<RobotStateSource>& own,
                                       std::shared_ptr<TrajectoryClock> trajectory_clock = nullptr);

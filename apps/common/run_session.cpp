@@ -111,6 +111,8 @@ void request_session_stop() { g_stop_requested.store(true); }
 
 int run_session(const Config& config, const SessionOptions& args) {
   const bool paced = config.source.pace && !args.unpaced;
+  // Before anything is opened: a recording never silently replaces a file, nor the source.
+  if (!args.record.empty()) check_record_output(config, args.record, args.overwrite);
   SourceOptions source_options;
   source_options.stop_requested = &g_stop_requested;
   source_options.with_color = args.with_color;

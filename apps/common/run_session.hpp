@@ -19,6 +19,7 @@ struct SessionOptions {
   int64_t frames = -1;  ///< --frames N; -1: the source's length
   std::string out;      ///< --out FILE; empty: stdout
   std::string record;   ///< --record FILE.bag; empty: no recording
+  bool overwrite = false;  ///< --overwrite: the recording may replace an existing file (check_record_output)
   /// Play the source as fast as processing goes, whatever source.pace says (headless
   /// snapshots). A live camera paces itself either way.
   bool unpaced = false;

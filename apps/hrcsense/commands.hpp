@@ -22,6 +22,7 @@ struct CommandArgs {
   std::string shared;               ///< verify-filters --shared DIR; empty: ../shared
   std::string record;               ///< run --record FILE.bag; empty: no recording
   double duration_s = -1.0;         ///< record --duration-s S; < 0: until --frames or the source's end
+  bool overwrite = false;           ///< record / run --record: --overwrite replaces an existing recording
 };
 
 /// `hrcsense eval`'s flags (docs/EVALUATION.md).

@@ -42,10 +42,12 @@ int main(int argc, char** argv) {
   add_common_flags(*run, args);
   run->add_option("--out", args.out, "JSON Lines output file (default: stdout)");
   run->add_option("--record", args.record, "also record the source's frames to this RealSense .bag (docs/RECORDINGS.md)");
+  run->add_flag("--overwrite", args.overwrite, "with --record: replace an existing recording (never the source itself)");
 
   CLI::App* record = app.add_subcommand("record", "record the configured source to a RealSense .bag (docs/RECORDINGS.md)");
   add_common_flags(*record, args);
   record->add_option("--out", args.out, "the .bag file (with record.split_mb: FILE-000.bag, ...)")->required();
+  record->add_flag("--overwrite", args.overwrite, "replace an existing recording (never the source itself)");
   // A day at most: longer recordings are split files of a service, not one command.
   record->add_option("--duration-s", args.duration_s, "stop after S seconds of source time, 0.001 to 86400")
       ->check(CLI::Range(0.001, 86400.0))

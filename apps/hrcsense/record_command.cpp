@@ -35,6 +35,8 @@ constexpr int kRecordWaitMs = 5000;
 
 int record_command(const CommandArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
+  // Before anything is opened: never replace a file unasked, never the source being played.
+  check_record_output(config, args.out, args.overwrite);
   SourceOptions source_options;
   source_options.stop_requested = &g_record_stop;
   std::unique_ptr<Source> source = make_source(config, source_options);

@@ -13,6 +13,7 @@ int run_command(const CommandArgs& args) {
   options.frames = args.frames;
   options.out = args.out;
   options.record = args.record;
+  options.overwrite = args.overwrite;
   return run_session(config, options);
 }
 

@@ -152,7 +152,7 @@ TEST(RecordCli, RecordsTheRequestedFramesAndDuration) {
   ASSERT_EQ(run({"--out", dir / "d.bag", "--duration-s", "0.5"}), 0);
   EXPECT_EQ(summarize_recording(dir / "d.bag").streams[0].frames, 15);
   EXPECT_NE(run({"--out", dir / "x.bag", "--frames", "2", "--duration-s", "1"}), 0) << "one or the other";
-  EXPECT_NE(run({"--out", "/dev/full"}), 0);
+  EXPECT_NE(run({"--out", "/dev/full", "--overwrite"}), 0);  // /dev/full exists: replacing it is asked for
   const std::vector<char> err = test::read_bytes(dir / "err.txt");
   EXPECT_NE(std::string(err.begin(), err.end()).find("/dev/full: write failed"), std::string::npos);
 }

@@ -218,7 +218,7 @@ TEST_F(RecordedState, ABagWithoutJointStatesIsAClearError) {
 
 TEST_F(RecordedState, AFailedRecordingShowsInTheSummaryAndTheRunGoesOn) {
   const test::CliResult run =
-      test::cli("run " + moving_cell(5) + " --record /dev/full --out " + (*dir_ / "full.jsonl"));
+      test::cli("run " + moving_cell(5) + " --record /dev/full --overwrite --out " + (*dir_ / "full.jsonl"));
   EXPECT_EQ(run.exit_code, 0) << "record.on_error continue: " << run.out;
   const RunOutput out = read_run(*dir_ / "full.jsonl");
   EXPECT_EQ(out.frames.size(), 5U);
