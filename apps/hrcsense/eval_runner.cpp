@@ -207,6 +207,43 @@ void write_results_md(const ResultTable& table, const std::string& md) {
   if (!out.flush()) throw std::runtime_error(md + ": cannot write");
 }
 
+// What every row of a sweep shares and its rows do not show: --frames and the --set applied to
+// all rows, one line each ("frames N", "set KEY=VALUE"), kept in DIR/sweep-settings.txt beside
+// results.csv. Rows made with other ones would be merged into one table as if comparable.
+std::vector<std::string> sweep_settings(const SweepRequest& request) {
+  std::vector<std::string> lines{"frames " + std::to_string(request.frames)};
+  for (const std::string& set : request.sets) lines.push_back("set " + set);
+  return lines;
+}
+
+// A fresh table: writes the settings. A resumed one: they must be the ones it was started with,
+// else std::runtime_error naming what differs.
+void check_sweep_settings(const SweepRequest& request, const std::string& csv, bool resuming) {
+  const std::string path = (std::filesystem::path(request.out_dir) / "sweep-settings.txt").string();
+  const std::vector<std::string> now = sweep_settings(request);
+  if (resuming && std::filesystem::exists(path)) {
+    std::ifstream in(path, std::ios::binary);
+    std::vector<std::string> before;
+    for (std::string line; std::getline(in, line);) before.push_back(line);
+    if (before == now) return;
+    std::string differs;
+    const auto note = [&](const std::string& text) { differs += (differs.empty() ? "" : "; ") + text; };
+    for (const std::string& line : now) {
+      if (std::find(before.begin(), before.end(), line) == before.end()) note("now " + line);
+    }
+    for (const std::string& line : before) {
+      if (std::find(now.begin(), now.end(), line) == now.end()) note("started with " + line);
+    }
+    if (differs.empty()) differs = "the --set order";
+    throw std::runtime_error(csv + ": its rows were made with other settings (" + differs +
+                             "); resume with the same --frames and --set, or use another --out");
+  }
+  // A table from before the settings were kept, or a new one: what is run now is written down.
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  for (const std::string& line : now) out << line << '\n';
+  if (!out.flush()) throw std::runtime_error(path + ": cannot write");
+}
+
 }  // namespace
 
 size_t ResultTable::column(const std::string& name) const {
@@ -268,6 +305,7 @@ ResultTable run_sweep(const SweepRequest& request) {
   std::filesystem::create_directories(request.out_dir);
   const std::string csv = (std::filesystem::path(request.out_dir) / "results.csv").string();
   const eval::ResumeState resumed = eval::resume_results(csv, header_line(), kKeyColumns);
+  check_sweep_settings(request, csv, resumed.existed);
   std::vector<size_t> pending;
   for (size_t i = 0; i < rows.size(); ++i) {
     if (resumed.done.count(eval::row_key(rows[i].key_fields())) == 0) pending.push_back(i);

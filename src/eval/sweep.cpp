@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -203,6 +204,7 @@ ResumeState resume_results(const std::string& path, const std::string& header, s
     throw std::runtime_error(path + ": not this sweep's table (its header differs); use another --out or remove it");
   }
   const size_t columns = split_csv_line(header).size();
+  std::map<std::string, size_t> first_line;  // row key -> the line it first appeared on (1-based)
   for (size_t i = 1; i < lines.size(); ++i) {
     std::vector<std::string> fields;
     try {
@@ -215,7 +217,14 @@ ResumeState resume_results(const std::string& path, const std::string& header, s
                                " fields, got " + std::to_string(fields.size()));
     }
     fields.resize(key_columns);
-    state.done.insert(row_key(fields));
+    const std::string key = row_key(fields);
+    const auto [at, fresh] = first_line.emplace(key, i + 1);
+    if (!fresh) {
+      // Two rows of one sweep point: a table merged from two runs, which no summary may average.
+      throw std::runtime_error(path + ":" + std::to_string(i + 1) + ": the row " + key + " is there twice (also line " +
+                               std::to_string(at->second) + "); use another --out or remove one");
+    }
+    state.done.insert(key);
   }
   state.existed = true;
   state.rows = static_cast<int64_t>(lines.size()) - 1;

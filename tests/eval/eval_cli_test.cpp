@@ -117,6 +117,28 @@ TEST(EvalCli, AResumedSweepEqualsAnUninterruptedOne) {
   EXPECT_EQ(deterministic_rows(cut), deterministic_rows(whole));
 }
 
+// Rows made with another --frames or --set are not comparable: resuming with them is refused,
+// naming what differs, and the table is left as it was (issue R2, defect 4).
+TEST(EvalCli, ResumingWithOtherSettingsIsRefused) {
+  const std::string dir = fresh_dir("other_settings");
+  ASSERT_EQ(test::cli(eval_args(dir)).exit_code, 0);
+  const std::string text = read(dir + "/results.csv");
+  const size_t second_row = text.find('\n', text.find('\n') + 1) + 1;
+  std::ofstream(dir + "/results.csv", std::ios::binary | std::ios::trunc) << text.substr(0, second_row);
+  std::string other_frames = eval_args(dir);
+  other_frames.replace(other_frames.find("--frames 112"), 12, "--frames 100");
+  const test::CliResult frames = test::cli(other_frames);
+  EXPECT_NE(frames.exit_code, 0);
+  EXPECT_NE(frames.out.find("other settings (now frames 100; started with frames 112)"), std::string::npos)
+      << frames.out;
+  const test::CliResult set = test::cli(eval_args(dir) + " --set safety.hysteresis_m=0");
+  EXPECT_NE(set.exit_code, 0);
+  EXPECT_NE(set.out.find("now set safety.hysteresis_m=0"), std::string::npos) << set.out;
+  EXPECT_EQ(read(dir + "/results.csv"), text.substr(0, second_row));
+  // The same settings resume.
+  EXPECT_EQ(test::cli(eval_args(dir)).exit_code, 0);
+}
+
 TEST(EvalCli, TwoJobsGiveTheSameDeterministicColumns) {
   const std::string serial = fresh_dir("serial");
   ASSERT_EQ(test::cli(eval_args(serial)).exit_code, 0);

@@ -159,5 +159,17 @@ TEST_F(ResumeResults, AnotherSweepsTableOrABrokenRowIsAnErrorNamingTheFile) {
   }
 }
 
+// One sweep point twice (two runs merged into one table): refused, naming both lines.
+TEST_F(ResumeResults, ARowKeyTwiceIsAnErrorNamingBothLines) {
+  write(header_ + "\na.b=1,walk.yaml,1,300\na.b=2,walk.yaml,1,300\na.b=1,walk.yaml,1,200\n");
+  try {
+    resume_results(path_, header_, 3);
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              path_ + ":4: the row a.b=1,walk.yaml,1, is there twice (also line 2); use another --out or remove one");
+  }
+}
+
 }  // namespace
 }  // namespace hrcsense::eval
