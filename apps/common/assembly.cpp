@@ -159,8 +159,13 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
     UdpJsonParams params;
     params.listen = state.listen;
     params.history = state.history;
-    // A bind failure (port in use, address not local) is a runtime error naming the address.
-    return std::make_unique<UdpJsonRobotState>(params, run_clock);
+    // A bind failure (port in use, address not local) is a runtime error naming the key and
+    // the address; an address that is no numeric host:port is the configuration's error.
+    try {
+      return std::make_unique<UdpJsonRobotState>(params, run_clock);
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(where + ": " + e.what());
+    }
   }
   if (source == "rtde") {
     if (state.host.empty()) throw ConfigError(where + ": robot.state.host: required for robot.state.source rtde");

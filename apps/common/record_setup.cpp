@@ -65,9 +65,17 @@ std::vector<std::filesystem::path> existing_outputs(const std::string& out, int6
 
 void check_record_output(const Config& config, const std::string& out, bool overwrite) {
   namespace fs = std::filesystem;
+  // A folder on the way that is a file: said here, naming both, rather than as the library's
+  // "cannot create directories".
+  std::error_code ignored;
+  for (fs::path folder = fs::path(out).parent_path(); !folder.empty(); folder = folder.parent_path()) {
+    if (fs::exists(folder, ignored) && !fs::is_directory(folder, ignored)) {
+      throw ConfigError("record: cannot write " + out + ": " + folder.string() + " is a file, not a folder");
+    }
+    if (folder == folder.parent_path()) break;
+  }
   const std::vector<fs::path> existing = existing_outputs(out, config.record.split_mb);
   // Never the source being played, --overwrite or not: the recording would destroy what it reads.
-  std::error_code ignored;
   if (!config.source.path.empty() && fs::exists(config.source.path, ignored)) {
     for (const fs::path& file : existing) {
       if (fs::equivalent(file, config.source.path, ignored)) {

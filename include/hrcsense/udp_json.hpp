@@ -69,8 +69,9 @@ struct UdpJsonParams {
 /// step back is a restarted sender. All members are thread-safe.
 class UdpJsonRobotState final : public RobotStateSource {
  public:
-  /// Binds the socket and starts the reader. Throws std::runtime_error naming the address when
-  /// it is not a numeric address with a port or cannot be bound (in use, not local).
+  /// Binds the socket and starts the reader. Throws std::invalid_argument naming the key and
+  /// the address when it is not a numeric address with a port (a configuration error), and
+  /// std::runtime_error naming them when it cannot be bound (in use, not local).
   /// `clock` must outlive this object.
   UdpJsonRobotState(const UdpJsonParams& params, const RunClock& clock);
   /// Stops the reader (at once: it is woken, not waited out) and closes the socket.

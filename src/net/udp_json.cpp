@@ -290,7 +290,7 @@ UdpJsonDatagram parse_udp_json_state(const char* bytes, size_t size) {
 namespace {
 
 [[noreturn]] void throw_listen(const std::string& listen, const std::string& why) {
-  throw std::runtime_error("udp_json: robot.state.listen '" + listen + "': " + why);
+  throw std::invalid_argument("udp_json: robot.state.listen '" + listen + "': " + why);
 }
 
 // "a.b.c.d:port" or "[v6]:port", numeric only (no name lookup at start-up).
@@ -362,7 +362,7 @@ UdpJsonRobotState::UdpJsonRobotState(const UdpJsonParams& params, const RunClock
       ::pipe2(fds, O_NONBLOCK | O_CLOEXEC) != 0) {
     const int error = errno;
     ::close(fd_);
-    throw std::runtime_error("udp_json: cannot bind " + listen_ + ": " + errno_text(error));
+    throw std::runtime_error("udp_json: robot.state.listen '" + listen_ + "': cannot bind: " + errno_text(error));
   }
   wake_read_fd_ = fds[0];
   wake_write_fd_ = fds[1];

@@ -425,12 +425,15 @@ TEST(UdpJsonRobotState, ReorderedDatagramIsBackwardsAndLeavesTheClockMap) {
 // A socket bound to 127.0.0.1 on an ephemeral port, held by the test.
 using HeldPort = test::LoopbackUdpSocket;
 
-void expect_runtime_error(const UdpJsonParams& params, const std::string& message) {
+// `Error`: std::runtime_error for what only the machine decides (bind), std::invalid_argument
+// for an address that is no numeric host:port (the configuration's error, exit 2).
+template <class Error>
+void expect_error(const UdpJsonParams& params, const std::string& message) {
   FakeClock clock;
   try {
     UdpJsonRobotState source(params, clock);
     ADD_FAILURE() << "no error for " << params.listen;
-  } catch (const std::runtime_error& e) {
+  } catch (const Error& e) {
     EXPECT_EQ(std::string(e.what()), message);
   }
 }
@@ -439,15 +442,16 @@ TEST(UdpJsonRobotState, BindFailureAndBadAddressesNameTheAddress) {
   const HeldPort held;
   UdpJsonParams params;
   params.listen = "127.0.0.1:" + std::to_string(held.port);
-  expect_runtime_error(params, "udp_json: cannot bind " + params.listen + ": Address already in use");
+  expect_error<std::runtime_error>(params, "udp_json: robot.state.listen '" + params.listen +
+                                               "': cannot bind: Address already in use");
   params.listen = "localhost:30010";
-  expect_runtime_error(params, "udp_json: robot.state.listen 'localhost:30010': expected a numeric IPv4 address "
-                               "a.b.c.d:port or [IPv6]:port");
+  expect_error<std::invalid_argument>(params, "udp_json: robot.state.listen 'localhost:30010': expected a numeric "
+                                              "IPv4 address a.b.c.d:port or [IPv6]:port");
   params.listen = "127.0.0.1:65536";
-  expect_runtime_error(params, "udp_json: robot.state.listen '127.0.0.1:65536': expected host:port with a port "
-                               "from 0 to 65535");
+  expect_error<std::invalid_argument>(params, "udp_json: robot.state.listen '127.0.0.1:65536': expected host:port "
+                                              "with a port from 0 to 65535");
   params.listen = "[::1x]:5";
-  expect_runtime_error(params, "udp_json: robot.state.listen '[::1x]:5': not a numeric IPv6 address");
+  expect_error<std::invalid_argument>(params, "udp_json: robot.state.listen '[::1x]:5': not a numeric IPv6 address");
 }
 
 // Destruction wakes the reader: it takes far less than its 200 ms poll timeout (bounded at 1 s
@@ -473,8 +477,19 @@ TEST(UdpJsonAssembly, BuildsTheSourceFromTheConfiguration) {
       (void)make_robot_state_source(config);
       ADD_FAILURE() << "bound a held port";
     } catch (const std::runtime_error& e) {
-      EXPECT_EQ(std::string(e.what()), "udp_json: cannot bind " + listen + ": Address already in use");
+      EXPECT_EQ(std::string(e.what()),
+                "udp_json: robot.state.listen '" + listen + "': cannot bind: Address already in use");
     }
+  }
+  // A host name is the configuration's error (exit 2, naming the file and the key), as it is
+  // for link.udp.address (issue R2, defect 6): no name is looked up at start-up.
+  const Config named = load_config("", {"robot.state.source=udp_json", "robot.state.listen=localhost:30010"});
+  try {
+    (void)make_robot_state_source(named);
+    ADD_FAILURE() << "took a host name";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "configuration: udp_json: robot.state.listen 'localhost:30010': expected a "
+                                     "numeric IPv4 address a.b.c.d:port or [IPv6]:port");
   }
   // The port is free again. One datagram stamped with the steady clock: it lands between t0
   // (before sending) and t1 (once taken). At t0 + 150 ms its age is at most 150 ms: valid with

@@ -65,6 +65,15 @@ TEST(RecordOverwrite, AnyExistingPartOfASplitSetIsRefused) {
   EXPECT_EQ(other.exit_code, 0) << other.out;
 }
 
+// An output under a file (not a folder): a usage error naming both (issue R2, defect 6).
+TEST(RecordOverwrite, AnOutputUnderAFileNamesIt) {
+  test::ScratchDir dir("record_overwrite_under_file");
+  std::ofstream(dir / "notes.txt") << "a file";
+  const test::CliResult refused = test::cli("record " + small_cell() + " --out " + (dir / "notes.txt") + "/take.bag");
+  EXPECT_EQ(refused.exit_code, 2) << refused.out;
+  EXPECT_NE(refused.out.find((dir / "notes.txt") + " is a file, not a folder"), std::string::npos) << refused.out;
+}
+
 // Recording onto the bag being played would destroy the source: refused, --overwrite or not.
 TEST(RecordOverwrite, TheSourceItselfIsRefusedEvenWithOverwrite) {
   test::ScratchDir dir("record_overwrite_source");
