@@ -49,6 +49,7 @@ class Taken {
   int32_t size() const { return count_; }
   bool valid(int32_t i) const { return infos_[static_cast<size_t>(i)].valid_data; }
   const T& operator[](int32_t i) const { return *static_cast<const T*>(samples_[static_cast<size_t>(i)]); }
+  dds_instance_handle_t publisher(int32_t i) const { return infos_[static_cast<size_t>(i)].publication_handle; }
 
  private:
   dds_entity_t reader_;
@@ -106,19 +107,32 @@ Ros2CameraSource::Ros2CameraSource(Ros2SourceParams params) : params_(std::move(
   // comes soon, gives the rate (realsense-ros publishes one per image).
   const auto timeout = static_cast<dds_duration_t>(params_.startup_timeout_s * 1e9);
   const dds_time_t deadline = dds_time() + timeout;
+  const dds_time_t second_info_deadline_ns = DDS_MSECS(500);
+  const auto stopping = [this] { return params_.stop_requested != nullptr && params_.stop_requested->load(); };
   std::vector<int64_t> stamps;
-  while (stamps.size() < 2) {
-    const dds_time_t wait_until = stamps.empty() ? deadline : std::min<dds_time_t>(deadline, dds_time() + DDS_MSECS(500));
-    if (dds_waitset_wait_until(dds_->info_waitset, nullptr, 0, wait_until) <= 0) break;
+  dds_time_t second_deadline = deadline;
+  while (stamps.size() < 2 && !stopping() && dds_time() < std::min(deadline, second_deadline)) {
+    // Slices of 100 ms, so that a stop request (a signal) ends the wait promptly.
+    const dds_time_t slice = std::min({deadline, second_deadline, dds_time() + DDS_MSECS(100)});
+    if (dds_waitset_wait_until(dds_->info_waitset, nullptr, 0, slice) <= 0) continue;
     Taken<sensor_msgs_msg_dds__CameraInfo_> taken(dds_->depth_info_reader);
     for (int32_t i = 0; i < taken.size(); ++i) {
       if (!taken.valid(i)) continue;
-      depth_intrinsics_ = intrinsics_from_camera_info(taken[i], topics.depth_info);  // Ros2Error: unusable
+      try {
+        depth_intrinsics_ = intrinsics_from_camera_info(taken[i], topics.depth_info);
+      } catch (const Ros2Error& e) {
+        throw Ros2StartupError(e.what());  // the camera's message, not the configuration, is wrong
+      }
       stamps.push_back(stamp_ns(taken[i].header.stamp));
+      if (stamps.size() == 1) second_deadline = dds_time() + second_info_deadline_ns;
     }
   }
+  if (stamps.empty() && stopping()) {
+    throw Ros2StartupError("stopped while waiting for the first CameraInfo on " + topics.depth_info + " (" + domain +
+                           ")");
+  }
   if (stamps.empty()) {
-    throw Ros2Error("no CameraInfo on " + topics.depth_info + " (DDS " + dds_topic_name(topics.depth_info) + ", " +
+    throw Ros2StartupError("no CameraInfo on " + topics.depth_info + " (DDS " + dds_topic_name(topics.depth_info) + ", " +
                     domain + ") within " + std::to_string(params_.startup_timeout_s) +
                     " s (source.ros2.startup_timeout_s): is the camera node running, in this domain "
                     "(ROS_DOMAIN_ID), reachable under CYCLONEDDS_URI's network settings?");
@@ -139,7 +153,7 @@ Ros2CameraSource::~Ros2CameraSource() = default;
 SourceInfo Ros2CameraSource::info() const { return info_; }
 
 int64_t Ros2CameraSource::frames_dropped_camera() const {
-  return frames_missed_.load() + rejected_.load() + overtaken_.load();
+  return frames_missed_.load() + rejected_.load() + overtaken_.load() + other_publishers_.load();
 }
 
 void Ros2CameraSource::reject(const std::string& topic, int64_t stamp_ns, const std::string& why) {
@@ -148,6 +162,26 @@ void Ros2CameraSource::reject(const std::string& topic, int64_t stamp_ns, const 
   if (count <= 3 || count % 100 == 0) {
     spdlog::warn("{}: message stamped {} ns rejected: {} ({} rejected so far)", topic, stamp_ns, why, count);
   }
+}
+
+bool Ros2CameraSource::from_followed_publisher(uint64_t publication_handle) {
+  if (publication_handle == followed_publisher_) return true;
+  if (followed_publisher_ != 0) {
+    std::array<dds_instance_handle_t, 16> matched{};
+    const dds_return_t count = dds_get_matched_publications(dds_->depth_reader, matched.data(), matched.size());
+    const auto end = matched.begin() + std::clamp<dds_return_t>(count, 0, static_cast<dds_return_t>(matched.size()));
+    if (std::find(matched.begin(), end, followed_publisher_) != end) {
+      if (++other_publishers_ == 1) {
+        spdlog::warn("{}: a second publisher sends images on this topic; only the first one's are used, the "
+                     "other's are dropped and counted in frames_dropped_camera",
+                     params_.topics.depth_image);
+      }
+      return false;
+    }
+    spdlog::info("{}: the publisher followed has gone; following the one now sending", params_.topics.depth_image);
+  }
+  followed_publisher_ = publication_handle;
+  return true;
 }
 
 void Ros2CameraSource::take_infos() {
@@ -243,7 +277,7 @@ Source::Status Ros2CameraSource::next(Frame& out) {
       int32_t newest = -1;
       int32_t good = 0;
       for (int32_t i = 0; i < taken.size(); ++i) {
-        if (!taken.valid(i)) continue;
+        if (!taken.valid(i) || !from_followed_publisher(taken.publisher(i))) continue;
         const int64_t sample_stamp = stamp_ns(taken[i].header.stamp);
         const int64_t outages_before = gaps_.outages;
         const int64_t previous_stamp = gaps_.previous_ns;

@@ -15,6 +15,14 @@
 
 namespace hrcsense::ros2 {
 
+/// The camera never became usable at start-up: no depth CameraInfo within startup_timeout_s,
+/// an unusable one, or a stop requested while waiting. The run reports it as its source's
+/// error (header, stop, summary; exit 1), not as a configuration error.
+class Ros2StartupError : public Ros2Error {
+ public:
+  using Ros2Error::Ros2Error;
+};
+
 struct Ros2SourceParams {
   CameraTopics topics;               ///< ROS 2 names; the DDS ones are "rt" + these
   bool color = true;                 ///< read colour and pair it with depth by stamp
@@ -24,6 +32,8 @@ struct Ros2SourceParams {
   /// How long next() waits for a depth image before it returns idle (the run then checks for
   /// a stop; its watchdog reports a silent camera after safety.max_frame_age_s).
   int64_t idle_after_ns = 100'000'000;
+  /// Ends the start-up wait early (SIGINT while no camera answers); null: only the timeout does.
+  const std::atomic<bool>* stop_requested = nullptr;
 };
 
 /// Reads depth Images with their CameraInfo, optional colour and the latched depth→colour
@@ -36,8 +46,9 @@ struct Ros2SourceParams {
 /// back, then frames resume.
 class Ros2CameraSource final : public Source {
  public:
-  /// Joins the domain and waits for the first depth CameraInfo; throws Ros2Error naming the
-  /// topic and domain when none comes within startup_timeout_s, or when it cannot be used.
+  /// Joins the domain and waits for the first depth CameraInfo; throws Ros2StartupError naming
+  /// the topic and domain when none comes within startup_timeout_s, when it cannot be used, or
+  /// when a stop is requested meanwhile (Ros2Error for a DDS call that fails).
   explicit Ros2CameraSource(Ros2SourceParams params);
   ~Ros2CameraSource() override;
   Ros2CameraSource(const Ros2CameraSource&) = delete;
@@ -53,6 +64,11 @@ class Ros2CameraSource final : public Source {
   int64_t frames_missed() const { return frames_missed_.load(); }
   /// Times the publisher fell silent for longer than a second and came back.
   int64_t outages() const { return outages_.load(); }
+  /// Depth images from another publisher on the topic while the one followed is still there:
+  /// two cameras' images are no one stream, so they are dropped (counted in
+  /// frames_dropped_camera, warned about once). The first publisher seen is followed; when it
+  /// goes away, the next one to send is.
+  int64_t images_from_other_publishers() const { return other_publishers_.load(); }
 
  private:
   struct Dds;
@@ -65,6 +81,7 @@ class Ros2CameraSource final : public Source {
   void take_infos();
   void take_colors();
   bool attach_color(int64_t depth_stamp_ns, Frame& out);
+  bool from_followed_publisher(uint64_t publication_handle);
 
   Ros2SourceParams params_;
   std::unique_ptr<Dds> dds_;
@@ -78,6 +95,8 @@ class Ros2CameraSource final : public Source {
   int64_t delivered_ = 0;
   std::atomic<int64_t> rejected_{0};
   std::atomic<int64_t> overtaken_{0};
+  std::atomic<int64_t> other_publishers_{0};
+  uint64_t followed_publisher_ = 0;  ///< DDS instance handle of the writer whose images are used; 0: none yet
   std::atomic<int64_t> frames_missed_{0};
   std::atomic<int64_t> outages_{0};
   std::string error_;

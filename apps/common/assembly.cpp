@@ -73,6 +73,7 @@ namespace {
 
 // source.type ros2: realsense-ros topics over Cyclone DDS (docs/CAMERAS.md).
 std::unique_ptr<Source> make_ros2_source([[maybe_unused]] const Config& config,
+                                         [[maybe_unused]] const SourceOptions& options,
                                          [[maybe_unused]] const std::string& where) {
 #if HRCSENSE_HAVE_DDS
   const Ros2SourceConfig& ros2 = config.source.ros2;
@@ -91,7 +92,12 @@ std::unique_ptr<Source> make_ros2_source([[maybe_unused]] const Config& config,
   params.domain_id = static_cast<uint32_t>(ros2.domain_id);
   params.startup_timeout_s = ros2.startup_timeout_s;
   params.stereo_baseline_mm = config.source.stereo_baseline_mm;
-  return std::make_unique<ros2::Ros2CameraSource>(params);
+  params.stop_requested = options.stop_requested;
+  try {
+    return std::make_unique<ros2::Ros2CameraSource>(params);
+  } catch (const ros2::Ros2StartupError& e) {
+    throw SourceStartError(e.what());
+  }
 #else
   throw ConfigError(where + ": source.type 'ros2': this hrcsense was built without Cyclone DDS; install "
                     "cyclonedds-dev and cyclonedds-tools (scripts/setup does) and rebuild");
@@ -113,7 +119,7 @@ std::unique_ptr<Source> make_source(const Config& config, const SourceOptions& o
     params.with_joint_states = config.robot_state.source == "recorded";  // make_robot_state_source takes them
     return std::make_unique<BagSource>(params);
   }
-  if (config.source.type == "ros2") return make_ros2_source(config, where);
+  if (config.source.type == "ros2") return make_ros2_source(config, options, where);
   if (config.source.type == "realsense") {
 #ifdef HRCSENSE_HAVE_REALSENSE
     return std::make_unique<RealSenseSource>(RealSenseParams{config.source, options.stop_requested});
@@ -133,6 +139,23 @@ std::vector<DeviceDescriptor> list_cameras() {
 #endif
 }
 
+namespace {
+
+// What every robot state source keeps its samples under: robot.state.max_age_s and, with an
+// arm, its joint limits, so that no source takes a pose the arm cannot have.
+RobotStateHistoryParams robot_state_history_params(const Config& config) {
+  RobotStateHistoryParams params = config.robot_state.history;
+  if (const std::optional<RobotDescription>& arm = config.pipeline.robot.arm) {
+    for (size_t j = 0; j < kJointCount; ++j) {
+      params.q_min_rad[j] = arm->limits[j].min_rad;
+      params.q_max_rad[j] = arm->limits[j].max_rad;
+    }
+  }
+  return params;
+}
+
+}  // namespace
+
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock,
                                                           std::shared_ptr<TrajectoryClock> trajectory_clock) {
   const RobotStateConfig& state = config.robot_state;
@@ -146,7 +169,7 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
     params.latency_s = config.robot_state.sim_latency_s;
     params.jitter_s = config.robot_state.sim_jitter_s;
     params.seed = config.source.seed;
-    params.history = config.robot_state.history;
+    params.history = robot_state_history_params(config);
     params.clock = std::move(trajectory_clock);
     return std::make_unique<SimRobotState>(*config.robot_state.trajectory, params);
   }
@@ -158,7 +181,7 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
   if (source == "udp_json") {
     UdpJsonParams params;
     params.listen = state.listen;
-    params.history = state.history;
+    params.history = robot_state_history_params(config);
     // A bind failure (port in use, address not local) is a runtime error naming the key and
     // the address; an address that is no numeric host:port is the configuration's error.
     try {
@@ -173,7 +196,7 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
     params.host = state.host;
     params.port = state.port;
     params.frequency_hz = state.frequency_hz;
-    params.history = state.history;
+    params.history = robot_state_history_params(config);
     params.arm = config.pipeline.robot.arm;  // the forward kinematics actual_TCP_pose is checked against
     return std::make_unique<RtdeRobotState>(params, run_clock);
   }

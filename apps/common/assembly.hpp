@@ -17,6 +17,7 @@
 
 #include <atomic>
 #include <memory>
+#include <stdexcept>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,6 +49,14 @@ struct SourceOptions {
   const std::atomic<bool>* stop_requested = nullptr;  ///< ends a live camera's waits while it is unplugged (null: never)
   std::shared_ptr<TrajectoryClock> trajectory_clock;  ///< sim: the arm follows it (make_trajectory_clock)
 };
+/// A live source that could not start (a ROS 2 camera that never answered, a stop requested
+/// while waiting for it): the run still writes a header, a stop and a summary naming it.
+class SourceStartError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Throws ConfigError for what the configuration gets wrong, SourceStartError as above.
 std::unique_ptr<Source> make_source(const Config& config, const SourceOptions& options = {});
 
 /// The RealSense cameras connected (`hrcsense devices`); throws ConfigError in a build without

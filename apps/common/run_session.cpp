@@ -6,6 +6,7 @@
 #include "common/assembly.hpp"
 #include "common/background_start.hpp"
 #include "common/console_sink.hpp"
+#include "common/fault_log.hpp"
 #include "common/follow_link_sink.hpp"
 #include "common/record_setup.hpp"
 #include "common/tee_sink.hpp"
@@ -51,6 +52,23 @@ void install_signal_handlers() {
   std::signal(SIGPIPE, SIG_IGN);
 }
 
+// A live source that could not start: the run's one event is its error.
+class UnstartedSource final : public Source {
+ public:
+  UnstartedSource(std::string type, std::string error) : error_(std::move(error)) {
+    info_.type = std::move(type);
+    info_.live = true;
+    info_.frame_count = -1;
+  }
+  SourceInfo info() const override { return info_; }
+  Status next(Frame&) override { return Status::error; }
+  std::string error() const override { return error_; }
+
+ private:
+  SourceInfo info_;
+  std::string error_;
+};
+
 // Adds the recorder's counters to the summary. The summary comes after the run's final stop, so
 // closing the recording here (writing what is still queued) never delays a verdict.
 class RecordCountersSink final : public Sink {
@@ -91,9 +109,66 @@ class ViewerCountersSink final : public Sink {
   std::function<int64_t()> dropped_;
 };
 
+// What each part of the run can say is wrong while it runs (fault_log.hpp).
+std::vector<FaultProbe> fault_probes(const RobotStateSource& robot_states, const Recorder* recorder,
+                                     const UdpLinkSink* link, const RtdeLinkSink* rtde_link) {
+  std::vector<FaultProbe> probes;
+  // A frame stopped for want of a state says why (the source's problem is in its reason);
+  // samples rejected while frames still find a state are said as they come.
+  auto rejected = when_rising(
+      [&robot_states] {
+        const RobotStateStats stats = robot_states.stats();
+        return stats.samples.rejected() + stats.malformed;
+      },
+      [&robot_states] { return "samples rejected: " + robot_states.stats().last_problem; });
+  probes.push_back({"robot state", [rejected](const FrameResult& newest) mutable {
+                      const bool no_state = newest.withheld_code == ReasonCode::no_robot_state ||
+                                            newest.withheld_code == ReasonCode::robot_state_stale;
+                      if (newest.source_frame && !newest.valid && no_state) return newest.withheld_reason;
+                      return rejected(newest);
+                    }});
+  if (recorder != nullptr) {
+    auto dropped = when_rising([recorder] { return recorder->stats().frames_dropped; },
+                               [recorder] {
+                                 return std::to_string(recorder->stats().frames_dropped) +
+                                        " frames not recorded so far (the disk is slower than the camera)";
+                               });
+    probes.push_back({"recording", [recorder, dropped](const FrameResult& newest) mutable {
+                        const std::string error = recorder->stats().error;
+                        return error.empty() ? dropped(newest) : "recording ended: " + error;
+                      }});
+  }
+  if (link != nullptr) {
+    probes.push_back({"link.udp", when_rising([link] { return link->counters().send_errors; },
+                                              [link] { return link->counters().last_error; })});
+  }
+  if (rtde_link != nullptr) {
+    auto failed = when_rising(
+        [rtde_link] {
+          const RtdeLinkCounters c = rtde_link->counters();
+          return c.refusals + c.disconnects + c.malformed;
+        },
+        [rtde_link] { return rtde_link->counters().last_problem; });
+    probes.push_back({"link.rtde", [rtde_link, failed](const FrameResult& newest) mutable {
+                        const RtdeLinkCounters c = rtde_link->counters();
+                        // Not streaming after a problem: the writes do not reach the controller.
+                        if (!c.connected && !c.last_problem.empty()) return c.last_problem;
+                        return failed(newest);
+                      }});
+  }
+  return probes;
+}
+
 void restore_signal_handlers() {
   for (int signal : kStopSignals) std::signal(signal, SIG_DFL);
 }
+
+struct SignalHandlers {
+  SignalHandlers() { install_signal_handlers(); }
+  ~SignalHandlers() { restore_signal_handlers(); }
+  SignalHandlers(const SignalHandlers&) = delete;
+  SignalHandlers& operator=(const SignalHandlers&) = delete;
+};
 
 const char* signal_name(int signal) {
   switch (signal) {
@@ -120,7 +195,18 @@ int run_session(const Config& config, const SessionOptions& args) {
   const std::shared_ptr<TrajectoryClock> trajectory_clock = make_trajectory_clock(config);
   if (trajectory_clock) trajectory_clock->set_lockstep(!paced);
   source_options.trajectory_clock = trajectory_clock;
-  std::unique_ptr<Source> source = make_source(config, source_options);
+  // From here a signal ends the run with a stop line and a summary, also while a live camera
+  // is still awaited; the handlers go when the session does, however it ends.
+  const SignalHandlers signal_handlers;
+  std::unique_ptr<Source> source;
+  bool source_started = true;
+  try {
+    source = make_source(config, source_options);
+  } catch (const SourceStartError& e) {
+    // The run still says so as every run does: header, stop, summary (source_error, exit 1).
+    source = std::make_unique<UnstartedSource>(config.source.type, e.what());
+    source_started = false;
+  }
   std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config, *source, nullptr, trajectory_clock);
   const bool recording_source = config.source.type == "bag" || config.source.type == "folder";
   if (args.wrap_recording && recording_source) {
@@ -180,7 +266,10 @@ int run_session(const Config& config, const SessionOptions& args) {
   Sink& recorded = with_record ? static_cast<Sink&>(*with_record) : tee;
   std::optional<ViewerCountersSink> with_viewer;
   if (args.viewer_frames_dropped) with_viewer.emplace(recorded, args.viewer_frames_dropped);
-  Sink& sinks = with_viewer ? static_cast<Sink&>(*with_viewer) : recorded;
+  Sink& counted = with_viewer ? static_cast<Sink&>(*with_viewer) : recorded;
+  // Faults said when they start and when they clear, not only in the summary.
+  FaultLogSink sinks(counted, fault_probes(*robot_states, recorder ? &*recorder : nullptr, link.get(), rtde_link.get()),
+                     [] { return SteadyClock().now_ns(); });
 
   RunHeader header = make_run_header(config, info);
   header.unknown_background_share = pipeline.unknown_background_share();  // a loaded background's
@@ -190,12 +279,12 @@ int run_session(const Config& config, const SessionOptions& args) {
   options.pace = paced;
   options.camera_latency_s = config.robot_state.camera_latency_s;
   options.max_frames = args.frames;
-  options.stop_requested = &g_stop_requested;
+  // A source that never started has nothing to stop: its error, not the signal that ended the
+  // wait, is how the run ends.
+  options.stop_requested = source_started ? &g_stop_requested : nullptr;
   options.on_processed = args.on_processed;
   options.before_process = args.before_process;
-  install_signal_handlers();
   const RunSummary summary = run_pipeline(frames, *robot_states, pipeline, sinks, options, header);
-  restore_signal_handlers();
   if (g_stop_signal.load() != 0) spdlog::info("{} received: the run ended with a stop", signal_name(g_stop_signal.load()));
 
   if (link) {

@@ -9,6 +9,8 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
+#include <string>
 
 namespace hrcsense {
 
@@ -22,6 +24,17 @@ struct RobotStateHistoryParams {
   /// A sample may move each joint by at most |qd|·dt plus this much from the previous one
   /// (dt ≤ max_age_s); more is a jump and the sample is rejected.
   double jump_tolerance_rad = 0.05;
+  /// The arm's joint limits (`robot.arm`), rad, joint 1 first, inclusive: a sample with a joint
+  /// outside them is no pose of this arm (degrees sent as radians, garbage) and is rejected.
+  /// Unbounded until the run sets them from its arm (assembly's robot_state_history_params).
+  JointAngles q_min_rad = unbounded(-1.0);
+  JointAngles q_max_rad = unbounded(1.0);
+
+  static JointAngles unbounded(double sign) {
+    JointAngles q;
+    q.fill(sign * std::numeric_limits<double>::infinity());
+    return q;
+  }
 };
 
 /// Samples offered to a history, by what became of them.
@@ -30,7 +43,8 @@ struct RobotStateCounts {
   int64_t rejected_non_finite = 0;  ///< a NaN or Inf angle or velocity
   int64_t rejected_backwards = 0;   ///< not later than the previous sample
   int64_t rejected_jump = 0;        ///< a joint moved further than qd·dt + tolerance
-  int64_t rejected() const { return rejected_non_finite + rejected_backwards + rejected_jump; }
+  int64_t rejected_limits = 0;      ///< a joint outside the arm's limits
+  int64_t rejected() const { return rejected_non_finite + rejected_backwards + rejected_jump + rejected_limits; }
 };
 
 /// The state for one frame, with how it was found.
@@ -42,7 +56,7 @@ struct RobotStateLookup {
 };
 
 /// The last kCapacity accepted samples, oldest first, on the host clock. Not thread-safe: a
-/// live source guards it with its own mutex. No allocation.
+/// live source guards it with its own mutex. No allocation for an accepted sample.
 class RobotStateHistory {
  public:
   static constexpr size_t kCapacity = 256;  ///< 0.5 s at RTDE's 500 Hz, 2 s at 125 Hz
@@ -50,7 +64,8 @@ class RobotStateHistory {
   RobotStateHistoryParams params;
 
   /// Adds a sample (host_time_ns already on the host clock). Returns false and counts it when
-  /// it is rejected: non-finite, not later than the previous one, or a jump. A sample that
+  /// it is rejected: non-finite, a joint outside the limits, not later than the previous one,
+  /// or a jump; last_rejection() then says why, naming the joint and value. A sample that
   /// follows a gap longer than max_age_s starts the history afresh (a reconnect may find the
   /// arm elsewhere).
   bool add(const RobotState& sample);
@@ -63,6 +78,9 @@ class RobotStateHistory {
   void clear() { size_ = 0; }
   size_t size() const { return size_; }
   const RobotStateCounts& counts() const { return counts_; }
+  /// Why the last rejected sample was rejected, for people ("joint 2 (shoulder_lift) 171.9 rad
+  /// outside its limits -6.283..6.283 rad"); empty before the first rejection.
+  const std::string& last_rejection() const { return last_rejection_; }
   /// The newest accepted sample; only when size() > 0.
   const RobotState& newest() const { return sample(size_ - 1); }
 
@@ -71,6 +89,7 @@ class RobotStateHistory {
   size_t first_ = 0;  ///< index of the oldest sample in ring_
   size_t size_ = 0;
   RobotStateCounts counts_;
+  std::string last_rejection_;  ///< written only on a rejection: the accepted path stays allocation-free
 
   const RobotState& sample(size_t i) const { return ring_[(first_ + i) % kCapacity]; }
 };

@@ -110,7 +110,8 @@ class UdpJsonRobotState final : public RobotStateSource {
   int64_t last_t_ns_ = 0;
   int64_t last_host_ns_ = 0;
   int64_t malformed_ = 0;
-  std::string last_problem_;
+  std::string last_problem_;   ///< the latest problem: a datagram's or a lookup's
+  std::string sample_problem_; ///< the latest malformed or rejected datagram
   std::string error_;          ///< the reader's fatal error
   std::string lookup_error_;   ///< why the last state_at failed
 

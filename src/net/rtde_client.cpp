@@ -417,7 +417,7 @@ void RtdeRobotState::on_data(const rtde::Frame& frame, Connection& c) {
   if (fraction >= 0.0 && fraction <= 1.0) state.speed_fraction = fraction;
   if (!history_.add(state)) {
     stats_.last_problem = "RTDE: DATA_PACKAGE at controller time " + std::to_string(data.timestamp_s) +
-                          " s rejected (non-finite joints, not later than the previous one, or a jump)";
+                          " s rejected: " + history_.last_rejection();
   }
 }
 

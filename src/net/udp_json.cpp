@@ -430,7 +430,8 @@ void UdpJsonRobotState::handle(const char* bytes, size_t size, int64_t arrival_n
   const std::lock_guard<std::mutex> lock(mutex_);
   if (!datagram.ok && !datagram.non_finite) {
     ++malformed_;
-    last_problem_ = "from " + address_name(peer) + ": " + datagram.error;
+    sample_problem_ = "from " + address_name(peer) + ": " + datagram.error;
+    last_problem_ = sample_problem_;
     return;
   }
   RobotState sample;
@@ -451,13 +452,11 @@ void UdpJsonRobotState::handle(const char* bytes, size_t size, int64_t arrival_n
     last_t_ns_ = datagram.t_ns;
     last_host_ns_ = sample.host_time_ns;
   }
-  const RobotStateCounts before = history_.counts();
   if (history_.add(sample)) return;
-  const RobotStateCounts& after = history_.counts();
-  std::string why = datagram.error;  // non-finite: names the field
-  if (after.rejected_backwards > before.rejected_backwards) why = "not later than the previous state";
-  if (after.rejected_jump > before.rejected_jump) why = "a joint jumped further than qd·dt + tolerance";
-  last_problem_ = "from " + address_name(peer) + ": t_ns " + std::to_string(datagram.t_ns) + " rejected: " + why;
+  // A non-finite datagram's parser names the field; every other rejection the history names.
+  const std::string& why = datagram.non_finite ? datagram.error : history_.last_rejection();
+  sample_problem_ = "from " + address_name(peer) + ": t_ns " + std::to_string(datagram.t_ns) + " rejected: " + why;
+  last_problem_ = sample_problem_;
 }
 
 bool UdpJsonRobotState::state_at(int64_t host_time_ns, RobotState& out) {
@@ -467,11 +466,21 @@ bool UdpJsonRobotState::state_at(int64_t host_time_ns, RobotState& out) {
   out.origin = RobotStateOrigin::udp_json;
   if (lookup.state.valid) {
     lookup_error_.clear();
-  } else if (lookup.code == ReasonCode::robot_state_stale) {
-    lookup_error_ = "udp_json on " + listen_ + ": newest state " + milliseconds(lookup.age_ms) + " old (max " +
-                    milliseconds(history_.params.max_age_s * 1e3) + ")";
   } else {
-    lookup_error_ = "udp_json on " + listen_ + ": no robot state received";
+    if (lookup.code == ReasonCode::robot_state_stale) {
+      lookup_error_ = "udp_json on " + listen_ + ": newest state " + milliseconds(lookup.age_ms) + " old (max " +
+                      milliseconds(history_.params.max_age_s * 1e3) + ")";
+    } else {
+      lookup_error_ = "udp_json on " + listen_ + ": no robot state accepted";
+    }
+    // What was received instead (a datagram rejected, malformed) is why; nothing at all is
+    // said as such, so that a silent or wrong-port sender shows in the output and the summary.
+    if (!sample_problem_.empty()) {
+      lookup_error_ += "; last datagram problem: " + sample_problem_;
+    } else if (lookup.code == ReasonCode::no_robot_state) {
+      lookup_error_ += "; no datagram received";
+    }
+    last_problem_ = lookup_error_;
   }
   return lookup.state.valid;
 }

@@ -180,6 +180,15 @@ struct ProcessingStats {
   std::string error;
 };
 
+// A frame withheld for want of a robot state says what the source knows about it (a refused
+// connection, a rejected sample, nothing received), so that the fault shows on the frame.
+void say_why_no_robot_state(const RobotStateSource& robot_states, Measurement& m) {
+  if (m.withheld_code != ReasonCode::no_robot_state && m.withheld_code != ReasonCode::robot_state_stale) return;
+  std::string why = robot_states.error();
+  if (why.empty()) why = robot_states.stats().last_problem;
+  if (!why.empty()) m.withheld_reason += ": " + why;
+}
+
 // Measures every frame it takes and hands the measurement to the output, where the monitor
 // decides it. A paced run's measurement that replaces one not yet taken carries that one's
 // verdict (carry_replaced), so a stop is never dropped unseen. Closes `results` when `frames`
@@ -201,6 +210,7 @@ void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const R
       // The robot as it was when the camera saw the frame; none withholds it (Pipeline::process).
       if (!robot_states.state_at(in.frame.host_time_ns - camera_latency_ns, robot_state)) robot_state.valid = false;
       pipeline.process(in.frame, robot_state, result);
+      if (!robot_state.valid) say_why_no_robot_state(robot_states, result);
       result.timestamp_warning = in.timestamp_warning;
       result.clocked = true;
       result.delivered_ns = in.captured_ns;

@@ -2,8 +2,11 @@
 // hrcsense — the robot state history and the sender-to-host clock map.
 #include "hrcsense/robot_state_history.hpp"
 
+#include "hrcsense/robot.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace hrcsense {
 
@@ -15,17 +18,37 @@ namespace {
 
 double seconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
 
+// "joint 2 (shoulder_lift) 171.9 rad" and what follows; %.6g keeps 1e300 readable.
+std::string joint_text(size_t j, double value_rad, const char* what) {
+  char text[160];
+  std::snprintf(text, sizeof text, "joint %zu (%s) %.6g rad %s", j + 1, joint_name(static_cast<int>(j)).c_str(),
+                value_rad, what);
+  return text;
+}
+
 }  // namespace
 
 bool RobotStateHistory::add(const RobotState& sample) {
   if (!all_finite(sample.q_rad) || !all_finite(sample.qd_rad_s)) {
     ++counts_.rejected_non_finite;
+    last_rejection_ = "a non-finite joint angle or velocity";
     return false;
+  }
+  for (size_t j = 0; j < kJointCount; ++j) {
+    if (!(sample.q_rad[j] >= params.q_min_rad[j] && sample.q_rad[j] <= params.q_max_rad[j])) {
+      ++counts_.rejected_limits;
+      char limits[96];
+      std::snprintf(limits, sizeof limits, "outside the arm's limits %.4g..%.4g rad", params.q_min_rad[j],
+                    params.q_max_rad[j]);
+      last_rejection_ = joint_text(j, sample.q_rad[j], limits);
+      return false;
+    }
   }
   if (size_ > 0) {
     const RobotState& previous = newest();
     if (sample.host_time_ns <= previous.host_time_ns) {
       ++counts_.rejected_backwards;
+      last_rejection_ = "not later than the previous sample";
       return false;
     }
     const double dt_s = seconds(sample.host_time_ns - previous.host_time_ns);
@@ -37,6 +60,9 @@ bool RobotStateHistory::add(const RobotState& sample) {
         // Written so that the comparison fails (rejects) for anything unexpected.
         if (!(std::fabs(sample.q_rad[j] - previous.q_rad[j]) <= speed * dt_s + params.jump_tolerance_rad)) {
           ++counts_.rejected_jump;
+          char from[64];
+          std::snprintf(from, sizeof from, "jumped from %.6g rad, further than qd·dt + tolerance", previous.q_rad[j]);
+          last_rejection_ = joint_text(j, sample.q_rad[j], from);
           return false;
         }
       }

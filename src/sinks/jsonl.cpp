@@ -457,6 +457,7 @@ void JsonLinesSink::summary(const RunSummary& summary) {
   m.integer("rejected_non_finite", robot.samples.rejected_non_finite);
   m.integer("rejected_backwards", robot.samples.rejected_backwards);
   m.integer("rejected_jump", robot.samples.rejected_jump);
+  m.integer("rejected_limits", robot.samples.rejected_limits);
   m.integer("connections", robot.connections);
   m.integer("disconnects", robot.disconnects);
   m.integer("malformed", robot.malformed);

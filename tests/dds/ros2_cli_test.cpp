@@ -137,5 +137,53 @@ TEST(Ros2Cli, SilentCameraStopsTheCellAndTheRunResumesWhenItIsBack) {
   }
 }
 
+// A run whose ROS 2 camera never answers still writes what every run writes (issue 31, defect
+// 5): the header, a stop and a summary that names the error as a source error, exit 1.
+void expect_start_failure(const std::string& out, const std::string& error_part) {
+  const std::vector<json> lines = read_lines(out);
+  ASSERT_GE(lines.size(), 3U) << "header, stop, summary";
+  EXPECT_EQ(lines.front()["type"], "header");
+  EXPECT_EQ(lines.front()["source"]["type"], "ros2");
+  const json& stop = lines[lines.size() - 2];
+  EXPECT_EQ(stop["verdict"], "stop") << stop.dump();
+  const json& summary = lines.back();
+  ASSERT_EQ(summary["type"], "summary");
+  EXPECT_EQ(summary["end_reason_code"], "source_error") << summary.dump();
+  EXPECT_EQ(summary["frames_in"], 0);
+  ASSERT_TRUE(summary["error"].is_string()) << summary.dump();
+  EXPECT_NE(summary["error"].get<std::string>().find(error_part), std::string::npos) << summary.dump();
+}
+
+std::vector<std::string> silent_camera_run(const std::string& domain, const std::string& timeout_s,
+                                           const std::string& out) {
+  return {HRCSENSE_CLI, "run", "--config", kWalk, "--set", "source.type=ros2", "--set",
+          "source.ros2.namespace=/nobody/camera", "--set", "source.ros2.domain_id=" + domain, "--set",
+          "source.ros2.startup_timeout_s=" + timeout_s, "--out", out};
+}
+
+TEST(Ros2Cli, NoCameraWithinTheStartupTimeoutIsASourceErrorWithOutput) {
+  if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
+  const std::string out = std::string(::testing::TempDir()) + "ros2_cli_no_camera.jsonl";
+  std::remove(out.c_str());
+  const pid_t run = spawn(silent_camera_run(std::to_string(test::test_domain()), "0.5", out));
+  ASSERT_GT(run, 0);
+  EXPECT_EQ(wait_exit(run, 30s), 1);
+  expect_start_failure(out, "no CameraInfo on /nobody/camera/depth/camera_info");
+  std::remove(out.c_str());
+}
+
+TEST(Ros2Cli, ASignalWhileWaitingForTheCameraEndsWithOutput) {
+  if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
+  const std::string out = std::string(::testing::TempDir()) + "ros2_cli_signal.jsonl";
+  std::remove(out.c_str());
+  const pid_t run = spawn(silent_camera_run(std::to_string(test::test_domain()), "60", out));
+  ASSERT_GT(run, 0);
+  std::this_thread::sleep_for(1500ms);  // well into the wait (the process starts in ~0.1 s)
+  ::kill(run, SIGINT);
+  EXPECT_EQ(wait_exit(run, 20s), 1) << "the wait should end within 0.1 s of the signal";
+  expect_start_failure(out, "stopped while waiting for the first CameraInfo on /nobody/camera/depth/camera_info");
+  std::remove(out.c_str());
+}
+
 }  // namespace
 }  // namespace hrcsense

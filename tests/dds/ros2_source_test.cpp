@@ -207,6 +207,28 @@ TEST(Ros2Source, PublisherThatGoesAwayAndComesBackIsPickedUpAgain) {
   EXPECT_EQ(again.size(), 3U) << "frames did not resume after the publisher came back";
 }
 
+// A second camera node publishing on the same topic (issue 31, defect 6): its images are not
+// merged into the stream of the first. Its stamps are 1000 s later than the first's, so any
+// of its frames that got through would show; it is warned about once and counted.
+TEST(Ros2Source, ASecondPublisherOnTheTopicIsDroppedAndCounted) {
+  if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
+  const std::vector<Frame> frames = simulated_frames(4);
+  std::vector<Frame> later = frames;
+  for (Frame& frame : later) frame.timestamp_ns += 1'000'000'000'000;
+  PublisherThread first("/two/camera", frames);
+  Ros2SourceParams params = source_params("/two/camera");
+  params.color = false;
+  Ros2CameraSource source(params);
+  ASSERT_EQ(receive(source, 3).size(), 3U);
+  PublisherThread second("/two/camera", later);
+  // Both publish every 10 ms; 40 frames take 0.4 s, time for the second to be matched and send.
+  const std::vector<Frame> received = receive(source, 40);
+  ASSERT_EQ(received.size(), 40U);
+  for (const Frame& frame : received) EXPECT_LT(frame.timestamp_ns, 1'000'000'000'000) << "a second publisher's frame";
+  EXPECT_GT(source.images_from_other_publishers(), 10);
+  EXPECT_GE(source.frames_dropped_camera(), source.images_from_other_publishers());
+}
+
 // `hrcsense publish` of the shared D435 .bag (a child process) against this process's source:
 // every frame received equals the bag reader's frame of the same timestamp.
 TEST(Ros2Source, PublishedD435BagEqualsTheBagReader) {

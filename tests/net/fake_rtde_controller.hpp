@@ -39,6 +39,7 @@
 namespace hrcsense::test {
 
 enum class RtdeFault { none, close, stall, truncated, oversized, unknown_type, wrong_recipe, nan_joints,
+                       huge_joint,  // joint 2 is 1e300 in one package: finite, but no pose of any arm
                        not_found, protocol1_only,
                        // input sessions: the setup reply has no recipe id (an empty payload); the
                        // connection is closed after fault_at input packages
@@ -421,7 +422,8 @@ class FakeRtdeController {
         if (name == "safety_mode") be32(payload, static_cast<uint32_t>(modes.safety_mode));
         for (size_t j = 0; j < 6; ++j) {
           const bool nan = here && fault == RtdeFault::nan_joints && j == 2;
-          if (name == "actual_q") be_double(payload, nan ? std::nan("") : q[j]);
+          const bool huge = here && fault == RtdeFault::huge_joint && j == 1;
+          if (name == "actual_q") be_double(payload, nan ? std::nan("") : huge ? 1e300 : q[j]);
           if (name == "actual_qd") be_double(payload, qd[j]);
           if (name == "actual_TCP_pose") be_double(payload, tcp[j]);
         }

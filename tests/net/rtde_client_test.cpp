@@ -180,7 +180,27 @@ INSTANTIATE_TEST_SUITE_P(Faults, RtdeInStreamFault,
                          ::testing::Values(InStream{RtdeFault::oversized, "DATA_PACKAGE: payload of 185 bytes"},
                                            InStream{RtdeFault::wrong_recipe, "recipe id 7, expected 1"},
                                            InStream{RtdeFault::unknown_type, "skipped package type 88 (unknown package type, 8 bytes)"},
-                                           InStream{RtdeFault::nan_joints, "rejected (non-finite"}));
+                                           InStream{RtdeFault::nan_joints, "rejected: a non-finite joint"}));
+
+// A package whose shoulder_lift reads 1e300 is finite but no pose of a UR5 (±2π): with the
+// arm's limits (what the assembly sets from robot.model), it is rejected, counted apart and
+// named; the stream goes on.
+TEST(RtdeClient, AJointOutsideTheArmsLimitsIsRejectedAndNamed) {
+  Rig rig(faulty(RtdeFault::huge_joint), 500.0, [](RtdeParams& params) {
+    params.history.q_min_rad.fill(-2.0 * M_PI);
+    params.history.q_max_rad.fill(2.0 * M_PI);
+  });
+  ASSERT_TRUE(rig.consumed(200));
+  const RobotStateStats stats = rig.client->stats();
+  EXPECT_EQ(stats.samples.rejected_limits, 1);
+  EXPECT_EQ(stats.samples.rejected(), 1);
+  EXPECT_EQ(stats.samples.accepted, 199);
+  EXPECT_NE(stats.last_problem.find(" s rejected: joint 2 (shoulder_lift) 1e+300 rad outside the arm's limits "
+                                    "-6.283..6.283 rad"),
+            std::string::npos)
+      << stats.last_problem;
+  EXPECT_TRUE(rig.matches_at(rig.clock.now_ns()));
+}
 
 // A refusal in the handshake: an error saying why, no state, retried with back-off.
 class RtdeHandshakeFault : public ::testing::TestWithParam<InStream> {};

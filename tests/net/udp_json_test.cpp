@@ -33,6 +33,7 @@ namespace hrcsense {
 namespace {
 
 constexpr int64_t kMs = 1'000'000;
+constexpr double kPi = 3.14159265358979323846;
 constexpr int64_t kS = 1'000'000'000;
 
 UdpJsonDatagram parse(const std::string& text) { return parse_udp_json_state(text.data(), text.size()); }
@@ -277,7 +278,7 @@ TEST(UdpJsonRobotState, StatesOnTheHostClockMatchTheSentTrajectory) {
   EXPECT_FALSE(source.state_at(kHostStart, state));  // nothing received yet
   EXPECT_FALSE(state.valid);
   EXPECT_EQ(state.origin, RobotStateOrigin::udp_json);
-  EXPECT_NE(source.error().find("no robot state received"), std::string::npos) << source.error();
+  EXPECT_NE(source.error().find("no robot state accepted; no datagram received"), std::string::npos) << source.error();
 
   Sender sender(source.bound_port());
   send_trajectory(clock, sender, source);
@@ -399,6 +400,43 @@ TEST(UdpJsonRobotState, NanJointsAreRejectedByTheHistory) {
   ASSERT_TRUE(source.state_at(kHostStart + 8 * kMs, state));  // between samples 0 and 2: 0.108, joint 3 zero
   EXPECT_NEAR(state.q_rad[0], 0.108, 1e-9);
   EXPECT_EQ(state.q_rad[2], 0.0);
+}
+
+// A sender that sends degrees for radians (or garbage such as 1e300) sends no pose of a UR5,
+// whose joints end at ±2π: each such datagram is rejected as outside the limits, counted apart,
+// and named in last_problem (joint, value, limits); with no state accepted, error() says so and
+// why, which a run puts on every stopped frame.
+TEST(UdpJsonRobotState, JointsOutsideTheArmsLimitsAreRejectedAndNamed) {
+  FakeClock clock(kHostStart);
+  UdpJsonParams params = loopback_params();
+  params.history.q_min_rad.fill(-2.0 * kPi);
+  params.history.q_max_rad.fill(2.0 * kPi);
+  UdpJsonRobotState source(params, clock);
+  Sender sender(source.bound_port());
+  const auto limits = [](const RobotStateStats& s) { return s.samples.rejected_limits; };
+  deliver(clock, kHostStart, sender,
+          R"({"t_ns": 1000000000000, "q": [-53.9, -85.9, 80.2, -97.4, -90, 0], "qd": [0, 0, 0, 0, 0, 0]})", source,
+          limits);
+  const std::string from = "from 127.0.0.1:" + std::to_string(sender.port()) + ": ";
+  EXPECT_EQ(source.stats().last_problem,
+            from + "t_ns 1000000000000 rejected: joint 1 (shoulder_pan) -53.9 rad outside the arm's limits "
+                   "-6.283..6.283 rad");
+  deliver(clock, kHostStart + kPeriod, sender,
+          R"({"t_ns": 1000008000000, "q": [0, 0, 0, 0, 0, 1e300], "qd": [0, 0, 0, 0, 0, 0]})", source, limits);
+  const RobotStateStats stats = source.stats();
+  EXPECT_EQ(stats.samples.rejected_limits, 2);
+  EXPECT_EQ(stats.samples.accepted, 0);
+  EXPECT_EQ(stats.malformed, 0);
+  EXPECT_NE(stats.last_problem.find("joint 6 (wrist_3) 1e+300 rad outside"), std::string::npos) << stats.last_problem;
+  RobotState state;
+  EXPECT_FALSE(source.state_at(kHostStart + kPeriod, state));
+  EXPECT_EQ(source.error(), "udp_json on 127.0.0.1:" + std::to_string(source.bound_port()) +
+                                ": no robot state accepted; last datagram problem: " + stats.last_problem);
+  // The summary's last_problem keeps the latest: now the lookup's, which carries the datagram's.
+  EXPECT_EQ(source.stats().last_problem, source.error());
+  // Within the limits again: taken.
+  deliver(clock, kHostStart + 2 * kPeriod, sender, trajectory_datagram(2), source, accepted);
+  EXPECT_TRUE(source.state_at(kHostStart + 2 * kPeriod, state)) << source.error();
 }
 
 // Sample 1 overtaken by sample 2 arrives late: rejected as backwards, and the clock map is left
@@ -547,6 +585,53 @@ TEST(UdpJsonCli, RunFollowsTheSenderAndStopsWhenItFallsSilent) {
   EXPECT_GE(robot.at("accepted").get<int64_t>(), test::kSilentAfterFrames);  // 250 Hz against 30 fps
   EXPECT_EQ(robot.at("malformed"), 0);
   test::expect_follows_then_stops(live, fixed);
+}
+
+// A sender that sends the cell's joints in degrees, end to end: the run takes the UR5's limits
+// from robot.model, rejects every datagram (shoulder_pan −53.9 is no pose of it), never
+// measures a frame against them, and says why on the frames and in the summary.
+TEST(UdpJsonCli, JointsInDegreesAreRejectedAndEveryFrameStops) {
+  const std::string config = test::write_cli_cell("udp_json_degrees");
+  uint16_t port = 0;
+  {
+    const HeldPort probe;  // free now; the tool binds it a moment later
+    port = probe.port;
+  }
+  std::atomic<bool> done{false};
+  std::thread sender([&] {
+    const Sender to(port);
+    const SteadyClock steady;
+    std::string q;
+    for (size_t j = 0; j < 6; ++j) q += (j ? ", " : "") + std::to_string(test::kCliJoints[j] * 180.0 / kPi);
+    for (int k = 0; k < 2500 && !done; ++k) {  // 250 Hz for the run, at most 10 s
+      to.send("{\"t_ns\": " + std::to_string(steady.now_ns()) + ", \"q\": [" + q + "], \"qd\": [0, 0, 0, 0, 0, 0]}");
+      std::this_thread::sleep_for(std::chrono::milliseconds(4));
+    }
+  });
+  const test::ToolRun live = test::run_tool(
+      config, "--set robot.state.source=udp_json --set robot.state.listen=127.0.0.1:" + std::to_string(port),
+      "udp_degrees");
+  done = true;
+  sender.join();
+  std::remove(config.c_str());
+
+  const nlohmann::json& robot = live.summary.at("robot_state");
+  EXPECT_EQ(robot.at("accepted"), 0);
+  EXPECT_GE(robot.at("rejected_limits").get<int64_t>(), 30);  // 250 Hz over a 2.5 s run
+  EXPECT_EQ(robot.at("malformed"), 0);
+  EXPECT_NE(robot.at("last_problem").get<std::string>().find("joint 1 (shoulder_pan) -53.9"), std::string::npos)
+      << robot.at("last_problem");
+  ASSERT_FALSE(live.frames.empty());
+  int named = 0;
+  for (const auto& [index, frame] : live.frames) {
+    EXPECT_EQ(frame.at("verdict"), "stop") << index;
+    EXPECT_FALSE(frame.at("valid").get<bool>()) << index;
+    const std::string reason = frame.at("verdict_reason").get<std::string>();
+    if (frame.at("reason_code") == "no_robot_state" && reason.find("outside the arm's limits") != std::string::npos) {
+      ++named;
+    }
+  }
+  EXPECT_GE(named, 30) << "the stopped frames should say why there is no state";
 }
 
 }  // namespace

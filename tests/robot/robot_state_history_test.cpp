@@ -108,6 +108,44 @@ TEST(RobotStateHistory, RejectsAndCountsBadSamples) {
   EXPECT_EQ(history.size(), 2U);
 }
 
+// A UR5's joints are limited to ±360° = ±2π rad (its datasheet). 171.9° sent as radians,
+// 1e300 and a value just past the limit are no pose of it: rejected, counted apart from the
+// other rejections, the joint named by number and name with its value. The limit itself is in.
+TEST(RobotStateHistory, RejectsAJointOutsideTheArmsLimits) {
+  constexpr double kTwoPi = 6.283185307179586;
+  RobotStateHistory history;
+  history.params.q_min_rad.fill(-kTwoPi);
+  history.params.q_max_rad.fill(kTwoPi);
+  RobotState degrees = sample(0, 0.0);
+  degrees.q_rad[1] = 171.9;
+  EXPECT_FALSE(history.add(degrees));
+  EXPECT_NE(history.last_rejection().find("joint 2 (shoulder_lift) 171.9 rad"), std::string::npos)
+      << history.last_rejection();
+  EXPECT_NE(history.last_rejection().find("-6.283..6.283 rad"), std::string::npos) << history.last_rejection();
+  RobotState huge = sample(0, 0.0);
+  huge.q_rad[5] = 1e300;
+  EXPECT_FALSE(history.add(huge));
+  EXPECT_NE(history.last_rejection().find("joint 6 (wrist_3) 1e+300 rad"), std::string::npos)
+      << history.last_rejection();
+  RobotState just_past = sample(0, -kTwoPi - 1e-9);
+  EXPECT_FALSE(history.add(just_past));
+  EXPECT_EQ(history.counts().rejected_limits, 3);
+  EXPECT_EQ(history.counts().rejected(), 3);
+  EXPECT_EQ(history.size(), 0U);
+  EXPECT_EQ(history.at(0).code, ReasonCode::no_robot_state);
+
+  EXPECT_TRUE(history.add(sample(0, kTwoPi)));
+  EXPECT_EQ(history.counts().accepted, 1);
+}
+
+// Without limits set (no arm known) every finite value is taken: the limits are the arm's, and
+// a run sets them from robot.arm.
+TEST(RobotStateHistory, WithoutAnArmNoLimitApplies) {
+  RobotStateHistory history;
+  EXPECT_TRUE(history.add(sample(0, 1e300)));
+  EXPECT_EQ(history.counts().rejected_limits, 0);
+}
+
 // After a gap longer than max_age_s (a reconnect) the arm may be anywhere: the new sample
 // starts the history afresh instead of being rejected as a jump.
 TEST(RobotStateHistory, AGapStartsAfresh) {

@@ -227,6 +227,7 @@ TEST(JsonLinesSink, SummaryHasEveryRunSummaryField) {
   s.robot_state.samples.rejected_non_finite = 1;
   s.robot_state.samples.rejected_backwards = 2;
   s.robot_state.samples.rejected_jump = 3;
+  s.robot_state.samples.rejected_limits = 4;
   s.robot_state.connections = 2;
   s.robot_state.disconnects = 1;
   s.robot_state.malformed = 4;
@@ -266,6 +267,7 @@ TEST(JsonLinesSink, SummaryHasEveryRunSummaryField) {
   EXPECT_EQ(robot["rejected_non_finite"], 1);
   EXPECT_EQ(robot["rejected_backwards"], 2);
   EXPECT_EQ(robot["rejected_jump"], 3);
+  EXPECT_EQ(robot["rejected_limits"], 4);
   EXPECT_EQ(robot["connections"], 2);
   EXPECT_EQ(robot["disconnects"], 1);
   EXPECT_EQ(robot["malformed"], 4);
