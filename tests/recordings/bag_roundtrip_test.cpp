@@ -74,7 +74,8 @@ void write_walk_bag(const std::string& path, const test::BagWriterParams& params
   for (const Frame& frame : walk_frames()) {
     writer.add_depth(frame);
     if (with_color && frame.index == 1) {
-      writer.add_color(frame.timestamp_ns + 1000, gradient(32, 24), color_intrinsics(), color_pose());
+      writer.add_color(frame.timestamp_ns + 1000, static_cast<uint32_t>(frame.index), gradient(32, 24),
+                       color_intrinsics(), color_pose());
     }
   }
   writer.close();
