@@ -21,14 +21,23 @@ using test::ScratchDir;
   const std::string path = (path_expression);                      \
   if (path.empty()) GTEST_SKIP() << "../shared/data is absent"
 
+/// `hrcsense record` of `source` (its --set arguments and limits) into a scratch bag, summarised;
+/// fails the test unless the recording has a depth and a colour stream.
+RecordingSummary record_with_colour(const std::string& source) {
+  ScratchDir out("recolour");
+  const std::string bag = out / "recorded.bag";
+  const CliResult r = cli("record " + source + " --out " + bag);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  const RecordingSummary summary = r.exit_code == 0 ? summarize_recording(bag) : RecordingSummary{};
+  EXPECT_EQ(summary.streams.size(), 2U) << "depth and colour";
+  return summary;
+}
+
 TEST(RecordColour, AFolderWithColourIsRecordedWithItsColourAndCalibration) {
   REQUIRE_SHARED(test::shared_data("ist_piv_lab_people"), folder);
-  ScratchDir out("recolour");
-  const std::string bag = out / "people.bag";
-  const CliResult r = cli("record --set source.type=folder --set source.path=" + folder + " --frames 3 --out " + bag);
-  ASSERT_EQ(r.exit_code, 0) << r.out;
-  const RecordingSummary summary = summarize_recording(bag);
-  ASSERT_EQ(summary.streams.size(), 2U) << "depth and colour";
+  const RecordingSummary summary = record_with_colour("--set source.type=folder --set source.path=" + folder +
+                                                      " --frames 3");
+  ASSERT_EQ(summary.streams.size(), 2U);
   const RecordingStream& color = summary.streams[1];
   EXPECT_EQ(color.frames, 3);
   EXPECT_EQ(color.intrinsics.width, 640);
@@ -43,12 +52,8 @@ TEST(RecordColour, AFolderWithColourIsRecordedWithItsColourAndCalibration) {
 
 TEST(RecordColour, ABagWithColourIsRecordedWithItsColourAndCalibration) {
   REQUIRE_SHARED(test::shared_d435_bag(), bag);
-  ScratchDir out("recolour");
-  const std::string copy = out / "again.bag";
-  const CliResult r = cli("record --set source.type=bag --set source.path=" + bag + " --out " + copy);
-  ASSERT_EQ(r.exit_code, 0) << r.out;
-  const RecordingSummary summary = summarize_recording(copy);
-  ASSERT_EQ(summary.streams.size(), 2U) << "depth and colour";
+  const RecordingSummary summary = record_with_colour("--set source.type=bag --set source.path=" + bag);
+  ASSERT_EQ(summary.streams.size(), 2U);
   const RecordingStream& color = summary.streams[1];
   EXPECT_GE(color.frames, 1);
   EXPECT_EQ(color.encoding, "rgb8");
