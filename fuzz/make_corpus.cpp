@@ -36,7 +36,8 @@ void write_bag(const std::string& path, const test::BagWriterParams& params, boo
       ColorImage rgb{4, 3, std::vector<uint8_t>(4 * 3 * 3, 0x80)};
       Pose T = Pose::Identity();
       T.translation() = Eigen::Vector3d(0.015, 0, 0);
-      writer.add_color(frame.timestamp_ns + 5, rgb, Intrinsics{4, 3, 3.0F, 3.0F, 1.5F, 1.0F}, T);
+      writer.add_color(frame.timestamp_ns + 5, static_cast<uint32_t>(frame.index), rgb,
+                       Intrinsics{4, 3, 3.0F, 3.0F, 1.5F, 1.0F}, T);
     }
   }
   writer.close();

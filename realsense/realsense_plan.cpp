@@ -141,6 +141,48 @@ int64_t HostClockMapper::host_time_ns(double timestamp_ms, TimestampDomain frame
   return arrival_ns;
 }
 
+std::vector<StreamKind> file_streams(const SourceConfig& source) {
+  std::vector<StreamKind> streams = {StreamKind::depth};
+  if (source.color.enabled) streams.push_back(StreamKind::color);
+  return streams;
+}
+
+FrameTimes FrameClock::times(double timestamp_ms, TimestampDomain domain, uint64_t frame_number,
+                             int64_t arrival_ns) {
+  FrameTimes out;
+  const int64_t stamp_ns = timestamp_ms_to_ns(timestamp_ms);
+  if (!from_file) {
+    out.timestamp_ns = stamp_ns;
+    out.host_time_ns = host_clock.host_time_ns(timestamp_ms, domain, arrival_ns);
+    return out;
+  }
+  if (has_last) {
+    if (frame_number != last_number) numbered = true;
+    if (numbered && frame_number == last_number && stamp_ns <= last_stamp_ns) {
+      out.deliver = false;  // the same frame again: the previous one was delivered
+      return out;
+    }
+    if (stamp_ns <= last_stamp_ns) {  // earlier, or a one-frame file again: timestamps must rise
+      // A new lap: its first frame one nominal period after the last one delivered.
+      const double fps = nominal_fps > 0.0 ? nominal_fps : 30.0;
+      lap_offset_ns = last_stamp_ns + lap_offset_ns + std::llround(1e9 / fps) - stamp_ns;
+      ++laps;
+    }
+  }
+  has_last = true;
+  last_stamp_ns = stamp_ns;
+  last_number = frame_number;
+  out.timestamp_ns = stamp_ns + lap_offset_ns;
+  return out;  // host_time_ns 0: run_pipeline decides, as for every recorded source
+}
+
+void FrameClock::reset() {
+  host_clock.reset();
+  has_last = false;
+  numbered = false;
+  lap_offset_ns = 0;
+}
+
 void FrameGapCounter::add(uint64_t frame_number) {
   constexpr uint64_t kWrap32 = uint64_t{1} << 32;
   if (has_last) {

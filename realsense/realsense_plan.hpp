@@ -125,6 +125,49 @@ struct HostClockMapper {
 /// The frame's own timestamp (ms, as the SDK gives it) in integer ns, rounded.
 int64_t timestamp_ms_to_ns(double timestamp_ms);
 
+// ---- Playing a file (source.path names a .bag)
+
+/// The streams to enable when the SDK plays a file: depth (Z16), and colour (RGB8) when
+/// `source.color.enabled`; never the file's other streams. With every stream enabled the SDK's
+/// pipeline drops the file's first depth frame (it holds it back to match streams nobody reads).
+std::vector<StreamKind> file_streams(const SourceConfig& source);
+
+/// A frame's times as the adapter hands them on.
+struct FrameTimes {
+  bool deliver = true;        ///< false: the same frame again (a looped file's last frame): skip it
+  int64_t timestamp_ns = 0;   ///< Frame::timestamp_ns
+  /// Frame::host_time_ns: a live camera's capture time on the host's steady clock; 0 for a file,
+  /// so that run_pipeline gives it the host time it gives a bag source (docs/ROBOT.md, "Clocks").
+  int64_t host_time_ns = 0;
+};
+
+/// Turns the SDK's frame timestamps into hrcsense's, for a live camera or a file.
+/// Live: the timestamp as the SDK gives it, the host time mapped by `host_clock`.
+/// File: host time 0 (above), and the timestamps of a looped file keep rising as BagSource's do:
+/// the SDK starts a file over with earlier timestamps and first hands on the file's last frame
+/// again. A frame with the number of the one before and a timestamp not after it is that repeat
+/// (in a file whose frames are numbered: numbers that never change say nothing) and is skipped;
+/// a timestamp not after the one before starts a lap, placed one nominal period after the
+/// last frame delivered, its frames keeping their steps.
+struct FrameClock {
+  bool from_file = false;
+  double nominal_fps = 30.0;   ///< file: the depth stream's rate, which spaces the laps (frames/s)
+  HostClockMapper host_clock;  ///< live only
+
+  /// The times of a depth frame stamped `timestamp_ms` in `domain`, numbered `frame_number`, that
+  /// arrived at `arrival_ns` (host steady clock).
+  FrameTimes times(double timestamp_ms, TimestampDomain domain, uint64_t frame_number, int64_t arrival_ns);
+  /// A restart of the camera (reconnect): a new device clock, a new stream.
+  void reset();
+
+  bool has_last = false;
+  int64_t last_stamp_ns = 0;      ///< the SDK's timestamp of the last frame seen
+  uint64_t last_number = 0;       ///< its frame number
+  bool numbered = false;          ///< two frames of the file had different numbers
+  int64_t lap_offset_ns = 0;      ///< added to the SDK's timestamps of the current lap
+  int64_t laps = 0;               ///< how often the file started over
+};
+
 // ---- Drops
 
 /// Counts the frames a camera made that never arrived, from gaps in its frame numbers

@@ -116,7 +116,7 @@ struct RealSenseSource::Impl {
   CameraLink link;
   std::atomic<ReasonCode> silence{ReasonCode::no_frame};
 
-  HostClockMapper clock;
+  FrameClock clock;
   FrameGapCounter gaps;
   SettleGate settle;
   std::string error;
@@ -126,6 +126,11 @@ struct RealSenseSource::Impl {
     from_file = !params.source.path.empty();
     if (from_file) {
       config.enable_device_from_file(params.source.path, params.source.loop);
+      // Only the streams asked for: with all of the file's, the SDK drops its first depth frame.
+      for (const StreamKind stream : file_streams(params.source)) {
+        if (stream == StreamKind::depth) config.enable_stream(RS2_STREAM_DEPTH, RS2_FORMAT_Z16);
+        if (stream == StreamKind::color) config.enable_stream(RS2_STREAM_COLOR, RS2_FORMAT_RGB8);
+      }
     } else {
       select_camera();
     }
@@ -205,6 +210,8 @@ struct RealSenseSource::Impl {
       color_intrinsics = intrinsics_from_sdk(sdk_intrinsics(p.as<rs2::video_stream_profile>()));
     }
     clock.reset();
+    clock.from_file = from_file;
+    clock.nominal_fps = info.nominal_fps;
     gaps.reset();
     settle.frames = from_file ? 0 : frames_to_settle(params.source);  // a file's exposure settled when it was made
     settle.restart();
@@ -251,11 +258,10 @@ struct RealSenseSource::Impl {
     }
   }
 
-  void copy_frame(const rs2::frameset& frames, const rs2::depth_frame& depth, int64_t arrival_ns, Frame& out) {
+  void copy_frame(const rs2::frameset& frames, const rs2::depth_frame& depth, const FrameTimes& times, Frame& out) {
     out.index = index++;
-    out.timestamp_ns = timestamp_ms_to_ns(depth.get_timestamp());
-    out.host_time_ns = clock.host_time_ns(depth.get_timestamp(),
-                                          static_cast<TimestampDomain>(depth.get_frame_timestamp_domain()), arrival_ns);
+    out.timestamp_ns = times.timestamp_ns;
+    out.host_time_ns = times.host_time_ns;
     out.intrinsics = info.intrinsics;
     out.stereo_baseline_mm = info.stereo_baseline_mm;
     out.depth.depth_scale_m = depth_scale_m;
@@ -315,9 +321,13 @@ struct RealSenseSource::Impl {
         link.frame_arrived(arrival_ns);
         silence = link.silence_code();
       }
+      const FrameTimes times =
+          clock.times(depth.get_timestamp(), static_cast<TimestampDomain>(depth.get_frame_timestamp_domain()),
+                      depth.get_frame_number(), arrival_ns);
+      if (!times.deliver) continue;  // a looped file's last frame, handed on again
       gaps.add(depth.get_frame_number());
       if (settle.skip()) continue;  // auto exposure still settling: not for background learning
-      copy_frame(frames, depth, arrival_ns, out);
+      copy_frame(frames, depth, times, out);
       return Status::frame;
     }
   }

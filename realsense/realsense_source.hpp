@@ -28,7 +28,9 @@ struct RealSenseParams {
 /// SDK options applied to the depth sensor, frames after auto exposure settled, timestamps
 /// mapped to the host's steady clock, frame-number gaps counted, and an unplugged camera
 /// reported (camera_disconnected) until the same serial is back. With source.path naming a
-/// `.bag`, the same pipeline plays the file, every frame (not in real time).
+/// `.bag`, the same pipeline plays the file, every frame (not in real time), as BagSource would:
+/// only the streams asked for, the host time left to run_pipeline, looped timestamps rising
+/// (file_streams, FrameClock; docs/CAMERAS.md, "`.bag` playback through the SDK").
 class RealSenseSource : public Source {
  public:
   /// Opens and starts the camera or file; throws RealSenseError (no camera, a profile it does

@@ -39,6 +39,8 @@ int record_command(const CommandArgs& args) {
   check_record_output(config, args.out, args.overwrite);
   SourceOptions source_options;
   source_options.stop_requested = &g_record_stop;
+  // A recording keeps what the source has: a folder's or bag's colour frames too.
+  source_options.with_color = true;
   std::unique_ptr<Source> source = make_source(config, source_options);
   const SourceInfo info = source->info();
   // The robot's joints at each frame go to /hrcsense/joint_states beside it, looked up as an
@@ -62,7 +64,13 @@ int record_command(const CommandArgs& args) {
       source_error = source->error();
       break;
     }
-    if (frames == 0) first_ns = frame.timestamp_ns;
+    if (frames == 0) {
+      first_ns = frame.timestamp_ns;
+      if (frame.color && !color_recordable(frame)) {
+        spdlog::warn("record: the source's colour frames have no calibration (a folder without rgb_K): recording "
+                     "depth only");
+      }
+    }
     // --duration-s counts source time: the frame at first + S is the first one left out.
     if (args.duration_s > 0.0 && frame.timestamp_ns - first_ns >= duration_ns) break;
     // No processing to protect: wait rather than drop.

@@ -79,7 +79,7 @@ const std::string& bag_path(const BagKind& kind) {
     if (kind.color) {
       // A smooth image, as LZ4 sees a real one: mostly gradients.
       for (size_t p = 0; p < color.rgb.size(); ++p) color.rgb[p] = static_cast<uint8_t>((p / 3 + p % 3 * 50 + i) / 16);
-      writer.add_color(frame.timestamp_ns + 1000, color, frame.intrinsics);
+      writer.add_color(frame.timestamp_ns + 1000, static_cast<uint32_t>(frame.index), color, frame.intrinsics);
     }
   }
   writer.close();

@@ -58,6 +58,11 @@ struct BagWriterParams {
   std::vector<std::string> joint_names;
 };
 
+/// True when add_frame records the frame's colour image: it has one, and its calibration
+/// (Frame::color_intrinsics of the image's size, focal lengths known). A folder without `rgb_K`
+/// has colour without calibration: its frames are recorded without colour.
+bool color_recordable(const Frame& frame);
+
 /// Writes one bag; messages go into chunks as they come, the index on close() (or destruction).
 /// Every method throws BagWriteError naming the file when the file system refuses, or when an
 /// image's buffer does not match its size.
@@ -68,7 +73,7 @@ class BagWriter {
   BagWriter(const BagWriter&) = delete;
   BagWriter& operator=(const BagWriter&) = delete;
 
-  /// The frame's depth image (and its colour image when it has one, with depth_to_color as
+  /// The frame's depth image (and its colour image when color_recordable, with depth_to_color as
   /// the colour stream's tf), and with `robot_state` the robot's joints at it (add_joint_state:
   /// positions and velocities), in that order: colour, joints, depth. Stream info, camera_info
   /// and tf go out with a stream's first frame.
@@ -76,9 +81,10 @@ class BagWriter {
   /// The depth image alone. Bag time: the frame's timestamp relative to the first frame's
   /// (plus 2 ns: the SDK's playback reads streams from there), header stamp: its timestamp.
   void add_depth(const Frame& frame);
-  /// An rgb8 colour image; T_color_depth (depth-frame points into the colour frame, the SDK's
-  /// depth→colour extrinsics) is the colour stream's tf.
-  void add_color(int64_t timestamp_ns, const ColorImage& color, const Intrinsics& intrinsics,
+  /// An rgb8 colour image numbered `frame_number` (header.seq and the "Frame Counter" metadata;
+  /// add_frame gives the frame's index, as for its depth image); T_color_depth (depth-frame
+  /// points into the colour frame, the SDK's depth→colour extrinsics) is the colour stream's tf.
+  void add_color(int64_t timestamp_ns, uint32_t frame_number, const ColorImage& color, const Intrinsics& intrinsics,
                  const Pose& T_color_depth = Pose::Identity());
   /// The robot's joints at a frame as `/hrcsense/joint_states` (sensor_msgs/JointState stamped
   /// `timestamp_ns`: names from params.joint_names, positions in rad, velocities in rad/s when
@@ -117,6 +123,8 @@ class BagWriter {
   void write(const uint8_t* data, size_t size);
   void write_bag_header(uint64_t index_pos, uint32_t conn_count, uint32_t chunk_count);
   void write_static_info();
+  /// A Depth_Units or Stereo_Baseline option of the stereo module: its value and description.
+  void put_option(const std::string& name, float value, const std::string& description);
   uint32_t topic(const std::string& name, const char* type, const char* md5);
   void begin_message(uint32_t conn, int64_t time_ns);
   void end_message();

@@ -22,6 +22,7 @@ struct RecordingStream {
   int64_t frames = 0;        ///< frames found (a damaged file: frames before the damage)
   int64_t first_ns = 0;      ///< timestamp of the first frame, nanoseconds (0 when unknown)
   int64_t last_ns = 0;       ///< timestamp of the last frame, nanoseconds
+  uint32_t fps = 0;          ///< the rate the recording states (bag: StreamInfo), frames/s; 0: none
 };
 
 /// What a recording holds, for `hrcsense info` and for tests. Read by going through the

@@ -51,6 +51,7 @@ TopicRole classify_topic(std::string_view topic) {
   const std::string_view what = rest.substr(slash);
   if (what == "/image/data") out.role = Role::image;
   if (what == "/info/camera_info") out.role = Role::camera_info;
+  if (what == "/info") out.role = Role::stream_info;
   if (what.rfind("/tf/", 0) == 0) out.role = Role::tf;
   if (out.role == Role::other) out.stream.clear();
   return out;
@@ -114,6 +115,16 @@ std::string parse_camera_info(Cursor c, Intrinsics& out) {
   const std::string problem = intrinsics_problem(in, IntrinsicsFieldNames{"K[0]", "K[4]", "K[2]", "K[5]", "D"});
   if (!problem.empty()) return "camera_info: " + problem;
   out = in;
+  return {};
+}
+
+std::string parse_stream_info(Cursor c, StreamInfoMessage& out) {
+  const auto fps = c.get<uint32_t>();
+  const std::string_view encoding = c.string();
+  c.get<uint8_t>();  // is_recommended: not used
+  if (!c.ok) return "stream info message is cut off";
+  out.fps = fps;
+  out.encoding = encoding;
   return {};
 }
 

@@ -13,7 +13,7 @@
 namespace hrcsense::bag {
 
 /// What a topic of the SDK's layout carries, as far as hrcsense cares.
-enum class Role { other, image, camera_info, tf, depth_units, stereo_baseline, file_version, joint_states };
+enum class Role { other, image, camera_info, stream_info, tf, depth_units, stereo_baseline, file_version, joint_states };
 
 /// hrcsense's own topic beside the SDK's: the robot's joints at each frame (sensor_msgs/JointState).
 inline constexpr std::string_view kJointStatesTopic = "/hrcsense/joint_states";
@@ -78,6 +78,14 @@ struct ImageView {
 std::string parse_image(Cursor cursor, ImageView& out);
 /// Parses a CameraInfo into intrinsics (the SDK's model names; at most 5 coefficients).
 std::string parse_camera_info(Cursor cursor, Intrinsics& out);
+/// realsense_msgs/StreamInfo (spec §4): the rate the stream was recorded at, as the SDK states it.
+struct StreamInfoMessage {
+  uint32_t fps = 0;            ///< frames/s; not checked here (the caller judges the streams it plays)
+  std::string_view encoding;   ///< e.g. "mono16", "rgb8"
+};
+
+/// Parses a StreamInfo; "" or what is wrong (cut off).
+std::string parse_stream_info(Cursor cursor, StreamInfoMessage& out);
 /// Parses a geometry_msgs/Transform: P_stream = R·P_ref + t, i.e. T_stream_ref.
 std::string parse_transform(Cursor cursor, Pose& out);
 

@@ -7,6 +7,7 @@
 #include "hrcsense/io.hpp"
 #include "hrcsense/recordings.hpp"
 
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -15,6 +16,12 @@ namespace hrcsense {
 
 /// Depth units when neither the image nor an option says (the SDK's default).
 constexpr float kDefaultDepthUnitsM = 0.001F;
+/// The rate of a bag that states none (no StreamInfo, e.g. a bag written without the SDK's
+/// metadata): the D435's default depth rate.
+constexpr double kDefaultFps = 30.0;
+/// The rates a depth stream's StreamInfo may state: a D400 streams at most 300 frames/s; a
+/// damaged 0 would divide by zero in pacing, a huge one would make every gap a skip.
+constexpr uint32_t kMaxFps = 1000;
 
 /// Everything BagSource knows while it plays a bag.
 struct BagState {
@@ -26,12 +33,13 @@ struct BagState {
   std::string color_stream;                  ///< e.g. "Color_0"
   std::map<std::string, Intrinsics> intrinsics;  ///< by stream, from camera_info
   std::map<std::string, Pose> tf;            ///< by stream: T_stream_reference
+  std::map<std::string, uint32_t> fps;       ///< by stream, from its StreamInfo (frames/s)
   float depth_units_option_m = 0.0F;         ///< last Depth_Units option; 0 before any
   float stereo_baseline_mm = 0.0F;
   int file_version = 0;
   // Counts over what has been read so far.
-  RecordingStream depth_info{"depth", "", {}, 0, 0, 0};
-  RecordingStream color_info{"color", "", {}, 0, 0, 0};
+  RecordingStream depth_info{"depth", "", {}, 0, 0, 0, 0};
+  RecordingStream color_info{"color", "", {}, 0, 0, 0, 0};
   ColorImage color;                          ///< the latest decoded colour frame
   bool have_color = false;
   /// RecordingParams::with_joint_states: the /hrcsense/joint_states read so far; null without.
@@ -135,6 +143,26 @@ std::string read_joint_state(BagState& s, const BagMessage& m, const bag::Cursor
   return {};
 }
 
+/// Keeps a stream's stated rate; "" or what is wrong. Only depth streams must state a usable
+/// rate (it paces the replay); the others' rates are kept as they are.
+std::string read_stream_info(BagState& s, const bag::TopicRole& role, const bag::Cursor& cursor) {
+  bag::StreamInfoMessage info;
+  std::string problem = bag::parse_stream_info(cursor, info);
+  if (!problem.empty()) return problem;
+  if (role.stream.rfind("Depth_", 0) == 0 && (info.fps == 0 || info.fps > kMaxFps)) {
+    return "StreamInfo field fps is " + std::to_string(info.fps) + ", not a frame rate (1 to " +
+           std::to_string(kMaxFps) + " frames/s)";
+  }
+  s.fps[role.stream] = info.fps;
+  return {};
+}
+
+/// The depth stream's stated rate, else kDefaultFps.
+double depth_fps(const BagState& s) {
+  const auto found = s.fps.find(s.depth_stream);
+  return found == s.fps.end() ? kDefaultFps : static_cast<double>(found->second);
+}
+
 /// Handles messages until one depth frame has been decoded into `out` (true) or the bag ends
 /// (false). Colour frames are decoded only when `with_color`. Throws IoError on damage.
 bool read_depth_frame(BagState& s, bool with_color, Frame& out) {
@@ -159,6 +187,9 @@ bool read_depth_frame(BagState& s, bool with_color, Frame& out) {
         break;
       case bag::Role::camera_info:
         problem = bag::parse_camera_info(cursor, s.intrinsics[role.stream]);
+        break;
+      case bag::Role::stream_info:
+        problem = read_stream_info(s, role, cursor);
         break;
       case bag::Role::tf:
         problem = bag::parse_transform(cursor, s.tf[role.stream]);
@@ -243,7 +274,7 @@ SourceInfo BagSource::info() const {
                      (s.reader.indexed() ? "indexed" : "not indexed: " + s.reader.index_problem()) + ")";
   info.intrinsics = s.pending.intrinsics.width > 0 ? s.pending.intrinsics : s.intrinsics.at(s.depth_stream);
   info.stereo_baseline_mm = s.stereo_baseline_mm > 0.0F ? s.stereo_baseline_mm : params_.stereo_baseline_mm;
-  info.nominal_fps = 30.0;
+  info.nominal_fps = depth_fps(s);  // the rate the bag states, which pacing and the watchdog count in
   info.frame_count = -1;
   if (s.reader.indexed() && !params_.loop) {
     for (const auto& [id, connection] : s.reader.connections()) {
@@ -268,8 +299,9 @@ Source::Status BagSource::next(Frame& out) {
       s.has_pending = false;
     } else if (!read_depth_frame(s, params_.with_color, out)) {
       if (!params_.loop) return Status::end;
-      // Each lap starts one nominal period after the last frame of the previous one.
-      s.lap_offset_ns += s.depth_info.last_ns - s.depth_info.first_ns + 33333333;
+      // Each lap starts one nominal period (of the bag's stated rate) after the last frame of the
+      // previous one.
+      s.lap_offset_ns += s.depth_info.last_ns - s.depth_info.first_ns + std::llround(1e9 / depth_fps(s));
       s.reader.rewind();
       if (!read_depth_frame(s, params_.with_color, out)) return Status::end;
     }
@@ -323,9 +355,11 @@ RecordingSummary summarize_bag(const std::string& path) {
   summary.depth_units_m = s.depth_units_option_m > 0.0F ? s.depth_units_option_m : kDefaultDepthUnitsM;
   if (s.depth_info.frames > 0) summary.depth_units_m = frame.depth.depth_scale_m;
   s.depth_info.intrinsics = s.intrinsics[s.depth_stream];
+  if (s.fps.count(s.depth_stream) != 0) s.depth_info.fps = s.fps.at(s.depth_stream);
   summary.streams.push_back(s.depth_info);
   if (!s.color_stream.empty()) {
     s.color_info.intrinsics = s.intrinsics[s.color_stream];
+    if (s.fps.count(s.color_stream) != 0) s.color_info.fps = s.fps.at(s.color_stream);
     summary.streams.push_back(s.color_info);
     const auto depth_tf = s.tf.find(s.depth_stream);
     const auto color_tf = s.tf.find(s.color_stream);

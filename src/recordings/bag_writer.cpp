@@ -21,6 +21,7 @@ constexpr const char* kKeyValueMd5 = "cf57fdc6617a881a88c16e768132149c";
 constexpr const char* kStreamInfoMd5 = "311d7e24eac31bb87271d041bf70ff7d";
 constexpr const char* kFloat32Md5 = "73fcbf46b49191e672908e50842a83d4";
 constexpr const char* kUInt32Md5 = "304a39449588c7f8ce2df6e8001c5fce";
+constexpr const char* kStringMd5 = "992ce8a1687cec8c8bd883ec73ca41d1";
 constexpr const char* kJointStateMd5 = "3066dcd76a6cfaef579bd0f34173e9fd";
 
 const std::string kDepthStream = "/device_0/sensor_0/Depth_0";
@@ -156,6 +157,12 @@ std::vector<uint8_t> key_value_message(const std::string& key, const std::string
   return b;
 }
 
+std::vector<uint8_t> string_message(const std::string& text) {
+  std::vector<uint8_t> b;
+  put_string(b, text);
+  return b;
+}
+
 std::vector<uint8_t> u32_message(uint32_t v) {
   std::vector<uint8_t> b;
   put32(b, v);
@@ -179,6 +186,14 @@ Pose extrinsics_pose(const Extrinsics& e) {
 }
 
 }  // namespace
+
+bool color_recordable(const Frame& frame) {
+  // A colour stream needs its camera_info: without one the SDK cannot play it, and hrcsense's
+  // reader refuses a camera_info with a zero focal length.
+  return frame.color && frame.color->width > 0 && frame.color_intrinsics.width == frame.color->width &&
+         frame.color_intrinsics.height == frame.color->height && frame.color_intrinsics.fx > 0.0F &&
+         frame.color_intrinsics.fy > 0.0F;
+}
 
 void BagWriter::FileCloser::operator()(std::FILE* file) const { std::fclose(file); }
 void BagWriter::Lz4Freer::operator()(LZ4F_cctx_s* context) const { LZ4F_freeCompressionContext(context); }
@@ -237,13 +252,20 @@ void BagWriter::write_static_info() {
                   "RGB Camera");
   }
   if (params_.depth_units_option_m > 0.0F) {
-    put_message(topic("/device_0/sensor_0/option/Depth_Units/value", "std_msgs/Float32", kFloat32Md5), kStaticTimeNs,
-                f32_message(params_.depth_units_option_m));
+    put_option("Depth_Units", params_.depth_units_option_m, "Metres per raw depth unit of the depth image");
   }
   if (params_.stereo_baseline_mm > 0.0F) {
-    put_message(topic("/device_0/sensor_0/option/Stereo_Baseline/value", "std_msgs/Float32", kFloat32Md5),
-                kStaticTimeNs, f32_message(params_.stereo_baseline_mm));
+    put_option("Stereo_Baseline", params_.stereo_baseline_mm, "Distance between the two infrared imagers, in mm");
   }
+}
+
+void BagWriter::put_option(const std::string& name, float value, const std::string& description) {
+  const std::string option = "/device_0/sensor_0/option/" + name;
+  put_message(topic(option + "/value", "std_msgs/Float32", kFloat32Md5), kStaticTimeNs, f32_message(value));
+  // The SDK's playback reads every option's description beside its value and logs an error
+  // for each one missing (its viewer then shows "N/A"): always write both (spec §3).
+  put_message(topic(option + "/description", "std_msgs/String", kStringMd5), kStaticTimeNs,
+              string_message(description));
 }
 
 uint32_t BagWriter::topic(const std::string& name, const char* type, const char* md5) {
@@ -363,8 +385,8 @@ void BagWriter::add_depth(const Frame& frame) {
             reinterpret_cast<const uint8_t*>(d.pixels.data()), static_cast<size_t>(d.width) * 2, d.depth_scale_m);
 }
 
-void BagWriter::add_color(int64_t timestamp_ns, const ColorImage& color, const Intrinsics& intrinsics,
-                          const Pose& T_color_depth) {
+void BagWriter::add_color(int64_t timestamp_ns, uint32_t frame_number, const ColorImage& color,
+                          const Intrinsics& intrinsics, const Pose& T_color_depth) {
   if (color.width <= 0 || color.height <= 0 ||
       color.rgb.size() != static_cast<size_t>(color.width) * static_cast<size_t>(color.height) * 3) {
     throw BagWriteError(path_ + ": colour image of " + std::to_string(color.width) + "x" + std::to_string(color.height) +
@@ -374,7 +396,7 @@ void BagWriter::add_color(int64_t timestamp_ns, const ColorImage& color, const I
     start_stream(kColorStream, "rgb8", intrinsics, T_color_depth);
     color_started_ = true;
   }
-  put_image(kColorStream, timestamp_ns, 0, color.width, color.height, "rgb8", color.rgb.data(),
+  put_image(kColorStream, timestamp_ns, frame_number, color.width, color.height, "rgb8", color.rgb.data(),
             static_cast<size_t>(color.width) * 3, 0.0F);
 }
 
@@ -383,9 +405,11 @@ void BagWriter::add_frame(const Frame& frame, const RobotState* robot_state) {
   // and joint state in file order (hrcsense's BagSource) then gets this frame's own. The joints
   // after the colour keep an SDK-sized colour image in a chunk of its own, which a reader that
   // wants no colour skips undecompressed.
-  if (frame.color && frame.color->width > 0) {
+  if (color_recordable(frame)) {
     const Pose T_color_depth = frame.depth_to_color ? extrinsics_pose(*frame.depth_to_color) : Pose::Identity();
-    add_color(frame.timestamp_ns, *frame.color, frame.color_intrinsics, T_color_depth);
+    // The depth frame's number: a frame's colour and depth images are one capture.
+    add_color(frame.timestamp_ns, static_cast<uint32_t>(frame.index), *frame.color, frame.color_intrinsics,
+              T_color_depth);
   }
   if (robot_state != nullptr) add_joint_state(frame.timestamp_ns, robot_state->q_rad, robot_state->qd_rad_s);
   add_depth(frame);

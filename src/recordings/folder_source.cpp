@@ -316,7 +316,7 @@ RecordingSummary summarize_folder(const std::string& path) {
   summary.path = path;
   summary.format = "folder (" + source.layout() + " layout)";
   summary.compression = "png";
-  RecordingStream depth{"depth", "png (16-bit)", source.info().intrinsics, 0, 0, 0};
+  RecordingStream depth{"depth", "png (16-bit)", source.info().intrinsics, 0, 0, 0, 0};
   Frame frame;
   Source::Status status = Source::Status::frame;
   while ((status = source.next(frame)) == Source::Status::frame) {
@@ -331,7 +331,7 @@ RecordingSummary summarize_folder(const std::string& path) {
   // Colour images are listed, not decoded: count them and name their format.
   const fs::path rgb = fs::path(path) / "rgb";
   if (fs::is_directory(rgb)) {
-    RecordingStream color{"color", "", {}, 0, 0, 0};
+    RecordingStream color{"color", "", {}, 0, 0, 0, 0};
     for (const fs::directory_entry& entry : fs::directory_iterator(rgb)) {
       const std::string ext = entry.path().extension().string();
       if (ext != ".png" && ext != ".jpg" && ext != ".jpeg") continue;

@@ -74,7 +74,8 @@ void write_walk_bag(const std::string& path, const test::BagWriterParams& params
   for (const Frame& frame : walk_frames()) {
     writer.add_depth(frame);
     if (with_color && frame.index == 1) {
-      writer.add_color(frame.timestamp_ns + 1000, gradient(32, 24), color_intrinsics(), color_pose());
+      writer.add_color(frame.timestamp_ns + 1000, static_cast<uint32_t>(frame.index), gradient(32, 24),
+                       color_intrinsics(), color_pose());
     }
   }
   writer.close();
@@ -242,6 +243,60 @@ TEST(BagRoundTrip, ImplausibleCameraInfoIsRefusedNamingTheField) {
     error = e.what();
   }
   EXPECT_NE(error.find("K[0]"), std::string::npos) << "error: '" << error << "'";
+}
+
+}  // namespace
+}  // namespace hrcsense
+
+namespace hrcsense {
+namespace {
+
+// Issue 31 item 7: the rate a bag's depth StreamInfo states is the source's nominal rate, and a
+// loop's next lap starts one period of it after the lap's last frame.
+TEST(BagRoundTrip, TheStatedRateIsTheNominalRateAndPacesTheLoop) {
+  test::ScratchDir dir("bagrt");
+  const std::string path = dir / "six.bag";
+  test::BagWriterParams params;
+  params.fps = 6;
+  write_walk_bag(path, params, false);
+  RecordingParams loop{path};
+  loop.loop = true;
+  BagSource source(loop);
+  EXPECT_EQ(source.info().nominal_fps, 6.0);
+  Frame frame;
+  std::vector<int64_t> stamps_ns;
+  for (int i = 0; i <= kFrames; ++i) {
+    ASSERT_EQ(source.next(frame), Source::Status::frame) << source.error();
+    stamps_ns.push_back(frame.timestamp_ns);
+  }
+  // The second lap's first frame: 1/6 s (166 666 666.7 ns, rounded) after the first lap's last.
+  EXPECT_EQ(stamps_ns[kFrames] - stamps_ns[kFrames - 1], 166'666'667);
+}
+
+TEST(BagRoundTrip, ABagThatStatesNoRateIsNominallyAt30FramesPerSecond) {
+  test::ScratchDir dir("bagrt");
+  const std::string path = dir / "bare.bag";
+  test::BagWriterParams params;
+  params.sdk_metadata = false;  // no StreamInfo at all
+  write_walk_bag(path, params, false);
+  EXPECT_EQ(BagSource(RecordingParams{path}).info().nominal_fps, 30.0) << "the D435's default rate";
+}
+
+TEST(BagRoundTrip, AStatedDepthRateOfZeroIsRefusedNamingFileTopicAndField) {
+  test::ScratchDir dir("bagrt");
+  const std::string path = dir / "zero.bag";
+  test::BagWriterParams params;
+  params.fps = 0;
+  write_walk_bag(path, params, false);
+  std::string error;
+  try {
+    BagSource source(RecordingParams{path});
+  } catch (const IoError& e) {
+    error = e.what();
+  }
+  EXPECT_NE(error.find(path), std::string::npos) << error;
+  EXPECT_NE(error.find("/device_0/sensor_0/Depth_0/info"), std::string::npos) << error;
+  EXPECT_NE(error.find("fps is 0"), std::string::npos) << error;
 }
 
 }  // namespace

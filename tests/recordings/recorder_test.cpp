@@ -20,6 +20,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <set>
 #include <thread>
 
@@ -271,6 +272,86 @@ TEST(Recorder, WritesEveryRecordTheSpecListsForSdkPlayback) {
   for (const char* key : {"Name", "Serial Number", "Firmware Version", "Product Id", "Product Line"}) {
     EXPECT_EQ(device_keys.count(key), 1U) << key;
   }
+}
+
+/// The image messages' header.seq (the first uint32, spec §4) and the "Frame Counter" metadata
+/// values of `stream` ("/device_0/sensor_1/Color_0"), in file order.
+struct FrameNumbers {
+  std::vector<uint32_t> seq;
+  std::vector<std::string> counter;
+};
+FrameNumbers frame_numbers(const std::string& path, const std::string& stream) {
+  FrameNumbers out;
+  BagReader reader(path);
+  BagMessage m;
+  for (int guard = 0; guard < 100000 && reader.next(m); ++guard) {
+    const std::string& topic = reader.connections().at(m.conn).topic;
+    if (topic == stream + "/image/data") {
+      uint32_t seq = 0;
+      std::memcpy(&seq, m.data, 4);
+      out.seq.push_back(seq);
+    }
+    if (topic == stream + "/image/metadata") {  // KeyValue: string key, string value
+      uint32_t key_len = 0, value_len = 0;
+      std::memcpy(&key_len, m.data, 4);
+      const std::string key(reinterpret_cast<const char*>(m.data) + 4, key_len);
+      std::memcpy(&value_len, m.data + 4 + key_len, 4);
+      if (key == "Frame Counter") out.counter.emplace_back(reinterpret_cast<const char*>(m.data) + 8 + key_len, value_len);
+    }
+  }
+  return out;
+}
+
+TEST(Recorder, ColourFramesAreNumberedAsTheFramesTheyBelongTo) {
+  ScratchDir dir("recorder");
+  const std::string path = dir / "numbers.bag";
+  ASSERT_TRUE(record_cell(recorder_params(path), 3, {"sim.width=424", "sim.height=240"}).error.empty());
+  // The simulator numbers its frames 0, 1, 2; a frame's colour image is part of the same capture.
+  const FrameNumbers color = frame_numbers(path, "/device_0/sensor_1/Color_0");
+  EXPECT_EQ(color.seq, (std::vector<uint32_t>{0, 1, 2}));
+  EXPECT_EQ(color.counter, (std::vector<std::string>{"0", "1", "2"}));
+  const FrameNumbers depth = frame_numbers(path, "/device_0/sensor_0/Depth_0");
+  EXPECT_EQ(depth.seq, (std::vector<uint32_t>{0, 1, 2}));
+}
+
+TEST(Recorder, EveryOptionValueHasItsDescription) {
+  ScratchDir dir("recorder");
+  const std::string path = dir / "options.bag";
+  RecorderParams params = recorder_params(path);
+  params.bag.stereo_baseline_mm = 50.0F;
+  ASSERT_TRUE(record_cell(params, 1, {"sim.width=424", "sim.height=240"}).error.empty());
+  // Spec §3: each `option/<Name>/value` comes with an `option/<Name>/description`, a
+  // std_msgs/String (md5 992ce8a1687cec8c8bd883ec73ca41d1) written once.
+  BagReader reader(path);
+  std::map<std::string, std::string> type_of, md5_of;
+  for (const auto& [id, c] : reader.connections()) {
+    type_of[c.topic] = c.type;
+    md5_of[c.topic] = c.md5sum;
+  }
+  std::map<std::string, int> descriptions;  // topic -> messages
+  BagMessage m;
+  for (int guard = 0; guard < 100000 && reader.next(m); ++guard) {
+    const std::string& topic = reader.connections().at(m.conn).topic;
+    if (topic.size() < 12 || topic.compare(topic.size() - 12, 12, "/description") != 0) continue;
+    ++descriptions[topic];
+    uint32_t length = 0;
+    ASSERT_GE(m.size, 4U) << topic;
+    std::memcpy(&length, m.data, 4);
+    EXPECT_EQ(m.size, 4U + length) << topic << ": one string";
+    EXPECT_GT(length, 0U) << topic << ": a description says something";
+  }
+  int values = 0;
+  for (const auto& [topic, type] : type_of) {
+    const size_t at = topic.rfind("/value");
+    if (topic.find("/option/") == std::string::npos || at == std::string::npos || at + 6 != topic.size()) continue;
+    ++values;
+    const std::string description = topic.substr(0, at) + "/description";
+    ASSERT_EQ(type_of.count(description), 1U) << "no " << description;
+    EXPECT_EQ(type_of[description], "std_msgs/String");
+    EXPECT_EQ(md5_of[description], "992ce8a1687cec8c8bd883ec73ca41d1");
+    EXPECT_EQ(descriptions[description], 1) << description;
+  }
+  EXPECT_EQ(values, 2) << "Depth_Units and Stereo_Baseline";
 }
 
 TEST(Recorder, JointStatesGoToTheirOwnTopic) {

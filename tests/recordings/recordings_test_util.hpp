@@ -51,6 +51,13 @@ inline std::string shared_data(const std::string& name) {
   return std::filesystem::exists(path) ? path : std::string();
 }
 
+/// The real D435 recording (6 frames/s, two depth frames, one colour frame), or "" when the
+/// shared data is absent.
+inline std::string shared_d435_bag() {
+  const std::string dir = shared_data("librealsense_d435_single_frame");
+  return dir.empty() ? dir : dir + "/single_depth_color_640x480.bag";
+}
+
 /// Keeps everything a run writes.
 struct KeepingSink : Sink {
   std::vector<FrameResult> results;
