@@ -190,7 +190,8 @@ int run_session(const Config& config, const SessionOptions& args) {
   if (!args.record.empty()) check_record_output(config, args.record, args.overwrite);
   SourceOptions source_options;
   source_options.stop_requested = &g_stop_requested;
-  source_options.with_color = args.with_color;
+  // A recording keeps the source's colour, so --record decodes it even where processing does not.
+  source_options.with_color = args.with_color || !args.record.empty();
   // robot.trajectory.follow_link: the simulated arm, its state and its truth obey what is sent.
   const std::shared_ptr<TrajectoryClock> trajectory_clock = make_trajectory_clock(config);
   if (trajectory_clock) trajectory_clock->set_lockstep(!paced);
@@ -223,8 +224,9 @@ int run_session(const Config& config, const SessionOptions& args) {
     RecorderParams params = recorder_params(config, args.record, info);
     const RecordOnError on_error = params.on_error;
     recorder.emplace(std::move(params));
-    const RecordStateLookup lookup =
+    RecordStateLookup lookup =
         record_state_lookup(config, *source, *robot_states, paced, recorder_states, trajectory_clock);
+    lookup.from_processing = true;  // the state each frame was measured against (on_processed below)
     recording.emplace(*source, *recorder, on_error, lookup);
   }
   Source& frames = recording ? static_cast<Source&>(*recording) : *source;
@@ -283,6 +285,13 @@ int run_session(const Config& config, const SessionOptions& args) {
   // wait, is how the run ends.
   options.stop_requested = source_started ? &g_stop_requested : nullptr;
   options.on_processed = args.on_processed;
+  if (recorder) {
+    // The recording holds the state processing used, so its replay decides as this run did.
+    options.on_processed = [&recorder, &args](const Frame& frame, const Pipeline& pipeline, const FrameResult& result) {
+      recorder->state_used(frame.index, result.robot_state);
+      if (args.on_processed) args.on_processed(frame, pipeline, result);
+    };
+  }
   options.before_process = args.before_process;
   const RunSummary summary = run_pipeline(frames, *robot_states, pipeline, sinks, options, header);
   if (g_stop_signal.load() != 0) spdlog::info("{} received: the run ended with a stop", signal_name(g_stop_signal.load()));

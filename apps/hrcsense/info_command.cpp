@@ -101,6 +101,7 @@ int print_recording(const std::string& path) {
     } else {
       std::printf(", duration unknown");
     }
+    if (stream.fps > 0) std::printf(", stated %u frames/s", stream.fps);
     if (in.fx > 0.0F) {
       std::printf(", fx=%.4f fy=%.4f ppx=%.4f ppy=%.4f model=%s", static_cast<double>(in.fx),
                   static_cast<double>(in.fy), static_cast<double>(in.ppx), static_cast<double>(in.ppy),

@@ -58,6 +58,17 @@ class Recorder {
   /// As push(), but waits (at most `timeout_ms`) for room in the queue: for `hrcsense record`,
   /// where the recorder is the only consumer and should lose nothing to a fast source.
   bool push_wait(const Frame& frame, int timeout_ms, const std::optional<RobotState>& robot_state = std::nullopt);
+  /// As push(), but the joint state written for the frame is the one processing measured it
+  /// against, reported by state_used(): so that a replay of the recording decides on what the
+  /// live run decided on, never on a state looked up a moment earlier. `fallback` (the capture
+  /// time's lookup) is written instead when processing never takes the frame (a paced run
+  /// replaced it by a newer one, the run ended) or says nothing within kStateWaitMs.
+  bool push_awaiting_state(const Frame& frame, const std::optional<RobotState>& fallback);
+  /// From processing: frame `frame_index` was measured against `state` (not valid: against
+  /// none; the frame is then recorded without a joint state). Frames pushed before it that
+  /// still await theirs were never processed.
+  void state_used(int64_t frame_index, const RobotState& state);
+  static constexpr int kStateWaitMs = 1000;
   /// True once a write error happened (stats().error says which file and why).
   bool failed() const;
   /// Writes what is queued, closes (and indexes) the last file, joins the thread. Idempotent.
@@ -68,8 +79,11 @@ class Recorder {
   struct Item {
     Frame frame;
     std::optional<RobotState> robot_state;
+    bool awaiting_state = false;  ///< push_awaiting_state: robot_state is the fallback until state_used()
   };
-  bool enqueue(const Frame& frame, const std::optional<RobotState>& robot_state, int timeout_ms);
+  bool enqueue(const Frame& frame, const std::optional<RobotState>& robot_state, int timeout_ms, bool awaiting_state);
+  /// The front item can be written: its state is known, or it never will be.
+  bool front_ready() const;
   void writer_loop();
   void write_item(const Item& item);
   void open_next_file(const Frame& first);
@@ -81,6 +95,7 @@ class Recorder {
   std::vector<Item> spare_;  ///< written items whose buffers push() reuses (no allocation per frame)
   bool closing_ = false;
   bool writer_exited_ = false;  ///< the writer thread has left its loop: later items would stay queued
+  int64_t processed_index_ = -1;  ///< the newest frame index state_used() reported
   RecorderStats stats_;
   std::unique_ptr<BagWriter> writer_;  ///< writer thread only
   int part_ = 0;
@@ -92,6 +107,9 @@ class Recorder {
 /// the state the frame was measured against.
 struct RecordStateLookup {
   RobotStateSource* states = nullptr;    ///< null: no joint states are recorded
+  /// Processing reports each frame's state (Recorder::state_used, `hrcsense run --record`): the
+  /// lookup below is then only the fallback for frames processing never takes.
+  bool from_processing = false;
   /// host_time_is_source_time(origin, paced) of the run: a frame without its own host time is
   /// looked up at its timestamp (true) or at its delivery time on `clock` (false).
   bool host_time_is_source_time = true;

@@ -2,6 +2,7 @@
 // hrcsense — the recorder's writer thread and bounded queue.
 #include "hrcsense/recorder.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 
@@ -23,14 +24,41 @@ Recorder::Recorder(RecorderParams params) : params_(std::move(params)) {
 Recorder::~Recorder() { close(); }
 
 bool Recorder::push(const Frame& frame, const std::optional<RobotState>& robot_state) {
-  return enqueue(frame, robot_state, 0);
+  return enqueue(frame, robot_state, 0, false);
 }
 
 bool Recorder::push_wait(const Frame& frame, int timeout_ms, const std::optional<RobotState>& robot_state) {
-  return enqueue(frame, robot_state, timeout_ms);
+  return enqueue(frame, robot_state, timeout_ms, false);
 }
 
-bool Recorder::enqueue(const Frame& frame, const std::optional<RobotState>& robot_state, int timeout_ms) {
+bool Recorder::push_awaiting_state(const Frame& frame, const std::optional<RobotState>& fallback) {
+  return enqueue(frame, fallback, 0, true);
+}
+
+void Recorder::state_used(int64_t frame_index, const RobotState& state) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    processed_index_ = std::max(processed_index_, frame_index);
+    for (Item& item : queue_) {
+      if (!item.awaiting_state || item.frame.index != frame_index) continue;
+      // A state processing could not use (none, non-finite) is recorded as none: a replay then
+      // stops on that frame as the run did.
+      const bool usable = state.valid && all_finite(state.q_rad) && all_finite(state.qd_rad_s);
+      item.robot_state = usable ? std::optional<RobotState>(state) : std::nullopt;
+      item.awaiting_state = false;
+      break;
+    }
+  }
+  wake_writer_.notify_one();
+}
+
+bool Recorder::front_ready() const {
+  const Item& front = queue_.front();
+  return !front.awaiting_state || closing_ || processed_index_ >= front.frame.index;
+}
+
+bool Recorder::enqueue(const Frame& frame, const std::optional<RobotState>& robot_state, int timeout_ms,
+                       bool awaiting_state) {
   std::unique_lock<std::mutex> lock(mutex_);
   const auto has_room = [this] {
     return closing_ || !stats_.error.empty() || queue_.size() < static_cast<size_t>(params_.queue_frames);
@@ -51,6 +79,7 @@ bool Recorder::enqueue(const Frame& frame, const std::optional<RobotState>& robo
   item.frame = frame;
   item.frame.truth.reset();  // ground truth is not recorded
   item.robot_state = robot_state;
+  item.awaiting_state = awaiting_state;
   lock.lock();
   if (writer_exited_) {  // close() finished meanwhile: nobody would write it
     ++stats_.frames_dropped;
@@ -115,6 +144,11 @@ void Recorder::writer_loop() {
       writer_exited_ = true;
       break;
     }
+    // A frame whose state processing reports waits for it; the items behind it keep their
+    // order (the recording's joint state precedes its frame, file order is time order).
+    if (!front_ready()) {
+      wake_writer_.wait_for(lock, std::chrono::milliseconds(kStateWaitMs), [this] { return front_ready(); });
+    }
     Item item = std::move(queue_.front());
     queue_.pop_front();
     room_.notify_one();
@@ -174,7 +208,11 @@ Source::Status RecordingSource::next(Frame& out) {
     error_ = "recording: " + recorder_.stats().error;
     return Status::error;
   }
-  recorder_.push(out, robot_state_for_recording(out, lookup_));
+  if (lookup_.from_processing) {
+    recorder_.push_awaiting_state(out, robot_state_for_recording(out, lookup_));
+  } else {
+    recorder_.push(out, robot_state_for_recording(out, lookup_));
+  }
   return status;
 }
 

@@ -27,8 +27,9 @@ TEST(InfoCli, DescribesTheRealBag) {
   EXPECT_EQ(r.exit_code, 0) << r.out;
   expect_line(r.out, "format: bag (indexed, file version 3)");
   expect_line(r.out, "compression: lz4");
-  EXPECT_NE(r.out.find("stream depth: 640x480 mono16, 2 frame(s), 0.167 s, fx=390.4315 fy=390.4315 ppx=331.3879 "
-                       "ppy=242.1873 model=Brown Conrady"),
+  // README: "Depth 640x480 Z16 (`mono16`) at 6 fps".
+  EXPECT_NE(r.out.find("stream depth: 640x480 mono16, 2 frame(s), 0.167 s, stated 6 frames/s, fx=390.4315 "
+                       "fy=390.4315 ppx=331.3879 ppy=242.1873 model=Brown Conrady"),
             std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("stream color: 640x480 rgb8, 1 frame(s)"), std::string::npos) << r.out;

@@ -63,5 +63,19 @@ TEST(RecordColour, ABagWithColourIsRecordedWithItsColourAndCalibration) {
   EXPECT_NEAR(summary.T_color_depth->translation().x(), 0.014311, 1e-6) << "README: Color_0/tf/0";
 }
 
+// `hrcsense run --record` keeps the colour too, although processing decodes none of its own.
+TEST(RecordColourCli, RunRecordKeepsTheColourOfABag) {
+  REQUIRE_SHARED(test::shared_d435_bag(), bag);
+  ScratchDir out("runrecolour");
+  const std::string recorded = out / "run.bag";
+  const CliResult r = cli("run --set source.type=bag --set source.path=" + bag + " --set background.frames=1 --record " +
+                          recorded + " --out " + (out / "run.jsonl"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const RecordingSummary summary = summarize_recording(recorded);
+  ASSERT_EQ(summary.streams.size(), 2U) << "depth and colour";
+  EXPECT_GE(summary.streams[1].frames, 1);
+  EXPECT_NEAR(summary.streams[1].intrinsics.fx, 613.2037, 1e-3) << "README: colour intrinsics";
+}
+
 }  // namespace
 }  // namespace hrcsense

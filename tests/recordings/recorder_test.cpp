@@ -383,6 +383,64 @@ TEST(Recorder, JointStatesGoToTheirOwnTopic) {
   EXPECT_TRUE(found);
 }
 
+// `run --record` (issue 31, defect 6): the joint state recorded for a frame is the one
+// processing reported (state_used), not the capture-time lookup pushed with it; a frame
+// processing skipped (a newer one was reported first) or never reached (the run ended) keeps
+// the lookup; one measured against no state, or a non-finite one, is recorded without. Read
+// back through the recorded state source, which is what a replay decides on.
+TEST(Recorder, TheStateProcessingUsedIsTheOneRecorded) {
+  ScratchDir dir("recorder");
+  const std::string path = dir / "used.bag";
+  const auto state_with = [](double q1) {
+    RobotState s;
+    s.valid = true;
+    s.q_rad = JointAngles{q1, -1.0, 1.5, -2.0, 2.5, -3.0};
+    return s;
+  };
+  {
+    std::unique_ptr<Source> source = cell_source(6, {"sim.width=424", "sim.height=240"});
+    RecorderParams params = recorder_params(path);
+    params.queue_frames = 16;  // room for every frame: none may be dropped here
+    Recorder recorder(params);
+    std::vector<Frame> frames(6);
+    for (Frame& frame : frames) {
+      ASSERT_EQ(source->next(frame), Source::Status::frame);
+    }
+    // Frame i is pushed with the capture-time lookup q1 = 0.1·i.
+    for (int i = 0; i < 3; ++i) ASSERT_TRUE(recorder.push_awaiting_state(frames[i], state_with(0.1 * i)));
+    recorder.state_used(0, state_with(0.55));  // processing measured frame 0 against 0.55
+    recorder.state_used(2, state_with(0.75));  // frame 1 was replaced before processing took it
+    ASSERT_TRUE(recorder.push_awaiting_state(frames[3], state_with(0.3)));
+    recorder.state_used(3, RobotState{});  // no state
+    ASSERT_TRUE(recorder.push_awaiting_state(frames[4], state_with(0.4)));
+    RobotState nan = state_with(0.95);
+    nan.q_rad[2] = std::nan("");
+    recorder.state_used(4, nan);
+    ASSERT_TRUE(recorder.push_awaiting_state(frames[5], state_with(0.5)));  // the run ends first
+    const RecorderStats stats = recorder.close();
+    ASSERT_TRUE(stats.error.empty()) << stats.error;
+    EXPECT_EQ(stats.frames_recorded, 6);
+  }
+  RecordingParams params{path};
+  params.with_joint_states = true;
+  BagSource bag(params);
+  std::unique_ptr<RobotStateSource> states = bag.recorded_robot_state();
+  ASSERT_NE(states, nullptr);
+  const std::vector<double> expected_q1{0.55, 0.1, 0.75, -1.0, -1.0, 0.5};  // -1: no state recorded
+  Frame frame;
+  for (size_t i = 0; i < expected_q1.size(); ++i) {
+    ASSERT_EQ(bag.next(frame), Source::Status::frame) << i;
+    RobotState state;
+    const bool found = states->state_at(frame.timestamp_ns, state);
+    if (expected_q1[i] < 0.0) {
+      EXPECT_FALSE(found) << "frame " << i << " was measured against no usable state";
+      continue;
+    }
+    ASSERT_TRUE(found) << "frame " << i << ": " << states->error();
+    EXPECT_EQ(state.q_rad[0], expected_q1[i]) << "frame " << i;
+  }
+}
+
 TEST(Recorder, SplitsIntoNumberedCompleteFiles) {
   ScratchDir dir("recorder");
   RecorderParams params = recorder_params(dir / "split.bag");
