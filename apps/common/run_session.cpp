@@ -127,6 +127,15 @@ std::vector<FaultProbe> fault_probes(const RobotStateSource& robot_states, const
                       if (newest.source_frame && !newest.valid && no_state) return newest.withheld_reason;
                       return rejected(newest);
                     }});
+  // Learning that starts over (someone moving in the cell) says where the motion is.
+  probes.push_back({"background", [](const FrameResult& newest) {
+                      constexpr const char* kRestarted = "restarted: ";
+                      const size_t at = newest.withheld_reason.find(kRestarted);
+                      if (newest.withheld_code != ReasonCode::learning_background || at == std::string::npos) {
+                        return std::string();
+                      }
+                      return newest.withheld_reason.substr(at + std::char_traits<char>::length(kRestarted));
+                    }});
   if (recorder != nullptr) {
     auto dropped = when_rising([recorder] { return recorder->stats().frames_dropped; },
                                [recorder] {

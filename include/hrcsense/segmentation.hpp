@@ -94,10 +94,26 @@ struct MotionRegion {
 /// Learns the background from consecutive frames. When the scene moved during a batch of
 /// `frames` frames, the batch is discarded and learning starts over (a person walking by
 /// is never learnt as background).
+namespace segmentation_detail {
+struct BatchView;
+}
+
 struct BackgroundLearner {
   enum class Status { learning, restarted, ready };
 
   BackgroundParams params;
+  /// `foreground.min_object_mm` (the Pipeline sets it): a blob of motion smaller than this at
+  /// its depth is no person or object and does not restart learning; 0 counts every blob.
+  float min_object_mm = 0.0F;
+  /// A moving pixel is checked for edge flicker against the still pixels this far around it,
+  /// so that a flickering band is at most 3 px wide (a depth camera's edge flicker is 1-3 px).
+  /// A person swaying by 10 cm at 2.5 m moves their outline by about 5 px: only the middle of
+  /// that band passes as flicker, the rest stays motion (and the erosion is taken before
+  /// flicker is cleared, so the middle does not make the rest thin).
+  static constexpr int kFlickerRadiusPx = 3;
+  /// A flickering pixel's spread reaches its farther side within this many spreads
+  /// (foreground.k_sigma's default).
+  static constexpr float kFlickerCoverSigmas = 4.0F;
 
   /// Adds one frame. Returns `restarted` (with `message()` saying why) when the batch just
   /// completed showed motion, `ready` once `model()` is usable.
@@ -120,12 +136,17 @@ struct BackgroundLearner {
   /// The depth noise σ / z² (1/m) the last completed batch was judged with: the stereo model's
   /// with a baseline, else learnt from the batch; 0 before the first batch.
   double noise_per_z2() const { return noise_per_z2_; }
+  /// Pixels of the last completed batch that flickered at a depth edge: filled from their
+  /// neighbours, never motion (0 before).
+  size_t flickering_pixels() const { return flickering_; }
 
  private:
   std::vector<double> sum_, sum_sq_;
   size_t unsettled_ = 0;
   std::vector<uint32_t> valid_count_;
   std::vector<uint16_t> nearest_raw_;  ///< per pixel: the batch's nearest valid sample, 0 for none
+  std::vector<uint16_t> farthest_raw_; ///< per pixel: the batch's farthest valid sample, 0 for none
+  size_t flickering_ = 0;
   int count_ = 0;
   bool ready_ = false;
   double noise_per_z2_ = 0.0;
@@ -134,9 +155,17 @@ struct BackgroundLearner {
   // Scratch of the batch summary, sized with the image: spread / mean² samples for the noise
   // median, the moving mask and its erosion, and the fill's queue and distance per pixel.
   std::vector<float> ratios_;
-  std::vector<uint8_t> moving_, eroded_, outside_;  ///< per pixel: moved, wide motion, moved outside the region
+  /// Per pixel: moved, row pass of the erosion, wide motion, moved outside the region, flickered
+  /// at an edge, visited by the blob search.
+  std::vector<uint8_t> moving_, eroded_, wide_, outside_, flicker_, seen_;
   std::vector<int32_t> fill_queue_;
   std::vector<uint16_t> fill_layer_;
+
+  /// Marks moving_ (motion far from the robot cleared; edge flicker still in), flicker_,
+  /// outside_; returns the number of reliable pixels.
+  size_t find_motion(const segmentation_detail::BatchView& batch, const Intrinsics& intrinsics,
+                     const MotionRegion* region);
+  void cover_flicker(const segmentation_detail::BatchView& batch);
 };
 
 /// Checks a background loaded from a file against the first frames of the live scene. A

@@ -172,6 +172,7 @@ ProximitySearch make_proximity_search(const PipelineParams& params) {
 Pipeline::Pipeline(PipelineParams params)
     : params_(std::move(params)), proximity_(make_proximity_search(params_)) {
   learner_.params = params_.background;
+  learner_.min_object_mm = params_.foreground.min_object_mm;  // motion is what the foreground would keep
   extractor_.params = params_.foreground;
   filters_.params = params_.filters;
   self_filter_.params = params_.self_filter;
@@ -199,6 +200,7 @@ void Pipeline::retune(const LiveTuning& tuning) {
   proximity_ = std::move(search);
   filters_.params = params_.filters;
   extractor_.params = params_.foreground;  // prepared_for() sees the change and re-prepares
+  learner_.min_object_mm = params_.foreground.min_object_mm;
   check_.k_sigma = params_.foreground.k_sigma;
   check_.min_margin_m = params_.foreground.min_margin_m;
 }
@@ -208,6 +210,7 @@ void Pipeline::relearn_background() {
   not_empty_ = false;  // the reference stays: the new background is compared with it too
   learner_ = BackgroundLearner{};
   learner_.params = params_.background;
+  learner_.min_object_mm = params_.foreground.min_object_mm;
   preset_background_ = false;
   preset_model_ = BackgroundModel{};
   check_ = BackgroundCheck{};

@@ -13,6 +13,7 @@
 #include "hrcsense/camera.hpp"
 #include "hrcsense/segmentation.hpp"
 
+#include "background_motion.hpp"
 #include "capsule_distance.hpp"
 
 #include <algorithm>
@@ -22,6 +23,14 @@
 #include <optional>
 
 namespace hrcsense {
+
+using segmentation_detail::BatchView;
+using segmentation_detail::mark_edge_flicker;
+using segmentation_detail::describe_blob;
+using segmentation_detail::object_motion;
+using segmentation_detail::ObjectMotion;
+using segmentation_detail::pooled_noise_per_z2;
+
 namespace {
 
 std::string size_changed_message(int old_w, int old_h, int new_w, int new_h) {
@@ -32,13 +41,13 @@ std::string size_changed_message(int old_w, int old_h, int new_w, int new_h) {
   return text;
 }
 
-std::string motion_message(double moving_share, int frames, double limit_share) {
-  char text[240];
+std::string motion_message(double moving_share, int frames, double limit_share, const std::string& where) {
+  char text[160];
   std::snprintf(text, sizeof text,
                 "background learning restarted: %.1f %% of pixels changed during the last %d frames "
-                "(limit %.1f %%); is something moving in the cell?",
+                "(limit %.1f %%); ",
                 100.0 * moving_share, frames, 100.0 * limit_share);
-  return text;
+  return text + where + "; is something moving in the cell?";
 }
 
 /// The running sums of one learning batch, in raw depth units.
@@ -121,9 +130,10 @@ size_t mark_moving(const BackgroundModel& model, const BackgroundParams& params,
   return reliable;
 }
 
-/// Moving pixels whose whole width_px × width_px square (clipped to the image, so that motion at
-/// the border counts) moved too: a binary erosion, separable into a row and a column pass.
-size_t count_wide_motion(const uint8_t* moving, int width, int height, int width_px, uint8_t* rows_ok) {
+/// Marks in `wide` the moving pixels whose whole width_px × width_px square (clipped to the
+/// image, so that motion at the border counts) moved too: a binary erosion, separable into a
+/// row and a column pass.
+void erode_motion(const uint8_t* moving, int width, int height, int width_px, uint8_t* rows_ok, uint8_t* wide) {
   const int r = std::max(width_px, 1) / 2;
   for (int v = 0; v < height; ++v) {
     const uint8_t* row = moving + static_cast<size_t>(v) * width;
@@ -133,17 +143,15 @@ size_t count_wide_motion(const uint8_t* moving, int width, int height, int width
       rows_ok[static_cast<size_t>(v) * width + u] = all;
     }
   }
-  size_t count = 0;
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {
       uint8_t all = 1;
       for (int k = std::max(v - r, 0); k <= std::min(v + r, height - 1); ++k) {
         all &= rows_ok[static_cast<size_t>(k) * width + u];
       }
-      count += all;
+      wide[static_cast<size_t>(v) * width + u] = all;
     }
   }
-  return count;
 }
 
 /// A few frames cannot measure one pixel's noise (three samples of a quantising camera are
@@ -163,10 +171,11 @@ void apply_noise_floor(BackgroundModel& model, double noise_per_z2, float min_va
 /// surface or an object a few pixels away does not lend its depth; the smallest mean among
 /// equally close ones, so that a pixel in a thin invalid band at a depth edge (where a camera
 /// rarely measures) is foreground only when nearer than both sides. Its own samples are not
-/// used: a single valid reading may be a person passing or a glint. With `keep_unseen`, pixels
-/// never valid stay unknown and the search does not cross them.
+/// used: a single valid reading may be a person passing or a glint. Pixels flickering at a depth
+/// edge (`flicker`) are filled the same way. With `keep_unseen`, pixels never valid stay unknown
+/// and the search does not cross them.
 void fill_unreliable(BackgroundModel& model, float min_valid_ratio, int radius_px, bool keep_unseen,
-                     std::vector<int32_t>& queue, std::vector<uint16_t>& layer) {
+                     const uint8_t* flicker, std::vector<int32_t>& queue, std::vector<uint16_t>& layer) {
   const int width = model.width;
   const int height = model.height;
   const size_t n = model.mean_m.size();
@@ -176,7 +185,8 @@ void fill_unreliable(BackgroundModel& model, float min_valid_ratio, int radius_p
   size_t tail = 0;
   for (size_t i = 0; i < n; ++i) {
     const bool unseen = keep_unseen && model.valid_ratio[i] == 0.0F;
-    layer[i] = is_reliable(model, i, min_valid_ratio) ? 0 : unseen ? kUnseen : kUnset;
+    const bool own = is_reliable(model, i, min_valid_ratio) && flicker[i] == 0;
+    layer[i] = own ? 0 : unseen ? kUnseen : kUnset;
     if (layer[i] == 0) continue;
     model.mean_m[i] = 0.0F;
     model.spread_m[i] = 0.0F;
@@ -227,10 +237,6 @@ namespace {
 
 using segmentation_detail::distance_to_capsules;
 
-// Clears the moving pixels whose batch mean lies outside `region` (farther than
-// max_distance_m from the robot, or outside the workspace) and marks them in `outside`.
-// Returns how many were cleared. A pixel that cannot be placed (no mean, a failed
-// deprojection) stays moving: only motion known to be far away is forgiven.
 // The nearer of two raw samples, 0 ("no sample") losing to any valid one.
 uint16_t nearer_sample(uint16_t a, uint16_t b) {
   const uint16_t a_key = static_cast<uint16_t>(a - 1U);  // 0 wraps to 65535, the farthest
@@ -238,9 +244,13 @@ uint16_t nearer_sample(uint16_t a, uint16_t b) {
   return static_cast<uint16_t>((a_key < b_key ? a_key : b_key) + 1U);
 }
 
+// Clears the moving pixels whose batch mean lies outside `region` (farther than
+// max_distance_m from the robot, or outside the workspace) and marks them in `outside`.
+// Returns how many were cleared. A pixel that cannot be placed (no mean, a failed
+// deprojection) stays moving: only motion known to be far away is forgiven.
 size_t keep_motion_near_robot(const BackgroundModel& model, const Intrinsics& intrinsics, const MotionRegion& region,
-                              float max_distance_m, const uint16_t* nearest_raw, float depth_scale_m, uint8_t* moving,
-                              uint8_t* outside) {
+                              float max_distance_m, const uint16_t* nearest_raw, float depth_scale_m,
+                              const uint8_t* flicker, uint8_t* moving, uint8_t* outside) {
   size_t cleared = 0;
   const size_t n = model.mean_m.size();
   const Eigen::Matrix3f R = region.T_base_camera.linear().cast<float>();
@@ -255,7 +265,8 @@ size_t keep_motion_near_robot(const BackgroundModel& model, const Intrinsics& in
   };
   for (size_t i = 0; i < n; ++i) {
     outside[i] = 0;
-    if (moving[i] == 0 || !(model.mean_m[i] > 0.0F)) continue;
+    // Flicker is no motion: it keeps its (filled) background wherever it is.
+    if (moving[i] == 0 || flicker[i] != 0 || !(model.mean_m[i] > 0.0F)) continue;
     const Eigen::Vector2f pixel(static_cast<float>(i % static_cast<size_t>(model.width)),
                                 static_cast<float>(i / static_cast<size_t>(model.width)));
     if (near_at(pixel, model.mean_m[i])) continue;
@@ -288,6 +299,7 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
     sum_sq_.assign(n, 0.0);
     valid_count_.assign(n, 0U);
     nearest_raw_.assign(n, 0);
+    farthest_raw_.assign(n, 0);
     model_.width = depth.width;
     model_.height = depth.height;
     model_.mean_m.assign(n, 0.0F);
@@ -297,7 +309,10 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
     ratios_.reserve(n);
     moving_.assign(n, 0);
     eroded_.assign(n, 0);
+    wide_.assign(n, 0);
     outside_.assign(n, 0);
+    flicker_.assign(n, 0);
+    seen_.assign(n, 0);
     fill_queue_.assign(n, 0);
     fill_layer_.assign(n, 0);
     count_ = 0;
@@ -306,6 +321,7 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
     std::fill(sum_sq_.begin(), sum_sq_.end(), 0.0);
     std::fill(valid_count_.begin(), valid_count_.end(), 0U);
     std::fill(nearest_raw_.begin(), nearest_raw_.end(), uint16_t{0});
+    std::fill(farthest_raw_.begin(), farthest_raw_.end(), uint16_t{0});
   }
 
   // Raw units are integers, so the sums stay exact in double (65535² · 2^20 < 2^53).
@@ -318,6 +334,7 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
     sum_sq_[i] += r * r;
     valid_count_[i] += sample != 0 ? 1U : 0U;
     nearest_raw_[i] = nearer_sample(nearest_raw_[i], sample);
+    farthest_raw_[i] = std::max(farthest_raw_[i], sample);
   }
   ++count_;
   if (count_ < std::max(params.frames, 1)) return status;
@@ -326,40 +343,86 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
   const int batch_frames = count_;
   count_ = 0;
   write_statistics(sums, depth.depth_scale_m, model_);
+  const BatchView batch{model_, nearest_raw_.data(), farthest_raw_.data(), depth.depth_scale_m, params.min_valid_ratio};
   // σ_noise(z) = noise_per_z2 · z²: the stereo model with a baseline, else learnt.
   const bool have_model = frame.stereo_baseline_mm > 0.0F && frame.intrinsics.fx > 0.0F;
+  const double cap = params.max_noise_per_z2;
   noise_per_z2_ = have_model
                       ? stereo_depth_sigma_m(1.0, frame.intrinsics.fx, frame.stereo_baseline_mm, params.subpixel_rms_px)
-                      : std::min(learnt_noise_per_z2(sums, model_, params.min_valid_ratio, ratios_),
-                                 static_cast<double>(params.max_noise_per_z2));
-  const size_t reliable = mark_moving(model_, params, noise_per_z2_, moving_.data());
-  const bool gated = region != nullptr && region->robot != nullptr && !region->robot->capsules.empty();
-  const size_t unsettled = gated ? keep_motion_near_robot(model_, frame.intrinsics, *region, params.motion_max_distance_m,
-                                                          nearest_raw_.data(), depth.depth_scale_m, moving_.data(),
-                                                          outside_.data())
-                                 : 0;
-  const size_t moving = count_wide_motion(moving_.data(), depth.width, depth.height, params.motion_min_width_px,
-                                          eroded_.data());
-  const double moving_share = reliable == 0 ? 0.0 : static_cast<double>(moving) / static_cast<double>(reliable);
+                      : std::min(learnt_noise_per_z2(sums, model_, params.min_valid_ratio, ratios_), cap);
+  size_t reliable = find_motion(batch, frame.intrinsics, region);
+  if (!have_model) {
+    // The median misses a quantising camera's steps (few frames of most pixels read one value):
+    // the noise pooled over the pixels that stayed still includes them. Judged again with it.
+    const double pooled = std::min(pooled_noise_per_z2(batch, valid_count_.data(), moving_.data(), flicker_.data()), cap);
+    if (pooled > noise_per_z2_) {
+      noise_per_z2_ = pooled;
+      reliable = find_motion(batch, frame.intrinsics, region);
+    }
+  }
+  // Wide motion is judged before flicker leaves it: flicker in the middle of a wider band of
+  // change (someone swaying) must not make the band thin.
+  erode_motion(moving_.data(), depth.width, depth.height, params.motion_min_width_px, eroded_.data(), wide_.data());
+  for (size_t i = 0; i < n; ++i) {
+    if (flicker_[i] == 0) continue;
+    moving_[i] = 0;
+    wide_[i] = 0;
+  }
+  const ObjectMotion motion =
+      object_motion(batch, moving_.data(), wide_.data(), frame.intrinsics.fx, min_object_mm, fill_queue_, seen_);
+  const double moving_share = reliable == 0 ? 0.0 : static_cast<double>(motion.counted) / static_cast<double>(reliable);
   if (moving_share > static_cast<double>(params.max_moving_share)) {
-    message_ = motion_message(moving_share, batch_frames, params.max_moving_share);
+    message_ = motion_message(moving_share, batch_frames, params.max_moving_share, describe_blob(motion.largest));
+    unsettled_ = 0;  // counts the batch that was learnt
     return Status::restarted;
   }
   // With a baseline the foreground test adds the stereo model itself.
   if (!have_model) apply_noise_floor(model_, noise_per_z2_, params.min_valid_ratio);
   const bool keep_unseen = batch_frames >= params.unseen_min_frames;
-  fill_unreliable(model_, params.min_valid_ratio, params.fill_radius_px, keep_unseen, fill_queue_, fill_layer_);
+  fill_unreliable(model_, params.min_valid_ratio, params.fill_radius_px, keep_unseen, flicker_.data(), fill_queue_,
+                  fill_layer_);
+  cover_flicker(batch);
   // What moved far from the robot never settled: its background is unknown, not its mean.
-  if (unsettled > 0) {
+  if (unsettled_ > 0) {
     for (size_t i = 0; i < n; ++i) {
       if (outside_[i] == 0) continue;
       model_.mean_m[i] = 0.0F;
       model_.spread_m[i] = 0.0F;
     }
   }
-  unsettled_ = unsettled;
   ready_ = true;
   return Status::ready;
+}
+
+size_t BackgroundLearner::find_motion(const BatchView& batch, const Intrinsics& intrinsics, const MotionRegion* region) {
+  const double k_noise = params.moving_k_sigma * noise_per_z2_;
+  const size_t reliable = mark_moving(model_, params, noise_per_z2_, moving_.data());
+  flickering_ = mark_edge_flicker(batch, k_noise, params.moving_min_spread_m, kFlickerRadiusPx, moving_.data(),
+                                  flicker_.data());
+  const bool gated = region != nullptr && region->robot != nullptr && !region->robot->capsules.empty();
+  unsettled_ = gated ? keep_motion_near_robot(model_, intrinsics, *region, params.motion_max_distance_m,
+                                              nearest_raw_.data(), batch.depth_scale_m, flicker_.data(), moving_.data(),
+                                              outside_.data())
+                     : 0;
+  if (!gated) std::fill(outside_.begin(), outside_.end(), uint8_t{0});
+  return reliable;
+}
+
+// A flickering pixel's background is its nearer side (the fill takes the closest side, which
+// may be the farther one; its own nearest sample is that side, clear_edge_flicker checked), so
+// that a near-side reading is no foreground; its band reaches the farther side too, so that
+// neither side's reading is taken for a change of the scene (a loaded background's check
+// counts pixels measured farther than mean + k · spread).
+void BackgroundLearner::cover_flicker(const BatchView& batch) {
+  const double scale = batch.depth_scale_m;
+  for (size_t i = 0; i < model_.mean_m.size(); ++i) {
+    if (flicker_[i] == 0) continue;
+    const float near_m = static_cast<float>(batch.nearest_raw[i] * scale);
+    const float far_m = static_cast<float>(batch.farthest_raw[i] * scale);
+    float& mean_m = model_.mean_m[i];
+    mean_m = mean_m > 0.0F ? std::min(mean_m, near_m) : near_m;
+    model_.spread_m[i] = std::max(model_.spread_m[i], (far_m - mean_m) / kFlickerCoverSigmas);
+  }
 }
 
 void BackgroundLearner::refuse(const std::string& why) {
