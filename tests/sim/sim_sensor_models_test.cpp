@@ -10,6 +10,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <optional>
+#include <stdexcept>
 #include <string>
 
 namespace hrcsense {
@@ -67,6 +69,79 @@ TEST(SimSensorModels, D435FramesAreTheUnchangedSimulators) {
   EXPECT_EQ(frames_checksum(exact, 0, 1, 1), 0xf944ee820acb789fULL);
   EXPECT_EQ(frames_checksum(walk, 0, 150, 2), 0x6088b86b0a7b324aULL);
   EXPECT_EQ(frames_checksum(cell, 150, 150, 2), 0xfb37684ab3060d48ULL);
+}
+
+TEST(SimSensorModels, NamesReadBackAndOthersAreRefused) {
+  for (const SimSensor sensor : {SimSensor::d435, SimSensor::structured_light}) {
+    EXPECT_EQ(parse_sim_sensor(sim_sensor_name(sensor)), sensor);
+  }
+  EXPECT_STREQ(sim_sensor_name(SimSensor::d435), "d435");
+  EXPECT_STREQ(sim_sensor_name(SimSensor::structured_light), "structured_light");
+  EXPECT_FALSE(parse_sim_sensor("kinect"));
+  EXPECT_FALSE(parse_sim_sensor("D435"));
+}
+
+TEST(SimSensorModels, StructuredLightIsAPrimeSenseClassCamera) {
+  SimParams p;
+  p.fps = 15.0;
+  p.frames = 42;
+  p.seed = 7;
+  p.noise = false;
+  apply_sim_sensor(SimSensor::structured_light, p);
+  EXPECT_EQ(p.sensor, SimSensor::structured_light);
+  EXPECT_EQ(p.width, 640);
+  EXPECT_EQ(p.height, 480);
+  EXPECT_FLOAT_EQ(p.baseline_mm, 75.0F);
+  EXPECT_FLOAT_EQ(p.disparity_step_px, 0.125F);
+  EXPECT_FLOAT_EQ(p.depth_scale_m, 0.001F);
+  EXPECT_FALSE(p.left_band);
+  EXPECT_FLOAT_EQ(p.min_range_m, 0.5F);
+  EXPECT_FLOAT_EQ(p.max_range_m, 4.5F);
+  EXPECT_GT(p.edge_flicker, 0.0F);
+  // What a sensor preset leaves alone.
+  EXPECT_EQ(p.fps, 15.0);
+  EXPECT_EQ(p.frames, 42);
+  EXPECT_EQ(p.seed, 7U);
+  EXPECT_FALSE(p.noise);
+  // Intrinsics: fx = fy = 570 px at 640x480, scaled with the width; the centre (size − 1) / 2.
+  const std::optional<Intrinsics> vga = structured_light_intrinsics(640, 480);
+  ASSERT_TRUE(vga);
+  EXPECT_FLOAT_EQ(vga->fx, 570.0F);
+  EXPECT_FLOAT_EQ(vga->fy, 570.0F);
+  EXPECT_FLOAT_EQ(vga->ppx, 319.5F);
+  EXPECT_FLOAT_EQ(vga->ppy, 239.5F);
+  EXPECT_EQ(vga->model, Distortion::none);
+  const std::optional<Intrinsics> qvga = structured_light_intrinsics(320, 240);
+  ASSERT_TRUE(qvga);
+  EXPECT_FLOAT_EQ(qvga->fx, 285.0F);
+  EXPECT_FLOAT_EQ(qvga->ppx, 159.5F);
+  EXPECT_FLOAT_EQ(structured_light_intrinsics(848, 480)->fx, 755.25F);  // 570 · 848/640
+  EXPECT_FALSE(structured_light_intrinsics(1000, 1000));
+  Simulator sim;
+  sim.params = p;
+  EXPECT_FLOAT_EQ(sim.intrinsics().fx, 570.0F);
+  sim.params.width = 1000;
+  EXPECT_THROW((void)sim.intrinsics(), std::invalid_argument);
+}
+
+TEST(SimSensorModels, BackToD435RendersTheD435Again) {
+  // The preset and back: every value the D435 renders with is restored.
+  Simulator there_and_back = every_effect_scene();
+  apply_sim_sensor(SimSensor::structured_light, there_and_back.params);
+  apply_sim_sensor(SimSensor::d435, there_and_back.params);
+  EXPECT_EQ(frames_checksum(there_and_back, 0, 1, 3), frames_checksum(every_effect_scene(), 0, 1, 3));
+}
+
+TEST(SimSensorModels, SourceReportsTheSensorModel) {
+  Simulator sim;
+  sim.params.frames = 1;
+  EXPECT_EQ(SimSource(sim).info().sensor_model, "d435");
+  apply_sim_sensor(SimSensor::structured_light, sim.params);
+  const SourceInfo info = SimSource(sim).info();
+  EXPECT_EQ(info.sensor_model, "structured_light");
+  EXPECT_FLOAT_EQ(info.stereo_baseline_mm, 75.0F);
+  EXPECT_FLOAT_EQ(info.intrinsics.fx, 570.0F);
+  EXPECT_EQ(info.intrinsics.width, 640);
 }
 
 }  // namespace
