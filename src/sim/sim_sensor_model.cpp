@@ -62,35 +62,6 @@ void set_structured_light(SimParams& p) {
   p.correlated_cell_px = 32;
 }
 
-void set_d435(SimParams& p) {
-  const SimParams d435;
-  p.sensor = SimSensor::d435;
-  p.width = d435.width;
-  p.height = d435.height;
-  p.disparity_noise_px = d435.disparity_noise_px;
-  p.baseline_mm = d435.baseline_mm;
-  p.depth_scale_m = d435.depth_scale_m;
-  p.disparity_step_px = d435.disparity_step_px;
-  p.left_band = d435.left_band;
-  p.occlusion_shadows = d435.occlusion_shadows;
-  p.max_disparity_px = d435.max_disparity_px;
-  p.min_range_m = d435.min_range_m;
-  p.max_range_m = d435.max_range_m;
-  p.range_dropout = d435.range_dropout;
-  p.range_dropout_start_m = d435.range_dropout_start_m;
-  p.edge_jump_px = d435.edge_jump_px;
-  p.edge_dropout = d435.edge_dropout;
-  p.flying_pixels = d435.flying_pixels;
-  p.edge_flicker = d435.edge_flicker;
-  p.dark_dropout = d435.dark_dropout;
-  p.shiny_dropout = d435.shiny_dropout;
-  p.low_texture_dropout = d435.low_texture_dropout;
-  p.material_cell_px = d435.material_cell_px;
-  p.speckle = d435.speckle;
-  p.correlated_noise_px = d435.correlated_noise_px;
-  p.correlated_cell_px = d435.correlated_cell_px;
-}
-
 }  // namespace
 
 const char* sim_sensor_name(SimSensor sensor) {
@@ -104,11 +75,18 @@ std::optional<SimSensor> parse_sim_sensor(const std::string& name) {
 }
 
 void apply_sim_sensor(SimSensor sensor, SimParams& p) {
-  if (sensor == SimSensor::structured_light) {
-    set_structured_light(p);
-  } else {
-    set_d435(p);
-  }
+  SimParams preset;  // the D435's values
+  if (sensor == SimSensor::structured_light) set_structured_light(preset);
+  // What belongs to the run and the colour camera, not to the depth sensor, stays.
+  preset.fps = p.fps;
+  preset.frames = p.frames;
+  preset.seed = p.seed;
+  preset.noise = p.noise;
+  preset.color = p.color;
+  preset.color_width = p.color_width;
+  preset.color_height = p.color_height;
+  preset.color_translation_m = p.color_translation_m;
+  p = preset;
 }
 
 std::optional<Intrinsics> structured_light_intrinsics(int width, int height) {
