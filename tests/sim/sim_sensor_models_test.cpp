@@ -132,6 +132,25 @@ TEST(SimSensorModels, BackToD435RendersTheD435Again) {
   EXPECT_EQ(frames_checksum(there_and_back, 0, 1, 3), frames_checksum(every_effect_scene(), 0, 1, 3));
 }
 
+TEST(SimSensorModels, StructuredLightFramesDependOnlyOnSeedAndIndex) {
+  // Flicker and far dropouts are new every frame, yet frame i is the same whenever it is
+  // rendered, and another seed gives other frames.
+  Simulator sim;
+  apply_sim_sensor(SimSensor::structured_light, sim.params);
+  // A box 1 m away (edges) before a wall 3.4–4.3 m away (range dropouts).
+  sim.scene.objects.push_back(object(Shape::plane({0, 0, 3.8F}, {0.2F, 0, -1}), true));
+  sim.scene.objects.push_back(object(Shape::box({-0.2F, -0.2F, 1.0F}, {0.2F, 0.2F, 1.2F}), false));
+  const uint64_t forwards = frames_checksum(sim, 1, 2, 2);     // frames 1, 3
+  Simulator other_order = sim;
+  Frame f;
+  other_order.render(3, f);
+  other_order.render(0, f);
+  EXPECT_EQ(frames_checksum(other_order, 1, 2, 2), forwards);
+  EXPECT_NE(frames_checksum(sim, 1, 1, 1), frames_checksum(sim, 2, 1, 1));
+  sim.params.seed = 10;
+  EXPECT_NE(frames_checksum(sim, 1, 2, 2), forwards);
+}
+
 TEST(SimSensorModels, SourceReportsTheSensorModel) {
   Simulator sim;
   sim.params.frames = 1;
