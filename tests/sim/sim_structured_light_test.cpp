@@ -182,89 +182,108 @@ std::vector<uint8_t> edge_mask(const Simulator& sim, const Frame& f) {
   return mask;
 }
 
-TEST(StructuredLight, EdgePixelsFlickerBetweenTheTwoDepthsInteriorPixelsStayWithinTheNoise) {
-  // A 0.3 m box whose front face is 1 m away, before a slanted wall 1.8–2.25 m away
-  // (z = 2 / (1 − 0.2·X), X = (u − 319.5) / 570), over 20 frames.
+/// 20 frames of a 0.3 m box whose front face is 1 m away, before a slanted wall 1.8–2.25 m
+/// away (z = 2 / (1 − 0.2·X), X = (u − 319.5) / 570), with frame 0's edge pixels.
+struct BoxBeforeWall {
+  static constexpr int kFrames = 20;
   Simulator sim = structured_light();
-  sim.params.speckle = 0.0F;
-  sim.scene.objects = {object(slanted_wall(2.0F, 0.2F), true),
-                       object(Shape::box({-0.15F, -0.15F, 1.0F}, {0.15F, 0.15F, 1.2F}), true)};
-  constexpr int kFrames = 20;
-  std::vector<Frame> frames(kFrames);
-  for (int k = 0; k < kFrames; ++k) sim.render(k, frames[static_cast<size_t>(k)]);
-  const Frame& f0 = frames[0];
-  const std::vector<uint8_t> edges = edge_mask(sim, f0);
-  size_t edge = 0, edge_both = 0, edge_samples = 0, near_samples = 0, far_samples = 0, none_samples = 0;
-  size_t interior = 0, interior_wide = 0, interior_samples = 0;
-  double interior_square_px = 0.0;
-  for (int v = 2; v + 2 < f0.depth.height; ++v) {
-    for (int u = 2; u + 2 < f0.depth.width; ++u) {
-      const size_t i = at(f0, u, v);
-      const auto shadow = [&frames, i] {
-        return std::all_of(frames.begin(), frames.end(), [i](const Frame& f) { return f.depth.pixels[i] == 0; });
-      };
-      if (edges[i] != 0) {
-        // Left of the box the wall lies in the projector's shadow: no depth there, ever.
-        if (shadow()) continue;
-        // The two sides by hand: the box's face at 1000 mm, the wall's depth at this column (a
-        // pixel's neighbour across the edge is within 1.4 mm of it). A step at 2.25 m is 14.8 mm
-        // and the noise adds a few more; 1 m and 2 m are far apart.
-        const double wall_mm = 2000.0 / (1.0 - 0.2 * (u - 319.5) / 570.0);
-        int near_seen = 0, far_seen = 0;
-        for (const Frame& f : frames) {
-          const int raw = f.depth.pixels[i];
-          const bool near = std::abs(raw - 1000) <= 15;
-          const bool far = std::abs(raw - wall_mm) <= 60.0;
-          EXPECT_TRUE(raw == 0 || near || far) << raw << " mm at an edge is on neither side, pixel " << u << "," << v;
-          near_seen += near ? 1 : 0;
-          far_seen += far ? 1 : 0;
-          none_samples += raw == 0 ? 1U : 0U;
-          ++edge_samples;
-        }
-        near_samples += static_cast<size_t>(near_seen);
-        far_samples += static_cast<size_t>(far_seen);
-        ++edge;
-        edge_both += near_seen > 0 && far_seen > 0 ? 1U : 0U;
-        continue;
+  std::vector<Frame> frames;
+  std::vector<uint8_t> edges;
+
+  BoxBeforeWall() : frames(kFrames) {
+    sim.params.speckle = 0.0F;
+    sim.scene.objects = {object(slanted_wall(2.0F, 0.2F), true),
+                         object(Shape::box({-0.15F, -0.15F, 1.0F}, {0.15F, 0.15F, 1.2F}), true)};
+    for (int k = 0; k < kFrames; ++k) sim.render(k, frames[static_cast<size_t>(k)]);
+    edges = edge_mask(sim, frames[0]);
+  }
+  int width() const { return frames[0].depth.width; }
+  int height() const { return frames[0].depth.height; }
+  /// No depth in any frame: the projector's shadow left of the box.
+  bool shadow(size_t i) const {
+    return std::all_of(frames.begin(), frames.end(), [i](const Frame& f) { return f.depth.pixels[i] == 0; });
+  }
+  /// No edge within two pixels of (u, v), which lies at least two pixels inside the image.
+  bool interior(int u, int v) const {
+    for (int dv = -2; dv <= 2; ++dv) {
+      for (int du = -2; du <= 2; ++du) {
+        if (edges[at(frames[0], u + du, v + dv)] != 0) return false;
       }
-      // Interior: no edge within two pixels, and not in the shadow.
-      bool near_edge = false;
-      for (int dv = -2; dv <= 2; ++dv) {
-        for (int du = -2; du <= 2; ++du) near_edge = near_edge || edges[at(f0, u + du, v + dv)] != 0;
-      }
-      if (near_edge || shadow()) continue;
-      // Measured in disparity, where steps and noise are the same at every depth.
-      const double d_true = 42.75 / f0.truth->depth_m[i];
-      double d_min = 1e9, d_max = 0.0;
-      for (const Frame& f : frames) {
+    }
+    return true;
+  }
+};
+
+TEST(StructuredLight, EdgePixelsFlickerBetweenTheNearAndTheFarDepth) {
+  const BoxBeforeWall scene;
+  size_t edge = 0, edge_both = 0, samples = 0, near_samples = 0, far_samples = 0, none_samples = 0;
+  for (int v = 0; v < scene.height(); ++v) {
+    for (int u = 0; u < scene.width(); ++u) {
+      const size_t i = at(scene.frames[0], u, v);
+      if (scene.edges[i] == 0 || scene.shadow(i)) continue;
+      // The two sides by hand: the box's face at 1000 mm, the wall's depth at this column (a
+      // pixel's neighbour across the edge is within 1.4 mm of it). A step at 2.25 m is 14.8 mm
+      // and the noise adds a few more; 1 m and 2 m are far apart.
+      const double wall_mm = 2000.0 / (1.0 - 0.2 * (u - 319.5) / 570.0);
+      int near_seen = 0, far_seen = 0;
+      for (const Frame& f : scene.frames) {
         const int raw = f.depth.pixels[i];
-        if (raw == 0) continue;
-        const double d = 42.75 / (raw * 1e-3);
-        d_min = std::min(d_min, d);
-        d_max = std::max(d_max, d);
-        interior_square_px += (d - d_true) * (d - d_true);
-        ++interior_samples;
+        const bool near = std::abs(raw - 1000) <= 15;
+        const bool far = std::abs(raw - wall_mm) <= 60.0;
+        EXPECT_TRUE(raw == 0 || near || far) << raw << " mm at an edge is on neither side, pixel " << u << "," << v;
+        near_seen += near ? 1 : 0;
+        far_seen += far ? 1 : 0;
+        none_samples += raw == 0 ? 1U : 0U;
+        ++samples;
       }
-      ++interior;
-      // σ 0.06 px and 1/8 px steps: 20 draws span about 0.22 px, two or three steps, and now and
-      // then four (±2 steps needs |g| > 3.1 twice); five (0.625 px, a span of over 8 σ) never.
-      // The 1 mm rounding of the output moves a disparity by at most 0.02 px at either end.
-      interior_wide += d_max - d_min > 4 * 0.125 + 0.05 ? 1U : 0U;
+      near_samples += static_cast<size_t>(near_seen);
+      far_samples += static_cast<size_t>(far_seen);
+      ++edge;
+      edge_both += near_seen > 0 && far_seen > 0 ? 1U : 0U;
     }
   }
   ASSERT_GT(edge, 1000U);
-  ASSERT_GT(interior, 100000U);
   // Each frame one in five edge pixels has no depth and the rest toss a coin between the sides:
   // 0.2 none, 0.4 near, 0.4 far.
-  const auto share = [edge_samples](size_t n) { return static_cast<double>(n) / static_cast<double>(edge_samples); };
+  const auto share = [samples](size_t n) { return static_cast<double>(n) / static_cast<double>(samples); };
   EXPECT_NEAR(share(none_samples), 0.2, 0.03);
   EXPECT_NEAR(share(near_samples), 0.4, 0.04);
   EXPECT_NEAR(share(far_samples), 0.4, 0.04);
   // Over 20 frames nearly every edge pixel shows both depths (never the near one: 0.6^20 ≈ 4e-5).
   EXPECT_GT(static_cast<double>(edge_both) / static_cast<double>(edge), 0.99);
-  EXPECT_EQ(interior_wide, 0U);
+}
+
+TEST(StructuredLight, InteriorPixelsOfStillSurfacesMoveOnlyByTheNoise) {
+  const BoxBeforeWall scene;
+  size_t interior = 0, wide = 0, samples = 0;
+  double square_px = 0.0;
+  for (int v = 2; v + 2 < scene.height(); ++v) {
+    for (int u = 2; u + 2 < scene.width(); ++u) {
+      const size_t i = at(scene.frames[0], u, v);
+      if (!scene.interior(u, v) || scene.shadow(i)) continue;
+      // Measured in disparity, where steps and noise are the same at every depth.
+      const double d_true = 42.75 / scene.frames[0].truth->depth_m[i];
+      double d_min = 1e9, d_max = 0.0;
+      for (const Frame& f : scene.frames) {
+        const int raw = f.depth.pixels[i];
+        if (raw == 0) continue;
+        const double d = 42.75 / (raw * 1e-3);
+        d_min = std::min(d_min, d);
+        d_max = std::max(d_max, d);
+        square_px += (d - d_true) * (d - d_true);
+        ++samples;
+      }
+      ++interior;
+      // σ 0.06 px and 1/8 px steps: 20 draws span about 0.22 px, two or three steps, and now and
+      // then four (±2 steps needs |g| > 3.1 twice); five (0.625 px, a span of over 8 σ) never.
+      // The 1 mm rounding of the output moves a disparity by at most 0.02 px at either end.
+      wide += d_max - d_min > 4 * 0.125 + 0.05 ? 1U : 0U;
+    }
+  }
+  ASSERT_GT(interior, 100000U);
+  EXPECT_EQ(wide, 0U);
   // RMS error in disparity: √(0.06² + 0.125²/12) = 0.070 px by hand (noise plus rounding).
-  EXPECT_NEAR(std::sqrt(interior_square_px / static_cast<double>(interior_samples)), 0.070, 0.01);
+  EXPECT_NEAR(std::sqrt(square_px / static_cast<double>(samples)), 0.070, 0.01);
 }
 
 TEST(StructuredLight, DarkAndShinySurfacesLoseThePatternLowTextureDoesNot) {
