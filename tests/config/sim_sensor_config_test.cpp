@@ -74,6 +74,20 @@ TEST(SimSensorConfig, KeysGivenOverrideThePresetInAnyOrder) {
   EXPECT_FLOAT_EQ(d435.max_range_m, 6.0F);
 }
 
+TEST(SimSensorConfig, TheEffectiveConfigurationReadsBackToTheSameSensor) {
+  // canonical_yaml writes the sensor and every value in effect; read again, the preset and
+  // the keys give the same values, so the same hash.
+  TempDir dir;
+  const Config config = load_config("", {"sim.sensor=structured_light", "sim.width=320", "sim.height=240",
+                                         "sim.edge_flicker=0.3"});
+  const Config again = load_config(dir.write("effective.yaml", config.canonical_yaml), {});
+  EXPECT_EQ(again.canonical_yaml, config.canonical_yaml);
+  EXPECT_EQ(config_hash(again), config_hash(config));
+  EXPECT_EQ(again.sim.sensor, SimSensor::structured_light);
+  EXPECT_EQ(again.sim.width, 320);
+  EXPECT_FLOAT_EQ(again.sim.edge_flicker, 0.3F);
+}
+
 TEST(SimSensorConfig, OtherNamesAndResolutionsAreRefusedNamingTheKey) {
   expect_config_error("", {"sim.sensor=kinect"}, {"'sim.sensor'", "d435, structured_light", "'kinect'"});
   expect_config_error("", {"sim.sensor=D435"}, {"'sim.sensor'", "'D435'"});
