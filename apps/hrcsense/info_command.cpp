@@ -43,6 +43,15 @@ void print_sensor_effects(const Simulator& simulator) {
                                                         : 0.0;
   std::printf("stereo: left band %s, occlusion shadows %s, minimum range %.3f m\n", p.left_band ? "on" : "off",
               p.occlusion_shadows ? "on" : "off", min_range_m);
+  // Only where set (structured light), so that a D435's lines read as before.
+  if (p.max_range_m > 0.0F) {
+    std::printf("working range: %.3f-%.3f m, far dropouts up to %.0f %% from %.3f m (new every frame)\n", min_range_m,
+                static_cast<double>(p.max_range_m), 100.0 * p.range_dropout, static_cast<double>(p.range_dropout_start_m));
+  }
+  if (p.noise && p.edge_flicker > 0.0F) {
+    std::printf("edge flicker: %.0f %% of the edge pixels with depth take the other side's, new every frame\n",
+                100.0 * p.edge_flicker);
+  }
   if (p.noise) {
     std::printf("dropouts: edges %.0f %%, flying pixels %.0f %%, speckle %.2f %%, dark %.0f %%, shiny %.0f %%, "
                 "low texture %.0f %%; disparity step 1/%.0f px, correlated sigma %.3f px\n",
@@ -63,6 +72,7 @@ int print_sim(const Config& config) {
   const Intrinsics in = simulator.intrinsics();
   std::printf("source: sim (seed %llu)%s\n", static_cast<unsigned long long>(sim.seed),
               config.file.empty() ? "" : (", " + config.file).c_str());
+  std::printf("sensor: %s\n", sim_sensor_name(sim.sensor));
   std::printf("resolution: %dx%d at %.3g frames/s\n", in.width, in.height, sim.fps);
   std::printf("intrinsics: fx=%.4f fy=%.4f ppx=%.4f ppy=%.4f model=%s\n", static_cast<double>(in.fx),
               static_cast<double>(in.fy), static_cast<double>(in.ppx), static_cast<double>(in.ppy),

@@ -100,11 +100,20 @@ inline constexpr std::array<std::array<uint8_t, 3>, 8> kSimPalette{{
     {220, 80, 60}, {60, 120, 220}, {230, 190, 40}, {150, 80, 170},
 }};
 
+/// The depth camera the simulator imitates (`sim.sensor`, docs/SIMULATOR.md).
+enum class SimSensor {
+  d435,              ///< Intel RealSense D435: active stereo, the defaults of SimParams
+  structured_light,  ///< a PrimeSense-class projector and IR camera (Kinect v1, ASUS Xtion)
+};
+
 /// The simulated camera and its D435 effects. Defaults are the D435's and are pinned in
 /// docs/SIMULATOR.md. `noise` switches every random effect at once (disparity noise and its
 /// quantisation, dropouts, flying pixels, speckle); the geometric ones (left band, occlusion
 /// shadows, minimum range) follow from the stereo layout and have their own switches.
 struct SimParams {
+  /// The camera: its intrinsics (d435: the D435i's; structured_light: fx 570 px at 640x480, scaled
+  /// with the width) and, through apply_sim_sensor, the defaults of the effects below.
+  SimSensor sensor = SimSensor::d435;
   int width = 848;                   ///< 640x480, 848x480 or 1280x720 (D435 intrinsics)
   int height = 480;
   double fps = 30.0;                 ///< nominal frame rate; timestamps are index / fps
@@ -119,9 +128,17 @@ struct SimParams {
   bool occlusion_shadows = true;     ///< no depth where a nearer surface hides the point from the right imager
   float max_disparity_px = 110.0F;   ///< search range: nearer than fx·B/max_disparity_px, no depth; 0: off
   float min_range_m = 0.0F;          ///< > 0: this minimum range instead of the one from max_disparity_px
+  /// > 0: a working range: no depth whose measured value lies beyond this or nearer than the
+  /// minimum range (metres); 0: no upper limit (the D435's range fades instead of ending).
+  float max_range_m = 0.0F;
+  float range_dropout = 0.0F;        ///< share of pixels at max_range_m with no depth, new every frame
+  float range_dropout_start_m = 0.0F;  ///< range_dropout grows as ((Z − start) / (max − start))² from here
   float edge_jump_px = 1.5F;         ///< a larger true-disparity step between 4-neighbours is a depth edge
   float edge_dropout = 0.25F;        ///< share of pixels beside a depth edge with no depth (fixed per seed)
   float flying_pixels = 0.15F;       ///< share of the other edge pixels mixed towards the far/near side
+  /// > 0: edge pixels are drawn anew every frame instead of fixed per seed, and this share of
+  /// those that keep a depth takes the other side's (a pixel flickers between the two depths).
+  float edge_flicker = 0.0F;
   float dark_dropout = 0.6F;         ///< share of a Material::dark surface with no depth
   float shiny_dropout = 0.35F;       ///< share of a Material::shiny surface with no depth
   float low_texture_dropout = 0.5F;  ///< share of a Material::low_texture surface with no depth
@@ -136,6 +153,24 @@ struct SimParams {
   /// Default: the test D435i of specs/d435-sensor-model.md §2.
   Eigen::Vector3f color_translation_m{0.01508F, 0.0000046F, 0.00017F};
 };
+
+/// The name `sim.sensor` gives `sensor`: "d435" or "structured_light".
+const char* sim_sensor_name(SimSensor sensor);
+/// The sensor called `name` (as sim_sensor_name writes it); nullopt for any other name.
+std::optional<SimSensor> parse_sim_sensor(const std::string& name);
+
+/// Sets `sensor` and the effects' values that model it in `p` (docs/SIMULATOR.md, "Sensor
+/// models"): d435 restores SimParams{}'s, structured_light its own (640x480, baseline 75 mm,
+/// 1/8 px disparity steps, a 0.5–4.5 m working range, edge flicker, ...). Leaves the frame rate,
+/// length, seed, the `noise` switch and the colour camera alone. The configuration applies it
+/// before reading the other sim.* keys, so that keys given explicitly override the preset.
+void apply_sim_sensor(SimSensor sensor, SimParams& p);
+
+/// A structured-light camera's depth intrinsics: fx = fy = 570 px at 640x480, scaled with the
+/// width, principal point at the image centre, no distortion. For PrimeSense's own modes
+/// (640x480, 320x240, 160x120) and the D435's (so that a scene written for the D435 runs with
+/// either); nullopt for other sizes.
+std::optional<Intrinsics> structured_light_intrinsics(int width, int height);
 
 /// A scene: objects plus the camera's pose in the base frame.
 struct Scene {
@@ -258,8 +293,9 @@ struct Simulator {
   /// threads at once (copy it instead).
   mutable SimScratch scratch;
 
-  /// The depth intrinsics used (D435i for the configured resolution).
-  /// Throws std::invalid_argument for a resolution the D435 does not offer.
+  /// The depth intrinsics used: the D435i's for the configured resolution, or
+  /// structured_light_intrinsics with SimSensor::structured_light.
+  /// Throws std::invalid_argument for a resolution the sensor does not offer.
   Intrinsics intrinsics() const;
   /// The colour intrinsics used (d435_color_intrinsics of the colour resolution).
   /// Throws std::invalid_argument for a resolution it does not know.

@@ -26,6 +26,9 @@ struct SourceInfo {
   std::string camera_name;
   std::string camera_serial;
   std::string camera_firmware;
+  /// The sensor a simulated source imitates ("d435", "structured_light": `sim.sensor`); empty
+  /// for other sources, written as null.
+  std::string sensor_model;
 };
 
 /// A source of depth frames. One of the two virtual interfaces of hrcsense.

@@ -64,12 +64,21 @@ void read_source_and_sim(KeyReader& r, Config& c) {
   config_detail::read_camera_source(r, c.source);  // src/config/camera_config.cpp
   c.sim.seed = c.source.seed;
 
+  // The sensor first: its preset fills the effects, and every sim.* key given overrides it.
+  std::string sensor = sim_sensor_name(c.sim.sensor);
+  r.choice("sim.sensor", sensor, {"d435", "structured_light"});
+  apply_sim_sensor(*parse_sim_sensor(sensor), c.sim);
   r.integer("sim.width", c.sim.width, 1, 65535);
   r.integer("sim.height", c.sim.height, 1, 65535);
-  if (!d435_depth_intrinsics(c.sim.width, c.sim.height)) {
-    r.fail_pair("sim.width", "sim.height", std::to_string(c.sim.width) + "x" + std::to_string(c.sim.height) +
-                            " is not a D435 depth resolution; expected 1280x720, 848x480, 640x480, "
-                            "640x360, 480x270 or 424x240");
+  const std::string size = std::to_string(c.sim.width) + "x" + std::to_string(c.sim.height);
+  if (c.sim.sensor == SimSensor::d435 && !d435_depth_intrinsics(c.sim.width, c.sim.height)) {
+    r.fail_pair("sim.width", "sim.height", size + " is not a D435 depth resolution; expected 1280x720, 848x480, "
+                                          "640x480, 640x360, 480x270 or 424x240");
+  }
+  if (c.sim.sensor == SimSensor::structured_light && !structured_light_intrinsics(c.sim.width, c.sim.height)) {
+    r.fail_pair("sim.width", "sim.height", size + " is not a structured_light depth resolution; expected 640x480, "
+                                          "320x240, 160x120 or a D435 one (1280x720, 848x480, 640x360, 480x270, "
+                                          "424x240)");
   }
   r.number_in("sim.fps", c.sim.fps, 1.0, 1000.0, " frames/s");
   r.integer("sim.frames", c.sim.frames, 1, kMaxSimFrames);

@@ -238,6 +238,7 @@ YAML::Node scene_objects_node(const Scene& scene) {
 }
 
 void read_sim_effects(KeyReader& r, SimParams& sim) {
+  // `sim` holds the sensor's preset (apply_sim_sensor): a key given replaces its value.
   const auto share = [&r](const std::string& key, float& value) {
     r.number(key, value, Bound::non_negative);
     if (value > 1.0F) r.fail(key, "expected a share between 0 and 1, got " + float_text(value));
@@ -251,9 +252,22 @@ void read_sim_effects(KeyReader& r, SimParams& sim) {
   r.flag("sim.occlusion_shadows", sim.occlusion_shadows);
   r.number("sim.max_disparity_px", sim.max_disparity_px, Bound::non_negative);
   r.number("sim.min_range_m", sim.min_range_m, Bound::non_negative);
+  r.number("sim.max_range_m", sim.max_range_m, Bound::non_negative);
+  if (sim.max_range_m > 0.0F && sim.max_range_m <= sim.min_range_m) {
+    r.fail_pair("sim.min_range_m", "sim.max_range_m", "expected the maximum range (" + float_text(sim.max_range_m) +
+                                                         " m) beyond the minimum (" + float_text(sim.min_range_m) + " m)");
+  }
+  share("sim.range_dropout", sim.range_dropout);
+  r.number("sim.range_dropout_start_m", sim.range_dropout_start_m, Bound::non_negative);
+  if (sim.range_dropout > 0.0F && !(sim.range_dropout_start_m < sim.max_range_m)) {
+    r.fail_pair("sim.range_dropout", "sim.max_range_m", "range dropouts grow from sim.range_dropout_start_m (" +
+                                                           float_text(sim.range_dropout_start_m) +
+                                                           " m) to the maximum range, which must lie beyond it");
+  }
   r.number("sim.edge_jump_px", sim.edge_jump_px, Bound::positive);
   share("sim.edge_dropout", sim.edge_dropout);
   share("sim.flying_pixels", sim.flying_pixels);
+  share("sim.edge_flicker", sim.edge_flicker);
   share("sim.dark_dropout", sim.dark_dropout);
   share("sim.shiny_dropout", sim.shiny_dropout);
   share("sim.low_texture_dropout", sim.low_texture_dropout);

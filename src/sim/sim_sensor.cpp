@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — the simulated D435's sensor model (specs/d435-sensor-model.md §3–4): visibility
-// from the right imager, minimum range, dropouts, flying pixels, disparity noise, quantisation.
+// hrcsense — the simulated sensor model (specs/d435-sensor-model.md §3–4, and the structured-light
+// camera of docs/SIMULATOR.md): visibility from the right imager (or projector), working range,
+// dropouts, flying pixels, edge flicker, disparity noise, quantisation.
 
 #include "sim_sensor.hpp"
 
@@ -22,6 +23,8 @@ constexpr uint64_t kFixedSalt = 0x5DEECE66DULL;
 constexpr uint64_t kMaterialSalt = 0xC2B2AE3D27D4EB4FULL;
 constexpr uint64_t kSpeckleSalt = 0x165667B19E3779F9ULL;
 constexpr uint64_t kCorrelatedSalt = 0x27D4EB2F165667C5ULL;
+constexpr uint64_t kFlickerSalt = 0x94D049BB133111EBULL;
+constexpr uint64_t kRangeSalt = 0xBF58476D1CE4E5B9ULL;
 
 /// A uniform in [0, 1) from 24 bits of `bits` starting at `shift`.
 inline float unit24(uint64_t bits, int shift) {
@@ -44,8 +47,10 @@ void compute_disparity(const float* z_m, float fxb_px_m, size_t n, float* dispar
 /// pixel further right in the same row lands at or left of x_r: that pixel's point is nearer
 /// and lies on the right camera's ray to this one. (Surfaces hidden in both views cast such a
 /// shadow through the surface that hides them, so scanning the visible pixels is exact.)
-void mark_hidden(const SimParams& p, float max_disparity_px, int width, int height, const float* disparity_px,
-                 uint8_t* hidden) {
+/// Outside the working range (disparity above max_disparity_px or below min_disparity_px)
+/// there is no depth either.
+void mark_hidden(const SimParams& p, float max_disparity_px, float min_disparity_px, int width, int height,
+                 const float* disparity_px, uint8_t* hidden) {
   // A step smaller than this is rounding, not occlusion: x_r grows by (1 − ∂d/∂u) per column,
   // which is > 0 for every surface the right imager sees at more than grazing incidence.
   constexpr float kEpsPx = 1e-3F;
@@ -88,7 +93,8 @@ void mark_hidden(const SimParams& p, float max_disparity_px, int width, int heig
           const int outside = xr < band_limit;
           const int shadowed = xr > m[u - begin] + shadow_eps;
           const int too_near = d[u] > max_disparity_px;
-          out[u] = static_cast<uint8_t>(hit & (outside | shadowed | too_near));
+          const int too_far = d[u] < min_disparity_px;
+          out[u] = static_cast<uint8_t>(hit & (outside | shadowed | too_near | too_far));
         }
       }
     }
@@ -209,14 +215,16 @@ struct NoisyDepth {
   }
 };
 
-/// Pixels beside a depth edge: a fixed share drops out, a fixed share of the far side flies
-/// (the matching window straddles the edge and takes in the nearer surface, whose texture
-/// dominates it, so the disparity lands between the two; the near side keeps its own).
-/// Fixed per pixel and seed, so that a still scene has still holes.
-void apply_edges(const SimParams& p, int width, int height, const float* d_true, const float* correlated,
-                 const float* g, const uint8_t* hidden, const NoisyDepth& to_raw, uint16_t* raw,
-                 std::vector<uint8_t>& row_steps) {
-  const uint64_t fixed_seed = mix64(p.seed ^ kFixedSalt);
+/// Pixels beside a depth edge: a share drops out, a share of the far side flies (the matching
+/// window straddles the edge and takes in the nearer surface, whose texture dominates it, so
+/// the disparity lands between the two; the near side keeps its own). Fixed per pixel and seed,
+/// so that a still scene has still holes; with edge_flicker, drawn anew every frame from
+/// `frame_seed`, and that share of the pixels that keep a depth take the other side's instead.
+void apply_edges(const SimParams& p, uint64_t frame_seed, int width, int height, const float* d_true,
+                 const float* correlated, const float* g, const uint8_t* hidden, const NoisyDepth& to_raw,
+                 uint16_t* raw, std::vector<uint8_t>& row_steps) {
+  const bool flicker = p.edge_flicker > 0.0F;
+  const uint64_t edge_seed = flicker ? mix64(frame_seed ^ kFlickerSalt) : mix64(p.seed ^ kFixedSalt);
   row_steps.resize(static_cast<size_t>(width));
   uint8_t* steps = row_steps.data();
   for (int v = 0; v < height; ++v) {
@@ -253,9 +261,12 @@ void apply_edges(const SimParams& p, int width, int height, const float* d_true,
       if (hidden[i] != 0 || !(d_true[i] > 0.0F)) continue;
       const ptrdiff_t j = edge_neighbour(d_true, u, v, width, height, i, p.edge_jump_px);
       if (j < 0) continue;
-      const uint64_t h = mix64(fixed_seed + i * kGolden);
+      const uint64_t h = mix64(edge_seed + i * kGolden);
       if (unit24(h, 0) < p.edge_dropout) {
         raw[i] = 0;
+      } else if (flicker && unit24(mix64(h), 0) < p.edge_flicker) {
+        // The other side's depth, near for a far pixel and far for a near one, with this pixel's noise.
+        raw[i] = to_raw(d_true[j] + (correlated != nullptr ? correlated[i] : 0.0F), g[i]);
       } else if (d_true[j] > d_true[i] && unit24(h, 24) < p.flying_pixels) {
         const float d = d_true[i] + unit24(h, 40) * (d_true[j] - d_true[i]);
         raw[i] = to_raw(d + (correlated != nullptr ? correlated[i] : 0.0F), g[i]);
@@ -290,6 +301,32 @@ void apply_materials(const SimParams& p, int width, int height, const uint16_t* 
   }
 }
 
+/// A working range (max_range_m > 0): no depth measured nearer than `min_range_m` or beyond
+/// max_range_m. With `dropouts`, from range_dropout_start_m on a share growing as the square of
+/// the way to max_range_m drops out, drawn anew every frame: the returned pattern fades with
+/// distance, so far pixels come and go.
+void apply_working_range(const SimParams& p, float min_range_m, bool dropouts, uint64_t frame_seed, size_t n,
+                         uint16_t* raw) {
+  // Limits in raw units, rounded as the depth is: 4.5 m keeps 4500 mm and drops 4501.
+  const auto to_units = [&p](float z_m) { return std::lround(static_cast<double>(z_m) / p.depth_scale_m); };
+  const long min_units = to_units(min_range_m);
+  const long max_units = to_units(p.max_range_m);
+  const long start_units = to_units(p.range_dropout_start_m);
+  const auto ramp_units = static_cast<float>(max_units - start_units);
+  dropouts = dropouts && p.range_dropout > 0.0F && ramp_units > 0.0F;
+  const uint64_t range_seed = mix64(frame_seed ^ kRangeSalt);
+  for (size_t i = 0; i < n; ++i) {
+    const long units = raw[i];
+    if (units == 0) continue;
+    if (units < min_units || units > max_units) {
+      raw[i] = 0;
+    } else if (dropouts && units > start_units) {
+      const float t = static_cast<float>(units - start_units) / ramp_units;
+      if (unit24(mix64(range_seed + i * kGolden), 0) < p.range_dropout * t * t) raw[i] = 0;
+    }
+  }
+}
+
 }  // namespace
 
 float sensor_min_range_m(const SimParams& p, float fx_px) {
@@ -308,8 +345,10 @@ void write_sensor_depth(const SimParams& p, float fx_px, int64_t index, const fl
   scratch.hidden.resize(n);
   const float min_range = sensor_min_range_m(p, fx_px);
   const float max_disparity = min_range > 0.0F ? fxb / min_range : std::numeric_limits<float>::infinity();
+  // A working range also ends far away (structured light); 0: no true depth is too far.
+  const float min_disparity = p.max_range_m > 0.0F ? fxb / p.max_range_m : 0.0F;
   compute_disparity(z_m, fxb, n, scratch.disparity_px.data());
-  mark_hidden(p, max_disparity, width, height, scratch.disparity_px.data(), scratch.hidden.data());
+  mark_hidden(p, max_disparity, min_disparity, width, height, scratch.disparity_px.data(), scratch.hidden.data());
 
   const float inv_scale = 1.0F / p.depth_scale_m;
   const uint64_t frame_seed = mix64(mix64(p.seed) ^ (static_cast<uint64_t>(index) * kGolden));
@@ -321,6 +360,7 @@ void write_sensor_depth(const SimParams& p, float fx_px, int64_t index, const fl
       const bool ok = scratch.disparity_px[i] > 0.0F && scratch.hidden[i] == 0 && r >= 1.0F && r < 65536.0F;
       raw[i] = ok ? static_cast<uint16_t>(r) : 0;
     }
+    if (p.max_range_m > 0.0F) apply_working_range(p, min_range, false, frame_seed, n, raw);
     return;
   }
   // One draw per pixel, hit or not, so that a pixel's noise does not depend on the scene.
@@ -354,8 +394,9 @@ void write_sensor_depth(const SimParams& p, float fx_px, int64_t index, const fl
     }
   }
   // Sparse fix-ups. Flying pixels first (they re-compute a value); dropouts only ever zero one.
-  apply_edges(p, width, height, d_true, correlated, g, hidden, to_raw, raw, scratch.row_steps);
+  apply_edges(p, frame_seed, width, height, d_true, correlated, g, hidden, to_raw, raw, scratch.row_steps);
   apply_materials(p, width, height, scratch.object_ids.data(), scratch.material_of_id.data(), raw);
+  if (p.max_range_m > 0.0F) apply_working_range(p, min_range, true, frame_seed, n, raw);
   SpeckleStream speckle(mix64(frame_seed ^ kSpeckleSalt), p.speckle);
   for (size_t i = speckle.first(); i < n; i = speckle.after(i)) raw[i] = 0;
 }

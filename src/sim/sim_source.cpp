@@ -20,6 +20,7 @@ SourceInfo SimSource::info() const {
   info.stereo_baseline_mm = sim_.params.baseline_mm;
   info.nominal_fps = sim_.params.fps;
   info.frame_count = sim_.params.frames;
+  info.sensor_model = sim_sensor_name(sim_.params.sensor);
   return info;
 }
 

@@ -273,10 +273,13 @@ void render_color(const Simulator& sim, const PoseF& T_base_camera_f, Frame& out
 }  // namespace
 
 Intrinsics Simulator::intrinsics() const {
-  const std::optional<Intrinsics> in = d435_depth_intrinsics(params.width, params.height);
+  const bool structured = params.sensor == SimSensor::structured_light;
+  const std::optional<Intrinsics> in = structured ? structured_light_intrinsics(params.width, params.height)
+                                                  : d435_depth_intrinsics(params.width, params.height);
   if (!in) {
-    throw std::invalid_argument("simulator: the D435 has no " + std::to_string(params.width) + "x" +
-                                std::to_string(params.height) + " depth mode");
+    throw std::invalid_argument(std::string("simulator: the ") + (structured ? "structured-light sensor" : "D435") +
+                                " has no " + std::to_string(params.width) + "x" + std::to_string(params.height) +
+                                " depth mode");
   }
   return *in;
 }

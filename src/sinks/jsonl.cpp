@@ -243,6 +243,11 @@ void JsonLinesSink::header(const RunHeader& header) {
   m.integer("frame_count", source.frame_count);
   m.number("nominal_fps", source.nominal_fps);
   m.number("stereo_baseline_mm", source.stereo_baseline_mm);
+  if (source.sensor_model.empty()) {
+    m.null("sensor_model");
+  } else {
+    m.text("sensor_model", source.sensor_model);
+  }
   if (!source.camera_serial.empty() || !source.camera_name.empty()) {
     m.text("name", source.camera_name);
     m.text("serial", source.camera_serial);

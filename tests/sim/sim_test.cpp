@@ -47,6 +47,7 @@ size_t count_label(const Frame& f, uint16_t label) {
 // number: that table and this check change together, and neither changes to make a test pass.
 void expect_documented_defaults(const SimParams& p, const std::string& where) {
   SCOPED_TRACE(where);
+  EXPECT_EQ(p.sensor, SimSensor::d435);
   EXPECT_EQ(p.width, 848);  // the table's figures are for 848x480
   EXPECT_EQ(p.height, 480);
   EXPECT_TRUE(p.noise);
@@ -58,9 +59,13 @@ void expect_documented_defaults(const SimParams& p, const std::string& where) {
   EXPECT_TRUE(p.occlusion_shadows);
   EXPECT_FLOAT_EQ(p.max_disparity_px, 110.0F);
   EXPECT_FLOAT_EQ(p.min_range_m, 0.0F);
+  EXPECT_FLOAT_EQ(p.max_range_m, 0.0F);  // no working range: off
+  EXPECT_FLOAT_EQ(p.range_dropout, 0.0F);
+  EXPECT_FLOAT_EQ(p.range_dropout_start_m, 0.0F);
   EXPECT_FLOAT_EQ(p.edge_jump_px, 1.5F);
   EXPECT_FLOAT_EQ(p.edge_dropout, 0.25F);
   EXPECT_FLOAT_EQ(p.flying_pixels, 0.15F);
+  EXPECT_FLOAT_EQ(p.edge_flicker, 0.0F);  // edges fixed per seed
   EXPECT_FLOAT_EQ(p.dark_dropout, 0.6F);
   EXPECT_FLOAT_EQ(p.shiny_dropout, 0.35F);
   EXPECT_FLOAT_EQ(p.low_texture_dropout, 0.5F);

@@ -135,6 +135,22 @@ TEST(JsonLinesSink, HeaderNamesTheLiveCamera) {
   EXPECT_EQ(h["source"]["name"], "Intel RealSense D435");
   EXPECT_EQ(h["source"]["serial"], "012345678901");  // a string: serials keep their leading zero
   EXPECT_EQ(h["source"]["firmware"], "5.13.0.50");
+  // Not a simulated sensor: no model, written as null (the key is always there).
+  ASSERT_TRUE(h["source"].contains("sensor_model"));
+  EXPECT_TRUE(h["source"]["sensor_model"].is_null());
+}
+
+TEST(JsonLinesSink, HeaderNamesTheSimulatedSensorModel) {
+  for (const std::string model : {"d435", "structured_light"}) {
+    std::ostringstream out;
+    JsonLinesSink sink(out);
+    RunHeader header;
+    header.source.type = "sim";
+    header.source.sensor_model = model;
+    sink.header(header);
+    const json h = json::parse(out.str());
+    EXPECT_EQ(h["source"]["sensor_model"], model);
+  }
 }
 
 TEST(JsonLinesSink, FrameWithContactHasEveryField) {
