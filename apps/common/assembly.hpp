@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense assembly — what both executables (`hrcsense`, later `hrcsense-view`) build from a
+// hrcsense assembly — what both executables (`hrcsense`, `hrcsense-view`) build from a
 // configuration: the source, the simulator, the background file, the run header. The
 // configuration itself stays plain data (config.hpp); adapters are chosen here, and one that
 // this build does not have is a ConfigError saying so.

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense apps — one run of the configured cell, as `hrcsense run` and `hrcsense-view` both
-// make it: source (and its recording), robot states, pipeline, background, JSON Lines and
-// console output, signal handling. The viewer joins through the hooks; nothing here knows it.
+// make it: source (and its recording), robot states, pipeline, background, the links to the
+// controller (UDP, RTDE), JSON Lines and console output, the fault log, signal handling. The
+// viewer joins through the hooks; nothing here knows it.
 #pragma once
 
 #include "hrcsense/config.hpp"

@@ -220,7 +220,7 @@ int info_command(const CommandArgs& args) {
     return 0;
   }
   if (config.source.type != "sim") {
-    make_source(config);  // throws the "not available in this build yet" error
+    make_source(config);  // ros2 in a build without DDS: throws "not built into this hrcsense"
   }
   const int status = print_sim(config);
   std::fflush(stdout);

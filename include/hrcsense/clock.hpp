@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — the clock run_pipeline decides by (pacing, frame ages, the watchdog, wall time):
-// the steady clock, or a fake one that tests move by hand.
+// the steady clock, or a fake one that tests move by hand. RunClock is one of the four virtual
+// interfaces (source.hpp says which).
 #pragma once
 
 #include <atomic>
@@ -19,7 +20,8 @@ inline int64_t seconds_to_ns(double s) {
 }
 
 /// The time source of run_pipeline. Times are integer nanoseconds from an arbitrary origin and
-/// never decrease. Implementations are called from the run's three threads at once.
+/// never decrease. Implementations are called from several threads at once: the run's three,
+/// and the threads of the link sinks and live robot state sources that are given the clock.
 class RunClock {
  public:
   virtual ~RunClock() = default;

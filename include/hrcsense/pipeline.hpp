@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — the per-frame processing path and the threads around it (run_pipeline). The
-// interfaces it joins are in source.hpp, sink.hpp and mailbox.hpp.
+// interfaces it joins are in source.hpp, sink.hpp, robot_state.hpp and clock.hpp, its
+// mailboxes in mailbox.hpp.
 #pragma once
 
 #include "hrcsense/cell_checks.hpp"
@@ -63,9 +64,11 @@ struct LiveTuning {
 /// The tunable part of `params`.
 LiveTuning tuning_of(const PipelineParams& params);
 
-/// The per-frame processing path: depth filters → background → foreground → robot capsules →
-/// proximity → verdict, on the caller's thread (run_pipeline gives it a thread of its own; the brute-force
-/// search may use a second one, `proximity.threads`). Owns the stages' state and scratch buffers.
+/// The per-frame processing path: depth filters → background (and the camera checks) → robot
+/// capsules → self-filter → foreground → per-link proximity → unknown space → per-link v_i and
+/// Z_d: a measurement, no verdict (a SafetyMonitor decides it). Runs on the caller's thread
+/// (run_pipeline gives it a thread of its own; the brute-force search may use a second one,
+/// `proximity.threads`). Owns the stages' state and scratch buffers.
 class Pipeline {
  public:
   explicit Pipeline(PipelineParams params);
@@ -200,7 +203,7 @@ class Pipeline {
 struct RunOptions {
   bool pace = false;         ///< play at the source's timestamps; frames may then be dropped
   int64_t max_frames = -1;   ///< stop after this many source frames; -1: until the source ends
-  std::atomic<bool>* stop_requested = nullptr;  ///< set from outside (SIGINT, SIGTERM, SIGHUP) to end the run
+  std::atomic<bool>* stop_requested = nullptr;  ///< set from outside (SIGINT, SIGTERM, SIGHUP, SIGTSTP) to end the run
   /// Decides pacing, frame ages, the watchdog and wall_s; null: the steady clock. Tests pass a
   /// FakeClock. Must outlive the run.
   RunClock* clock = nullptr;
@@ -231,16 +234,17 @@ bool host_time_is_source_time(RobotStateOrigin origin, bool paced);
 /// recorded, the latency already applied.
 int64_t robot_state_lookup_offset_ns(RobotStateOrigin origin, double camera_latency_s);
 
-/// Runs capture, processing and output on three threads joined by mailboxes. Processing
-/// measures (Pipeline::process); the output thread decides each measurement with one
-/// SafetyMonitor immediately before the sinks write it. Unpaced runs process every frame (the
+/// Runs capture and processing on two threads of their own and output on the caller's, joined
+/// by mailboxes. Processing measures (Pipeline::process); the output thread decides each
+/// measurement with one SafetyMonitor immediately before the sinks write it. Unpaced runs
+/// (options.pace false, live cameras included) process every frame the source delivers (the
 /// source waits for processing); paced runs drop and count, and a dropped measurement's verdict
 /// is carried into the next (carry_replaced).
 /// Each frame gets the robot state `robot_states` has at the frame's host time minus
-/// robot_state_lookup_offset_ns (camera_latency_s). The host time is the source's own (a live camera's capture time) when it
-/// sets Frame::host_time_ns; else the source timestamp with a `sim` state and for unpaced runs
-/// with a `fixed` one, and the delivery time on the run's clock otherwise (docs/ROBOT.md,
-/// "Clocks").
+/// robot_state_lookup_offset_ns (camera_latency_s). The host time is the source's own (a live
+/// camera's capture time) when it sets Frame::host_time_ns; else the source timestamp with a
+/// `sim` or `recorded` state and for unpaced runs with a `fixed` one, and the delivery time on
+/// the run's clock otherwise (host_time_is_source_time; docs/ROBOT.md, "Clocks").
 /// Writes header, every result and the summary to `sink`; returns the summary.
 RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline& pipeline, Sink& sink,
                         const RunOptions& options, const RunHeader& header);

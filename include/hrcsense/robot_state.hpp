@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — a source of robot joint states: the third one-level interface beside Source and
-// Sink. `fixed` (robot.joints_rad) is here; live ones (RTDE, UDP JSON) and the simulator's
-// scripted arm implement the same interface.
+// hrcsense — a source of robot joint states: one of the four one-level virtual interfaces
+// (source.hpp says which). `fixed` (robot.joints_rad) is here; the live ones (RTDE, UDP JSON),
+// the simulator's scripted arm and the states recorded in a bag implement the same interface.
 #pragma once
 
 #include "hrcsense/robot_state_history.hpp"

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — a Universal Robots RTDE client (protocol version 2, written from UR's public guide:
-// ../shared/specs/ur-rtde.md) as a robot state source. RTDE is not a safety interface and
-// hrcsense is not a safety-rated device: the robot's rated stop is its safety input.
+// ../shared/specs/ur-rtde.md) as a robot state source (RtdeRobotState), and the opt-in writer of
+// the verdict's speed scale to the controller's inputs (RtdeLinkSink, `link.rtde.*`). RTDE is
+// not a safety interface and hrcsense is not a safety-rated device: the robot's rated stop is
+// its safety input.
 #pragma once
 
 #include "hrcsense/clock.hpp"

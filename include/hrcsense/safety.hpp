@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — the safety verdict: run / slow / stop from the closest distance, and stop
-// whenever the data cannot be trusted. No data is never "all clear".
+// hrcsense — the safety verdict: run / slow / stop from each robot link's closest pair (`zones`
+// distances or the `ssm` protective separation distance), decided once per frame by the
+// output thread's SafetyMonitor, and stop whenever the data cannot be trusted. No data is
+// never "all clear".
 #pragma once
 
 #include "hrcsense/ssm.hpp"
@@ -142,7 +144,8 @@ class VerdictHold {
 /// written (run_pipeline's output thread, immediately before the sinks): the frame's age is
 /// taken at that moment, so a measurement that waited in a mailbox or through a stalled process
 /// is judged at its real age. Owns the verdict's hold and the no-frame watchdog. One monitor
-/// per run; not thread-safe. A fuser of several cameras hands their measurements to one.
+/// per run; not thread-safe. (Multi-camera fusion, still to come, is meant to hand the cameras'
+/// measurements to one monitor.)
 class SafetyMonitor {
  public:
   /// `nominal_fps` and `frames_at_a_rate` (a live or paced source) set the no-frame watchdog:

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — a simulated D435: a scene of planes, boxes, spheres and capsules, ray-cast into a
-// 16-bit depth image with the D435's stereo artefacts (docs/SIMULATOR.md), a flat-shaded rgb8
-// image from the D435's colour camera, plus ground truth.
+// hrcsense — a simulated D435 (or, with `sim.sensor: structured_light`, a PrimeSense-class
+// structured-light camera): a scene of planes, boxes, spheres and capsules, ray-cast into a
+// 16-bit depth image with the sensor's artefacts (docs/SIMULATOR.md), a flat-shaded rgb8 image
+// from the colour camera, plus ground truth.
 #pragma once
 
 #include "hrcsense/camera.hpp"

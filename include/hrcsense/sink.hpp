@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — a consumer of results: the other virtual interface (JSON Lines, the console, later
-// UDP, DDS, the recorder and the viewer), with what a run says before and after its frames.
+// hrcsense — a consumer of results: one of the four virtual interfaces (source.hpp says which).
+// JSON Lines, the console, the UDP and RTDE links to the controller and the viewer's tap
+// implement it (a ROS 2 output is still to come); with what a run says before and after its
+// frames.
 #pragma once
 
 #include "hrcsense/robot_state.hpp"
@@ -63,7 +65,7 @@ struct RecordCounters {
 struct RunSummary {
   int64_t frames_in = 0;          ///< frames read from the source
   int64_t frames_processed = 0;   ///< frames that went through processing
-  int64_t frames_dropped = 0;     ///< dropped by mailboxes (paced or live runs only)
+  int64_t frames_dropped = 0;     ///< dropped by mailboxes (paced runs only; unpaced ones wait)
   int64_t frames_dropped_camera = 0;  ///< lost before the source delivered them (Source::frames_dropped_camera)
   int64_t frames_valid = 0;
   int64_t verdict_run = 0, verdict_slow = 0, verdict_stop = 0;
@@ -88,7 +90,7 @@ struct RunSummary {
   std::optional<int64_t> viewer_frames_dropped;
 };
 
-/// A consumer of results. The other virtual interface of hrcsense.
+/// A consumer of results. One of the four virtual interfaces of hrcsense (listed at the top of source.hpp).
 class Sink {
  public:
   virtual ~Sink() = default;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — a source of depth frames: one of the two virtual interfaces (simulator, recordings,
-// live cameras implement it).
+// hrcsense — a source of depth frames: one of hrcsense's four one-level virtual interfaces,
+// with Sink (sink.hpp), RobotStateSource (robot_state.hpp) and RunClock (clock.hpp). The
+// simulator, the recordings and the live cameras implement it.
 #pragma once
 
 #include "hrcsense/types.hpp"
@@ -31,7 +32,7 @@ struct SourceInfo {
   std::string sensor_model;
 };
 
-/// A source of depth frames. One of the two virtual interfaces of hrcsense.
+/// A source of depth frames. One of the four virtual interfaces of hrcsense (listed above).
 class Source {
  public:
   /// `idle`: a live source had no frame within its own short wait (a silent camera); the run

@@ -241,8 +241,8 @@ enum class ReasonCode : uint16_t {
   no_robot_state = 12,      ///< stop: no valid robot state for the frame (an arm needs its joints)
   robot_state_stale = 13,   ///< stop: the newest robot state is older than robot.state.max_age_s
   foreground_failed = 14,   ///< stop: the foreground test could not run
-  stale_frame = 15,         ///< stop: the frame is older than safety.max_frame_age_s
-  no_frame = 16,            ///< stop: the watchdog saw no frame for safety.max_frame_age_s
+  stale_frame = 15,         ///< stop: when decided, delivered longer ago than the no-frame limit (no_frame's)
+  no_frame = 16,            ///< stop: the watchdog saw no frame for safety.max_frame_age_s (or max_frame_gap_periods)
   source_ended = 17,        ///< stop: end of the run, the source ended
   frame_limit_reached = 18, ///< stop: end of the run, --frames reached
   stop_requested = 19,      ///< stop: end of the run, SIGINT, SIGTERM, SIGHUP or SIGTSTP
@@ -294,7 +294,7 @@ struct LinkContact {
 
 /// What processing measured for one frame (Pipeline::process), before any decision: the
 /// SafetyMonitor turns it into the verdict on the output thread. Buffers are reused frame to
-/// frame. A camera's measurement is what a fuser of several cameras would receive.
+/// frame. A camera's measurement is what a fuser of several cameras (still to come) would receive.
 struct Measurement {
   int64_t frame = 0;          ///< source frame index
   /// false for a result that stands for no new source frame (watchdog timeout, end of run);

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — the per-frame processing path: background → foreground → proximity → verdict.
+// hrcsense — the per-frame processing path: filters → background and camera checks → robot
+// state → self-filter → foreground → proximity → unknown space → per-link v_i and Z_d, into a
+// Measurement; the verdict is decided later, by the output thread's SafetyMonitor.
 
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/unknown_space.hpp"
@@ -253,7 +255,8 @@ const BackgroundModel& Pipeline::background() const {
   return preset_background_ ? preset_model_ : learner_.model();
 }
 
-// One line per stage; a stage that cannot go on withholds the measurement with its reason.
+// One call per stage; a stage that cannot go on withholds the measurement with its reason, and
+// the stages after it do not run.
 void Pipeline::process(const Frame& source_frame, const RobotState& robot_state, Measurement& m) {
   const Clock::time_point start = Clock::now();
   begin_measurement(source_frame, robot_state, m);
