@@ -8,7 +8,7 @@
 // In-place blocks get a fresh copy of their input outside the timed region, so each iteration
 // sees real data (holes to fill, unsmoothed noise) rather than its own previous output.
 
-#include "../../tests/filters/reference.hpp"
+#include "tests/filters/reference.hpp"
 #include "hrcsense/filters.hpp"
 #include "hrcsense/sim.hpp"
 

@@ -5,9 +5,9 @@
 
 #include "hrcsense/person_cloud.hpp"
 
-#include "../../src/proximity/brute.hpp"
-#include "../../src/proximity/kdtree.hpp"
-#include "../../src/proximity/octree.hpp"
+#include "src/proximity/brute.hpp"
+#include "src/proximity/kdtree.hpp"
+#include "src/proximity/octree.hpp"
 #include "hrcsense/proximity.hpp"
 
 #include <benchmark/benchmark.h>

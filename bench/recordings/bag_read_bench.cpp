@@ -6,7 +6,7 @@
 // rss_end_MiB (resident memory after the first 100 frames and at the end) show that memory stays
 // flat however many frames are read (loop: true replays the file).
 
-#include "../../tests/support/bag_writer.hpp"
+#include "tests/support/bag_writer.hpp"
 #include "../common/thesis_scene.hpp"
 
 #include "hrcsense/recordings.hpp"

@@ -4,7 +4,7 @@
 // Pipeline/moving_ur5_sdk/848x480: the whole per-frame path on that cell with the sdk filters,
 // the self-filter and the arm's pose of each frame.
 
-#include "../../apps/common/assembly.hpp"
+#include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/robot.hpp"

@@ -34,7 +34,7 @@ std::string config_path(const std::string& name) { return std::string(HRCSENSE_S
 // on, where the wrist's swing comes towards them at up to ≈ 1 m/s, and the arm following the
 // link. `hold` false: safety.min_hold_s and hysteresis_m 0, so that each frame's scale reaches
 // the arm at once (the hold would hide a wrong scale for up to min_hold_s).
-Config standing_person_cell(bool hold) {
+Config closed_loop_cell(bool hold) {
   std::vector<std::string> overrides{"robot.trajectory.follow_link=true"};
   if (!hold) overrides.insert(overrides.end(), {"safety.min_hold_s=0", "safety.hysteresis_m=0"});
   Config config = load_config(config_path("cell-ur5-moving.yaml"), overrides);
@@ -157,7 +157,7 @@ void print(const char* name, const LoopCounts& count) {
 // may go faster, returns above the allowed speed.
 TEST(ClosedLoop, TheArmFollowingTheLinkStaysWithinTheAllowedSpeed) {
   for (const bool hold : {false, true}) {
-    const Config config = standing_person_cell(hold);
+    const Config config = closed_loop_cell(hold);
     ASSERT_EQ(config.pipeline.safety.mode, SafetyParams::Mode::ssm);
     ASSERT_EQ(config.pipeline.safety.ssm.robot_decel_mps2, 0.0F);  // allowed_speed_mps's linear S_p
     ASSERT_EQ(config.pipeline.background.frames, 100);

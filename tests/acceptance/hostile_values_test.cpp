@@ -28,7 +28,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int64_t kFrames = 7;
+constexpr int64_t kFramesPerValue = 7;
 const char* const kHostile[] = {".nan", ".inf", "-.inf", "1e39", "-1e39", "1e-39", "-1", "0"};
 
 // thesis-box.yaml with the box entering at frame 3 instead of 100.
@@ -127,7 +127,7 @@ TEST(HostileValues, EveryNumericKeyIsRefusedOrFailsSafe) {
     FixedRobotState robot_states(defaults.robot_state.joints_rad);
     Keeping sink;
     RunOptions options;
-    options.max_frames = kFrames;
+    options.max_frames = kFramesPerValue;
     run_pipeline(*source, robot_states, pipeline, sink, options, RunHeader{});
     ASSERT_GE(sink.results.size(), 5U);
     EXPECT_EQ(sink.results[4].verdict.state, VerdictState::run) << sink.results[4].verdict.reason;
@@ -155,7 +155,7 @@ TEST(HostileValues, EveryNumericKeyIsRefusedOrFailsSafe) {
         Pipeline pipeline(config.pipeline);
         FixedRobotState robot_states(config.robot_state.joints_rad);
         RunOptions options;
-        options.max_frames = kFrames;
+        options.max_frames = kFramesPerValue;
         run_pipeline(*source, robot_states, pipeline, sink, options, RunHeader{});
       } catch (const std::exception& e) {
         ADD_FAILURE() << assignment << ": accepted by config, then failed outside it: " << e.what();

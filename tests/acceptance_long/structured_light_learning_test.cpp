@@ -30,7 +30,7 @@
 namespace hrcsense {
 namespace {
 
-constexpr int kLearnFrames = 5;
+constexpr int kFiveLearnFrames = 5;
 constexpr int kFrames = 400;
 constexpr double kPixels = 640.0 * 480.0;
 
@@ -94,7 +94,7 @@ Outcome run_scene(const std::string& name) {
 void check(const std::string& name) {
   const Outcome o = run_scene(name);
   ASSERT_GE(o.ready_frame, 0) << name << ": learning never finished";
-  EXPECT_LE(o.ready_frame, 2 * kLearnFrames) << name << ": more than one restart";
+  EXPECT_LE(o.ready_frame, 2 * kFiveLearnFrames) << name << ": more than one restart";
   double worst_empty = 0.0, weakest_person = 1.0;
   int empty = 0, with_person = 0;
   for (const auto& [index, share] : o.foreground) {

@@ -26,7 +26,7 @@ std::string error_of(const std::string& path, const std::vector<std::string>& ov
   return {};
 }
 
-const char* const kPostArm = R"(name: post
+const char* const kMinimalPostArm = R"(name: post
 dh:
   - {d_m: 1, a_m: 0, alpha_deg: 0}
   - {d_m: 0, a_m: 0, alpha_deg: 0}
@@ -116,20 +116,20 @@ TEST(ConfigStrict, LeadingZerosAreRefusedForEveryNumber) {
 
 TEST(ConfigStrict, RobotDescriptionFilesGoThroughTheSameChecks) {
   TempDir dir;
-  const std::string dup = dir.write("dup.yaml", std::string(kPostArm) + "name: other\n");
+  const std::string dup = dir.write("dup.yaml", std::string(kMinimalPostArm) + "name: other\n");
   expect_config_error("", {"robot.model=custom", "robot.description=" + dup, "robot.joints_rad=[0, 0, 0, 0, 0, 0]"},
                       {"key 'robot.description'", dup + ":11:1: duplicate key 'name' (first at line 1)"});
-  const std::string two = dir.write("two.yaml", std::string(kPostArm) + "---\nname: x\n");
+  const std::string two = dir.write("two.yaml", std::string(kMinimalPostArm) + "---\nname: x\n");
   try {
     (void)load_robot_description(two);
     FAIL() << "no error";
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()).rfind(two + ":11:1: a second YAML document", 0), 0U) << e.what();
   }
-  const std::string tagged = dir.write("tag.yaml", std::string(kPostArm) + "padding_m: !cm 2\n");
+  const std::string tagged = dir.write("tag.yaml", std::string(kMinimalPostArm) + "padding_m: !cm 2\n");
   expect_config_error("", {"robot.model=custom", "robot.description=" + tagged, "robot.joints_rad=[0, 0, 0, 0, 0, 0]"},
                       {tagged + ":11:12: unknown tag '!cm' on key 'padding_m'"});
-  EXPECT_NO_THROW((void)load_robot_description(dir.write("good.yaml", kPostArm)));
+  EXPECT_NO_THROW((void)load_robot_description(dir.write("good.yaml", kMinimalPostArm)));
 }
 
 TEST(ConfigStrict, AFolderAsConfigOrDescriptionIsAConfigErrorNamingIt) {

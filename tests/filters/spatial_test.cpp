@@ -230,7 +230,7 @@ TEST(Spatial, NeverSmoothsAcrossAStepLargerThanDelta) {
   }
 }
 
-DepthImage random_depth(std::mt19937& rng, int w, int h) {
+DepthImage random_depth_with_holes(std::mt19937& rng, int w, int h) {
   std::uniform_int_distribution<int> value(900, 1100);
   std::uniform_int_distribution<int> hole(0, 9);
   DepthImage d;
@@ -241,7 +241,7 @@ DepthImage random_depth(std::mt19937& rng, int w, int h) {
 
 TEST(Spatial, AlphaOneWithoutHoleFillChangesNothing) {
   std::mt19937 rng(11);
-  const DepthImage in = random_depth(rng, 64, 48);
+  const DepthImage in = random_depth_with_holes(rng, 64, 48);
   DepthImage depth = in;
   spatial_filter(SpatialParams{1.0F, 50, 5, 0}, depth);
   EXPECT_EQ(depth.pixels, in.pixels);
@@ -255,7 +255,7 @@ TEST(Spatial, AlphaOneWithoutHoleFillChangesNothing) {
 TEST(Spatial, NeverInvalidatesAValidPixel) {
   std::mt19937 rng(13);
   for (int holes = 0; holes <= 5; ++holes) {
-    const DepthImage in = random_depth(rng, 50, 40);
+    const DepthImage in = random_depth_with_holes(rng, 50, 40);
     DepthImage depth = in;
     spatial_filter(SpatialParams{0.3F, 30, 3, holes}, depth);
     DisparityImage disparity;
@@ -275,7 +275,7 @@ TEST(Spatial, EqualsThePlainReferenceBitForBit) {
   const SpatialParams options[] = {{0.5F, 20, 2, 0}, {0.25F, 1, 1, 1}, {0.4F, 50, 5, 3},
                                    {0.77F, 8, 3, 5}, {1.0F, 20, 2, 2}, {0.5F, 20, 2, 4}};
   for (const SpatialParams& q : options) {
-    const DepthImage in = random_depth(rng, 37, 23);
+    const DepthImage in = random_depth_with_holes(rng, 37, 23);
     DepthImage ours = in, theirs = in;
     spatial_filter(q, ours);
     reference::spatial_depth(q, theirs);

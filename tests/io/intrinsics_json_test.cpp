@@ -36,7 +36,7 @@ std::string error_of(const std::string& text) {
   return {};
 }
 
-const char* kGood = R"({"width":640,"height":480,"fx":390.4315,"fy":390.4315,"ppx":331.3879,"ppy":242.1873,)"
+const char* kGoodIntrinsics = R"({"width":640,"height":480,"fx":390.4315,"fy":390.4315,"ppx":331.3879,"ppy":242.1873,)"
                     R"("model":"Brown Conrady","coeffs":[0,0,0,0,0]})";
 
 TEST(IntrinsicsJson, WritesTheAgreedFields) {
@@ -70,7 +70,7 @@ TEST(IntrinsicsJson, RoundTripIsBitExactForEveryModel) {
 }
 
 TEST(IntrinsicsJson, ReadsAHandWrittenFile) {
-  const Intrinsics in = intrinsics_from_json(kGood, "cell.json");
+  const Intrinsics in = intrinsics_from_json(kGoodIntrinsics, "cell.json");
   EXPECT_EQ(in.width, 640);
   EXPECT_EQ(in.height, 480);
   EXPECT_FLOAT_EQ(in.fx, 390.4315F);
@@ -80,7 +80,7 @@ TEST(IntrinsicsJson, ReadsAHandWrittenFile) {
 }
 
 TEST(IntrinsicsJson, ErrorsNameTheSourceAndTheField) {
-  nlohmann::json good = nlohmann::json::parse(kGood);
+  nlohmann::json good = nlohmann::json::parse(kGoodIntrinsics);
   for (const char* name : {"width", "height", "fx", "fy", "ppx", "ppy", "model", "coeffs"}) {
     nlohmann::json missing = good;
     missing.erase(name);

@@ -18,7 +18,7 @@
 namespace hrcsense {
 namespace {
 
-std::string temp_path(const std::string& name) {
+std::string png_temp_path(const std::string& name) {
   return ::testing::TempDir() + "hrcsense_png_" + std::to_string(::getpid()) + "_" + name;
 }
 
@@ -77,7 +77,7 @@ std::string expect_io_error(const std::string& path) {
 }
 
 TEST(DepthPng, RoundTripKeepsEveryValue) {
-  const std::string path = temp_path("round_trip.png");
+  const std::string path = png_temp_path("round_trip.png");
   const DepthImage written = test_pattern(37, 23);  // odd sizes catch stride mistakes
   write_depth_png(path, written);
 
@@ -100,8 +100,8 @@ TEST(DepthPng, RoundTripKeepsEveryValue) {
 }
 
 TEST(DepthPng, ReadingASmallerImageReusesTheBuffer) {
-  const std::string big = temp_path("big.png");
-  const std::string small = temp_path("small.png");
+  const std::string big = png_temp_path("big.png");
+  const std::string small = png_temp_path("small.png");
   write_depth_png(big, test_pattern(64, 48));
   write_depth_png(small, test_pattern(8, 6));
   DepthImage depth;
@@ -115,13 +115,13 @@ TEST(DepthPng, ReadingASmallerImageReusesTheBuffer) {
 }
 
 TEST(DepthPng, RejectsEightBitWithTheFileName) {
-  const std::string path = temp_path("eight_bit_gray.png");
+  const std::string path = png_temp_path("eight_bit_gray.png");
   write_foreign_png(path, PNG_FORMAT_GRAY, 5, 4);
   const std::string message = expect_io_error(path);
   EXPECT_NE(message.find(path), std::string::npos) << message;
   EXPECT_NE(message.find("8-bit"), std::string::npos) << message;
 
-  const std::string rgb_path = temp_path("eight_bit_rgb.png");
+  const std::string rgb_path = png_temp_path("eight_bit_rgb.png");
   ColorImage color;
   color.width = 5;
   color.height = 4;
@@ -135,7 +135,7 @@ TEST(DepthPng, RejectsEightBitWithTheFileName) {
 }
 
 TEST(DepthPng, RejectsSixteenBitColour) {
-  const std::string path = temp_path("sixteen_bit_rgb.png");
+  const std::string path = png_temp_path("sixteen_bit_rgb.png");
   write_foreign_png(path, PNG_FORMAT_LINEAR_RGB, 5, 4);
   const std::string message = expect_io_error(path);
   EXPECT_NE(message.find(path), std::string::npos) << message;
@@ -144,19 +144,19 @@ TEST(DepthPng, RejectsSixteenBitColour) {
 }
 
 TEST(DepthPng, RejectsMissingForeignAndTruncatedFiles) {
-  const std::string missing = temp_path("does_not_exist.png");
+  const std::string missing = png_temp_path("does_not_exist.png");
   const std::string missing_message = expect_io_error(missing);
   EXPECT_NE(missing_message.find(missing), std::string::npos) << missing_message;
   EXPECT_NE(missing_message.find("cannot open"), std::string::npos) << missing_message;
 
-  const std::string text = temp_path("not_a_png.png");
+  const std::string text = png_temp_path("not_a_png.png");
   std::ofstream(text) << "depth,values\n1,2\n";
   const std::string text_message = expect_io_error(text);
   EXPECT_NE(text_message.find(text), std::string::npos) << text_message;
   EXPECT_NE(text_message.find("not a PNG"), std::string::npos) << text_message;
 
   // A valid file cut in half fails inside libpng: exercises the longjmp error path.
-  const std::string cut = temp_path("truncated.png");
+  const std::string cut = png_temp_path("truncated.png");
   write_depth_png(cut, test_pattern(120, 90));
   std::filesystem::resize_file(cut, std::filesystem::file_size(cut) / 2);
   const std::string cut_message = expect_io_error(cut);
@@ -171,7 +171,7 @@ TEST(DepthPng, RejectsMissingForeignAndTruncatedFiles) {
 
 TEST(DepthPng, RejectsImplausibleSizesBeforeAllocating) {
   // 20000 px wide: beyond the reader's limit of 16384 px per side.
-  const std::string path = temp_path("too_wide.png");
+  const std::string path = png_temp_path("too_wide.png");
   write_foreign_png(path, PNG_FORMAT_LINEAR_Y, 20000, 1);
   const std::string message = expect_io_error(path);
   EXPECT_NE(message.find(path), std::string::npos) << message;
@@ -180,7 +180,7 @@ TEST(DepthPng, RejectsImplausibleSizesBeforeAllocating) {
 }
 
 TEST(DepthPng, WriteRejectsInconsistentSizes) {
-  const std::string path = temp_path("bad_size.png");
+  const std::string path = png_temp_path("bad_size.png");
   DepthImage depth = test_pattern(10, 10);
   depth.width = 11;  // pixels no longer match width · height
   EXPECT_THROW(write_depth_png(path, depth), IoError);
@@ -195,7 +195,7 @@ TEST(DepthPng, WriteRejectsInconsistentSizes) {
 }
 
 TEST(DepthPng, WriteIntoAMissingFolderNamesTheFile) {
-  const std::string path = temp_path("no_such_folder") + "/depth.png";
+  const std::string path = png_temp_path("no_such_folder") + "/depth.png";
   try {
     write_depth_png(path, test_pattern(4, 4));
     FAIL() << "expected IoError";
@@ -205,7 +205,7 @@ TEST(DepthPng, WriteIntoAMissingFolderNamesTheFile) {
 }
 
 TEST(ColorPng, IndependentDecoderReadsTheSameColours) {
-  const std::string path = temp_path("colour.png");
+  const std::string path = png_temp_path("colour.png");
   ColorImage color;
   color.width = 7;
   color.height = 3;

@@ -8,6 +8,7 @@
 
 #include "../support/child_process.hpp"
 #include "../support/loopback.hpp"
+#include "../support/units.hpp"
 
 #include <fcntl.h>
 #include <netinet/in.h>
@@ -34,7 +35,7 @@
 namespace hrcsense {
 namespace {
 
-constexpr int64_t kMs = 1'000'000;
+using test::kMs;
 constexpr uint32_t kDead = 0x0BADF00DU;   // the session of the process that dies
 constexpr uint32_t kReborn = 0x600DCAFEU; // the session of its restart
 

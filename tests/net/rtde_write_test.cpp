@@ -3,6 +3,7 @@
 // ../shared/specs/ur-rtde.md, and RtdeLinkSink against the fake controller's input session
 // (tests/net/fake_rtde_controller.hpp) on 127.0.0.1: what arrives (the recipe, the values, the
 // stops), IN_USE refusals, malformed replies, a lost connection. Every wait is bounded.
+#include "../support/units.hpp"
 #include "cli_cell.hpp"
 #include "fake_rtde_controller.hpp"
 
@@ -30,7 +31,7 @@ using test::FakeRtdeController;
 using test::FakeRtdeScript;
 using test::RtdeFault;
 
-constexpr int64_t kMs = 1'000'000;
+using test::kMs;
 
 // Waits (real time, at most `seconds`, looking every millisecond) until `done()`.
 bool eventually(const std::function<bool()>& done, double seconds = 5.0) {

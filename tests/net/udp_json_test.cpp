@@ -4,6 +4,7 @@
 #include "hrcsense/udp_json.hpp"
 
 #include "../support/loopback.hpp"
+#include "../support/units.hpp"
 #include "cli_cell.hpp"
 
 #include "common/assembly.hpp"
@@ -32,7 +33,7 @@
 namespace hrcsense {
 namespace {
 
-constexpr int64_t kMs = 1'000'000;
+using test::kMs;
 constexpr double kPi = 3.14159265358979323846;
 constexpr int64_t kS = 1'000'000'000;
 

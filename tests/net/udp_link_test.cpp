@@ -12,6 +12,7 @@
 #include "hrcsense/sinks.hpp"
 
 #include "../support/loopback.hpp"
+#include "../support/units.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -41,7 +42,7 @@
 namespace hrcsense {
 namespace {
 
-constexpr int64_t kMs = 1'000'000;
+using test::kMs;
 
 // A frame datagram laid out by hand: magic "HRCS", version 2, kind 1, sequence 0x01020304,
 // timestamp 0x0011223344556677, verdict 1 (slow), reason 2 (in_slow_zone), speed_scale 0.5

@@ -133,14 +133,14 @@ TEST(ClosestContactBrute, TiesPreferLowestPointThenLowestCapsule) {
 }
 
 // Straightforward double-precision reference, written independently of the implementation.
-struct Reference {
+struct BruteReference {
   double distance = std::numeric_limits<double>::infinity();
   size_t point = 0;
   size_t capsule = 0;
 };
 
-Reference reference_contact(const PointCloud& cloud, const RobotModel& robot) {
-  Reference best;
+BruteReference brute_reference_contact(const PointCloud& cloud, const RobotModel& robot) {
+  BruteReference best;
   for (size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3d p = cloud.point(i).cast<double>();
     for (size_t c = 0; c < robot.capsules.size(); ++c) {
@@ -174,7 +174,7 @@ TEST(ClosestContactBrute, RandomCloudsMatchDoubleReference) {
     for (int i = 0; i < points; ++i) {
       cloud.push_back(coord(rng) + 3.0F, coord(rng), coord(rng), static_cast<uint32_t>(i));
     }
-    const Reference ref = reference_contact(cloud, robot);
+    const BruteReference ref = brute_reference_contact(cloud, robot);
     const Contact c = closest_contact_brute(cloud, cloud, robot);
     ASSERT_TRUE(c.valid);
     EXPECT_NEAR(c.distance_m, ref.distance, 1e-5) << "trial " << trial;

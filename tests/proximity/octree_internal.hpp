@@ -7,5 +7,5 @@
 #pragma once
 #pragma GCC system_header
 
-#include "../../src/proximity/brute.hpp"
-#include "../../src/proximity/octree.hpp"
+#include "src/proximity/brute.hpp"
+#include "src/proximity/octree.hpp"

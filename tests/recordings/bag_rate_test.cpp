@@ -6,7 +6,7 @@
 #include "../support/run_cli.hpp"
 
 #include "hrcsense/recordings.hpp"
-#include "../../src/recordings/bag_reader.hpp"
+#include "src/recordings/bag_reader.hpp"
 
 #include <gtest/gtest.h>
 
@@ -21,7 +21,7 @@ using test::cli;
 using test::CliResult;
 using test::ScratchDir;
 
-#define REQUIRE_BAG()                                       \
+#define REQUIRE_D435_BAG()                                       \
   const std::string bag = test::shared_d435_bag();          \
   if (bag.empty()) GTEST_SKIP() << "../shared/data/librealsense_d435_single_frame is absent"
 
@@ -39,7 +39,7 @@ int64_t stated_fps(const std::string& bag, const std::string& topic) {
 }
 
 TEST(BagRate, TheRealBagsStatedRateIsTheSourcesNominalRate) {
-  REQUIRE_BAG();
+  REQUIRE_D435_BAG();
   BagSource source(RecordingParams{bag});
   EXPECT_EQ(source.info().nominal_fps, 6.0) << "README: depth 640x480 Z16 at 6 fps";
   const RecordingSummary summary = summarize_recording(bag);
@@ -49,7 +49,7 @@ TEST(BagRate, TheRealBagsStatedRateIsTheSourcesNominalRate) {
 }
 
 TEST(BagRate, ALoopedLapStartsOnePeriodOfTheStatedRateAfterTheLastFrame) {
-  REQUIRE_BAG();
+  REQUIRE_D435_BAG();
   RecordingParams params{bag};
   params.loop = true;
   BagSource source(params);
@@ -65,7 +65,7 @@ TEST(BagRate, ALoopedLapStartsOnePeriodOfTheStatedRateAfterTheLastFrame) {
 }
 
 TEST(BagRate, APacedReplayOfTheRealBagSkipsNoFramesAndNeverStopsForNoFrame) {
-  REQUIRE_BAG();
+  REQUIRE_D435_BAG();
   ScratchDir out("bagrate");
   // Six frames (three laps) paced at the bag's own 6 frames/s: about one second.
   const CliResult r = cli("run --set source.type=bag --set source.path=" + bag +
@@ -79,7 +79,7 @@ TEST(BagRate, APacedReplayOfTheRealBagSkipsNoFramesAndNeverStopsForNoFrame) {
 }
 
 TEST(BagRate, ARecordingOfTheRealBagStatesItsRate) {
-  REQUIRE_BAG();
+  REQUIRE_D435_BAG();
   ScratchDir out("bagrate");
   const std::string copy = out / "again.bag";
   const CliResult r = cli("record --set source.type=bag --set source.path=" + bag + " --out " + copy);

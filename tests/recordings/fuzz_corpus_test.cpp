@@ -2,7 +2,7 @@
 // Replays the fuzzers' seed corpus (fuzz/corpus/) and every crash reproducer kept in
 // fuzz/regressions/ through the fuzz targets' own entry code (fuzz/fuzz_entries.cpp), built
 // with GCC here: no crash, no sanitizer report (asan preset), a clean end or a clean error.
-#include "../../fuzz/fuzz_entries.hpp"
+#include "fuzz/fuzz_entries.hpp"
 #include "recordings_test_util.hpp"
 
 #include "hrcsense/io.hpp"

@@ -9,8 +9,8 @@
 #include "hrcsense/bag_writer.hpp"
 #include "hrcsense/io.hpp"
 #include "hrcsense/recordings.hpp"
-#include "../../src/recordings/bag_messages.hpp"
-#include "../../src/recordings/bag_reader.hpp"
+#include "src/recordings/bag_messages.hpp"
+#include "src/recordings/bag_reader.hpp"
 
 #include <gtest/gtest.h>
 

@@ -7,8 +7,8 @@
 #include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/recordings.hpp"
-#include "../../src/recordings/bag_messages.hpp"
-#include "../../src/recordings/bag_reader.hpp"
+#include "src/recordings/bag_messages.hpp"
+#include "src/recordings/bag_reader.hpp"
 
 #include <gtest/gtest.h>
 

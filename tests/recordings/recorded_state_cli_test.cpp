@@ -11,8 +11,8 @@
 #include "hrcsense/bag_writer.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/sim.hpp"
-#include "../../src/recordings/bag_messages.hpp"
-#include "../../src/recordings/bag_reader.hpp"
+#include "src/recordings/bag_messages.hpp"
+#include "src/recordings/bag_reader.hpp"
 #include "../support/run_cli.hpp"
 
 #include <gtest/gtest.h>
@@ -32,7 +32,7 @@ namespace {
 
 using nlohmann::json;
 
-constexpr int kFrames = 90;  // a full 2.7 s pick-and-place cycle and some
+constexpr int kRecordedFrames = 90;  // a full 2.7 s pick-and-place cycle and some
 
 std::string moving_config() { return std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml"; }
 
@@ -83,7 +83,7 @@ class RecordedState : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new SuiteDir();
-    live_run_ = new test::CliResult(test::cli("run " + moving_cell(kFrames) + " --set record.queue_frames=128 --record " +
+    live_run_ = new test::CliResult(test::cli("run " + moving_cell(kRecordedFrames) + " --set record.queue_frames=128 --record " +
                                               (*dir_ / "moving.bag") + " --out " + (*dir_ / "live.jsonl")));
     live_ = new RunOutput(live_run_->exit_code == 0 ? read_run(*dir_ / "live.jsonl") : RunOutput{});
   }
@@ -102,10 +102,10 @@ test::CliResult* RecordedState::live_run_ = nullptr;
 RunOutput* RecordedState::live_ = nullptr;
 
 TEST_F(RecordedState, TheLiveRunRecordedEveryFrameAndSaysSoInItsSummary) {
-  ASSERT_EQ(live_->frames.size(), static_cast<size_t>(kFrames));
+  ASSERT_EQ(live_->frames.size(), static_cast<size_t>(kRecordedFrames));
   const json& record = live_->summary["record"];
   ASSERT_TRUE(record.is_object()) << live_->summary.dump();
-  EXPECT_EQ(record["frames_recorded"], kFrames);
+  EXPECT_EQ(record["frames_recorded"], kRecordedFrames);
   EXPECT_EQ(record["frames_dropped"], 0);
   EXPECT_EQ(record["files"], json::array({*dir_ / "moving.bag"}));
   EXPECT_TRUE(record["error"].is_null());
@@ -127,7 +127,7 @@ TEST_F(RecordedState, AReplayMeasuresEveryFrameAgainstTheRecordedJoints) {
     EXPECT_EQ(again["distance_m"], live["distance_m"]) << "frame " << index;
     EXPECT_EQ(again["verdict"], live["verdict"]) << "frame " << index;
   }
-  EXPECT_EQ(replayed.summary["robot_state"]["accepted"], kFrames);
+  EXPECT_EQ(replayed.summary["robot_state"]["accepted"], kRecordedFrames);
   EXPECT_TRUE(replayed.summary["record"].is_null()) << "nothing recorded";
 }
 
@@ -163,11 +163,11 @@ TEST_F(RecordedState, TheJointsCarryUrNamesAndTheSimulatedVelocities) {
     for (size_t j = 0; j < 6; ++j) EXPECT_NEAR(joints.velocity_rad_s[j], want.qd_rad_s[j], 1e-9) << "joint " << j;
     ++states;
   }
-  EXPECT_EQ(states, kFrames);
+  EXPECT_EQ(states, kRecordedFrames);
 }
 
 TEST_F(RecordedState, HrcsenseRecordsBagsThatReplayTheSameWay) {
-  const test::CliResult record = test::cli("record " + moving_cell(kFrames) + " --frames 30 --out " + (*dir_ / "r.bag"));
+  const test::CliResult record = test::cli("record " + moving_cell(kRecordedFrames) + " --frames 30 --out " + (*dir_ / "r.bag"));
   ASSERT_EQ(record.exit_code, 0) << record.out;
   const test::CliResult run = test::cli("run " + replay(*dir_ / "r.bag") + " --out " + (*dir_ / "r.jsonl"));
   ASSERT_EQ(run.exit_code, 0) << run.out;

@@ -11,7 +11,7 @@
 #include "hrcsense/io.hpp"
 #include "hrcsense/recorder.hpp"
 #include "hrcsense/recordings.hpp"
-#include "../../src/recordings/bag_reader.hpp"
+#include "src/recordings/bag_reader.hpp"
 
 #include <gtest/gtest.h>
 

@@ -17,7 +17,7 @@ namespace {
 // deceleration (S_s = v·T_s/2); C = 8·(40 − 14) mm = 0.208 m; Z_r 0.01 m. At an age of 0 T_r is
 // 0.05 s, so with Z_d 0.02 m S_p(v) = 1.6·0.55 + 0.208 + 0.02 + 0.01 + v·(0.05 + 0.25)
 // = 1.118 + 0.3·v.
-SafetyParams ssm_params() {
+SafetyParams ssm_mode() {
   SafetyParams p;
   p.mode = SafetyParams::Mode::ssm;
   return p;
@@ -53,7 +53,7 @@ FrameResult measured(std::initializer_list<LinkContact> links) {
 // 1.568 m > 1.5 m, but at rest 1.118 m < 1.5 m: slow, allowed speed (1.5 − 1.118) / 0.3 =
 // 1.27333 m/s, scale 1.27333 / 1.5 = 0.848889. The wrist governs; the overall pair stays the base's.
 TEST(SafetyMonitor, AFastFartherLinkGovernsOverAStillCloserOne) {
-  SafetyMonitor monitor(ssm_params());
+  SafetyMonitor monitor(ssm_mode());
   FrameResult r = measured({link(0, 1.3F, 0.0F), link(5, 1.5F, 1.5F)});
   monitor.decide(r, 0);
   EXPECT_EQ(r.verdict.state, VerdictState::slow);
@@ -73,7 +73,7 @@ TEST(SafetyMonitor, AFastFartherLinkGovernsOverAStillCloserOne) {
 // When every link clears its S_p the verdict is run, and the link with the least slack
 // (d_i − S_p,i) is named: base 1.3 − 1.118 = 0.182 m, wrist 1.8 − (1.118 + 0.15) = 0.532 m.
 TEST(SafetyMonitor, TheLinkWithTheLeastSlackIsNamedWhenAllRun) {
-  SafetyMonitor monitor(ssm_params());
+  SafetyMonitor monitor(ssm_mode());
   FrameResult r = measured({link(0, 1.3F, 0.0F), link(5, 1.8F, 0.5F)});
   monitor.decide(r, 0);
   EXPECT_EQ(r.verdict.state, VerdictState::run);
@@ -93,7 +93,7 @@ TEST(SafetyMonitor, ZonesDecideOnTheClosestLink) {
 
 // A link whose speed could not be computed (NaN) is a stop in ssm mode, whatever the others say.
 TEST(SafetyMonitor, ALinkWithoutASpeedStops) {
-  SafetyMonitor monitor(ssm_params());
+  SafetyMonitor monitor(ssm_mode());
   FrameResult r = measured({link(0, 3.0F, 0.0F), link(4, 3.5F, std::numeric_limits<float>::quiet_NaN())});
   monitor.decide(r, 0);
   EXPECT_EQ(r.verdict.state, VerdictState::stop);
@@ -102,7 +102,7 @@ TEST(SafetyMonitor, ALinkWithoutASpeedStops) {
 }
 
 TEST(SafetyMonitor, AWithheldMeasurementIsAStopWithItsReason) {
-  SafetyMonitor monitor(ssm_params());
+  SafetyMonitor monitor(ssm_mode());
   FrameResult r;
   r.valid = false;
   r.withheld_code = ReasonCode::robot_state_stale;
@@ -118,7 +118,7 @@ TEST(SafetyMonitor, AWithheldMeasurementIsAStopWithItsReason) {
 // T_r = 0.25 s and S_p at rest = 1.6·(0.25 + 0.5) + 0.238 = 1.438 m: a person at 1.3 m, clear
 // of S_p had the frame been decided at once (1.118 m), is now inside it.
 TEST(SafetyMonitor, AgeCountsUntilTheDecision) {
-  SafetyMonitor monitor(ssm_params());
+  SafetyMonitor monitor(ssm_mode());
   FrameResult r = measured({link(0, 1.3F, 0.0F)});
   r.clocked = true;
   r.delivered_ns = 950'000'000;
@@ -150,7 +150,7 @@ TEST(SafetyMonitor, OlderThanTheWatchdogLimitIsStale) {
 // A stop that a mailbox replaced before it was decided is carried: the run that replaced it is
 // written as that stop, with its reason, and the replacement is counted.
 TEST(SafetyMonitor, AReplacedStopIsCarriedIntoTheNextResult) {
-  SafetyMonitor monitor(ssm_params());
+  SafetyMonitor monitor(ssm_mode());
   const FrameResult stop = measured({link(2, 0.4F, 0.0F)});  // below S_p at rest: stop
   FrameResult next;  // nobody in the cell: run
   next.valid = true;
@@ -161,7 +161,7 @@ TEST(SafetyMonitor, AReplacedStopIsCarriedIntoTheNextResult) {
   EXPECT_EQ(next.verdict.code, ReasonCode::below_protective_distance);
 
   // A run that replaced a slow: written as that slow, at its scale.
-  SafetyMonitor second(ssm_params());
+  SafetyMonitor second(ssm_mode());
   const FrameResult slow = measured({link(5, 1.5F, 1.5F)});  // scale 0.848889, as above
   FrameResult run;
   run.valid = true;
@@ -174,7 +174,7 @@ TEST(SafetyMonitor, AReplacedStopIsCarriedIntoTheNextResult) {
 // The strictest of several replaced measurements wins, whichever came first, and what a
 // replaced one carried itself is carried on.
 TEST(SafetyMonitor, TheStrictestOfSeveralReplacedWins) {
-  SafetyMonitor monitor(ssm_params());
+  SafetyMonitor monitor(ssm_mode());
   FrameResult first = measured({link(2, 0.4F, 0.0F)});  // stop
   FrameResult second;                                    // run, replaces first
   second.valid = true;
@@ -190,7 +190,7 @@ TEST(SafetyMonitor, TheStrictestOfSeveralReplacedWins) {
 // The mailbox hands the value it replaces to the merge, under its lock, and counts the drop.
 TEST(SafetyMonitor, MailboxMergesWhatItReplaces) {
   Mailbox<FrameResult> box;
-  SafetyMonitor monitor(ssm_params());
+  SafetyMonitor monitor(ssm_mode());
   const auto carry = [&](const FrameResult& replaced, FrameResult& next) { carry_replaced(monitor, replaced, 0, next); };
   FrameResult a = measured({link(2, 0.4F, 0.0F)});
   FrameResult b;
@@ -208,7 +208,7 @@ TEST(SafetyMonitor, MailboxMergesWhatItReplaces) {
 // The watchdog's stop is held: with min_hold_s 0.1 s the frame after a silence, though clear,
 // says `holding` stop; 0.1 s of frame time later it runs again.
 TEST(SafetyMonitor, TheFrameAfterASilenceHoldsTheWatchdogsStop) {
-  SafetyParams params = ssm_params();
+  SafetyParams params = ssm_mode();
   params.min_hold_s = 0.1;
   SafetyMonitor monitor(params);
   const Verdict silence = monitor.silence(ReasonCode::no_frame, "no frame for 0.600 s (max_frame_age_s 0.500)");
@@ -227,7 +227,7 @@ TEST(SafetyMonitor, TheFrameAfterASilenceHoldsTheWatchdogsStop) {
 
 // The unknown-space policy applies once, to the decided verdict; the governing link is kept.
 TEST(SafetyMonitor, UnknownSpaceStopsOnce) {
-  SafetyParams params = ssm_params();
+  SafetyParams params = ssm_mode();
   params.unknown_policy = SafetyParams::UnknownPolicy::stop_within_m;
   SafetyMonitor monitor(params);
   FrameResult r = measured({link(0, 3.0F, 0.0F), link(5, 3.2F, 0.2F)});
@@ -245,7 +245,7 @@ TEST(SafetyMonitor, UnknownSpaceStopsOnce) {
 // by the share the robot runs at (its speed fraction).
 
 SafetyParams no_hold() {
-  SafetyParams params = ssm_params();
+  SafetyParams params = ssm_mode();
   params.hysteresis_m = 0.0F;
   params.min_hold_s = 0.0;
   return params;

@@ -18,7 +18,7 @@ namespace {
 using namespace hrcsense::testing;
 using Status = BackgroundLearner::Status;
 
-size_t at(int u, int v) { return static_cast<size_t>(v) * kWidth + u; }
+size_t pixel_index(int u, int v) { return static_cast<size_t>(v) * kWidth + u; }
 
 // Four frames, hand-computed: pixel (5, 7) reads 2000, 2002, 0, 2004 → mean 2.002 m over its
 // 3 valid samples, spread sqrt((2² + 0² + 2²) / 3) = 1.63299 mm, valid ratio 3/4. Pixel (9, 9)
@@ -39,15 +39,15 @@ TEST(BackgroundLearner, HandComputedMeanSpreadAndValidRatio) {
   const BackgroundModel& model = learner.model();
   EXPECT_EQ(model.width, kWidth);
   EXPECT_EQ(model.height, kHeight);
-  EXPECT_NEAR(model.mean_m[at(5, 7)], 2.002, 1e-6);
-  EXPECT_NEAR(model.spread_m[at(5, 7)], 1.63299e-3, 1e-7);
-  EXPECT_FLOAT_EQ(model.valid_ratio[at(5, 7)], 0.75F);
-  EXPECT_EQ(model.mean_m[at(9, 9)], 2.0F);
-  EXPECT_EQ(model.spread_m[at(9, 9)], 0.0F);
-  EXPECT_EQ(model.valid_ratio[at(9, 9)], 0.0F);
-  EXPECT_NEAR(model.mean_m[at(40, 30)], 2.0, 1e-6);
-  EXPECT_EQ(model.spread_m[at(40, 30)], 0.0F);
-  EXPECT_EQ(model.valid_ratio[at(40, 30)], 1.0F);
+  EXPECT_NEAR(model.mean_m[pixel_index(5, 7)], 2.002, 1e-6);
+  EXPECT_NEAR(model.spread_m[pixel_index(5, 7)], 1.63299e-3, 1e-7);
+  EXPECT_FLOAT_EQ(model.valid_ratio[pixel_index(5, 7)], 0.75F);
+  EXPECT_EQ(model.mean_m[pixel_index(9, 9)], 2.0F);
+  EXPECT_EQ(model.spread_m[pixel_index(9, 9)], 0.0F);
+  EXPECT_EQ(model.valid_ratio[pixel_index(9, 9)], 0.0F);
+  EXPECT_NEAR(model.mean_m[pixel_index(40, 30)], 2.0, 1e-6);
+  EXPECT_EQ(model.spread_m[pixel_index(40, 30)], 0.0F);
+  EXPECT_EQ(model.valid_ratio[pixel_index(40, 30)], 1.0F);
   EXPECT_TRUE(learner.message().empty());
 }
 
@@ -62,7 +62,7 @@ TEST(BackgroundLearner, NoisyWallMatchesTwoPassStatistics) {
     // Drop a pixel now and then (every 7th frame at u + v ≡ f mod 7): ratio 85 or 86 %.
     for (int v = 0; v < kHeight; ++v) {
       for (int u = 0; u < kWidth; ++u) {
-        if ((u + v + f) % 7 == 0) batch.back().depth.pixels[at(u, v)] = 0;
+        if ((u + v + f) % 7 == 0) batch.back().depth.pixels[pixel_index(u, v)] = 0;
       }
     }
     EXPECT_EQ(learner.add(batch.back()), f + 1 < frames ? Status::learning : Status::ready);
@@ -73,18 +73,18 @@ TEST(BackgroundLearner, NoisyWallMatchesTwoPassStatistics) {
       double sum = 0.0;
       int valid = 0;
       for (const Frame& frame : batch) {
-        const uint16_t raw = frame.depth.pixels[at(u, v)];
+        const uint16_t raw = frame.depth.pixels[pixel_index(u, v)];
         if (raw != 0) sum += raw * 1e-3, ++valid;
       }
       const double mean = sum / valid;
       double squares = 0.0;
       for (const Frame& frame : batch) {
-        const uint16_t raw = frame.depth.pixels[at(u, v)];
+        const uint16_t raw = frame.depth.pixels[pixel_index(u, v)];
         if (raw != 0) squares += (raw * 1e-3 - mean) * (raw * 1e-3 - mean);
       }
-      ASSERT_NEAR(model.mean_m[at(u, v)], mean, 1e-6) << u << "," << v;
-      ASSERT_NEAR(model.spread_m[at(u, v)], std::sqrt(squares / valid), 1e-6) << u << "," << v;
-      ASSERT_NEAR(model.valid_ratio[at(u, v)], static_cast<double>(valid) / frames, 1e-6) << u << "," << v;
+      ASSERT_NEAR(model.mean_m[pixel_index(u, v)], mean, 1e-6) << u << "," << v;
+      ASSERT_NEAR(model.spread_m[pixel_index(u, v)], std::sqrt(squares / valid), 1e-6) << u << "," << v;
+      ASSERT_NEAR(model.valid_ratio[pixel_index(u, v)], static_cast<double>(valid) / frames, 1e-6) << u << "," << v;
     }
   }
 }
@@ -100,7 +100,7 @@ TEST(BackgroundLearner, MovingBlobRestartsThenStillBatchIsReady) {
     const int u0 = 2 * f;  // 2 px per frame, left to right
     fill_rect(frame, u0, 20, 10, 10, 1000);
     for (int v = 20; v < 30; ++v) {
-      for (int u = u0; u < u0 + 10; ++u) covered[at(u, v)] = 1;
+      for (int u = u0; u < u0 + 10; ++u) covered[pixel_index(u, v)] = 1;
     }
     const Status status = learner.add(frame);
     EXPECT_EQ(status, f < 19 ? Status::learning : Status::restarted) << "frame " << f;
@@ -117,7 +117,7 @@ TEST(BackgroundLearner, MovingBlobRestartsThenStillBatchIsReady) {
       for (int dv = -1; dv <= 1; ++dv) {
         for (int du = -1; du <= 1; ++du) {
           const int nu = u + du, nv = v + dv;
-          if (nu >= 0 && nu < kWidth && nv >= 0 && nv < kHeight) all = all && covered[at(nu, nv)] != 0;
+          if (nu >= 0 && nu < kWidth && nv >= 0 && nv < kHeight) all = all && covered[pixel_index(nu, nv)] != 0;
         }
       }
       moving += all ? 1 : 0;
@@ -141,7 +141,7 @@ TEST(BackgroundLearner, MovingBlobRestartsThenStillBatchIsReady) {
   Frame late = wall_frame(40);
   fill_rect(late, 0, 0, kWidth, kHeight, 500);
   EXPECT_EQ(learner.add(late), Status::ready);
-  EXPECT_NEAR(learner.model().mean_m[at(3, 3)], 2.0, 0.0021);
+  EXPECT_NEAR(learner.model().mean_m[pixel_index(3, 3)], 2.0, 0.0021);
 }
 
 // Pixels whose validity flickers are unreliable, not motion: a 20x20 patch valid in 4 of 10
@@ -159,12 +159,12 @@ TEST(BackgroundLearner, FlickeringValidityIsNotMotion) {
   }
   ASSERT_EQ(status, Status::ready) << learner.message();
   const BackgroundModel& model = learner.model();
-  EXPECT_NEAR(model.valid_ratio[at(10, 10)], 0.4, 1e-6);
-  EXPECT_NEAR(model.valid_ratio[at(50, 30)], 0.9, 1e-6);
+  EXPECT_NEAR(model.valid_ratio[pixel_index(10, 10)], 0.4, 1e-6);
+  EXPECT_NEAR(model.valid_ratio[pixel_index(50, 30)], 0.9, 1e-6);
   // Pixel (50, 30) keeps its own mean over 9 samples, 2.000 m ± 2 mm.
   double sum = 0.0;
   for (int f = 0; f < 10; ++f) sum += f == 4 ? 0.0 : kWallRaw + wall_noise(50, 30, f);
-  EXPECT_NEAR(model.mean_m[at(50, 30)], sum / 9.0 * 1e-3, 1e-6);
+  EXPECT_NEAR(model.mean_m[pixel_index(50, 30)], sum / 9.0 * 1e-3, 1e-6);
 }
 
 // An unreliable pixel (valid in fewer than half of the frames) learns nothing from its own
@@ -192,11 +192,11 @@ TEST(BackgroundLearner, UnreliablePixelsTakeClosestReliableBackground) {
   const float expected[] = {1.5F, 1.5F, 1.5F, 0.0F, 0.0F, 0.0F, 0.0F, 2.0F, 2.0F, 2.0F};
   for (int v = 0; v < kHeight; ++v) {
     for (int u = 20; u < 30; ++u) {
-      EXPECT_FLOAT_EQ(model.mean_m[at(u, v)], expected[u - 20]) << u << "," << v;
-      EXPECT_EQ(model.valid_ratio[at(u, v)], 0.25F) << u << "," << v;
+      EXPECT_FLOAT_EQ(model.mean_m[pixel_index(u, v)], expected[u - 20]) << u << "," << v;
+      EXPECT_EQ(model.valid_ratio[pixel_index(u, v)], 0.25F) << u << "," << v;
     }
-    EXPECT_FLOAT_EQ(model.mean_m[at(40, v)], 1.2F) << v;
-    EXPECT_FLOAT_EQ(model.mean_m[at(39, v)], 2.0F) << v;
+    EXPECT_FLOAT_EQ(model.mean_m[pixel_index(40, v)], 1.2F) << v;
+    EXPECT_FLOAT_EQ(model.mean_m[pixel_index(39, v)], 2.0F) << v;
   }
 }
 
@@ -214,7 +214,7 @@ TEST(BackgroundLearner, NeverValidInALongBatchStaysUnknown) {
       learner.add(frame);
     }
     ASSERT_TRUE(learner.ready()) << frames;
-    EXPECT_FLOAT_EQ(learner.model().mean_m[at(31, 21)], frames >= 10 ? 0.0F : 2.0F) << frames;
+    EXPECT_FLOAT_EQ(learner.model().mean_m[pixel_index(31, 21)], frames >= 10 ? 0.0F : 2.0F) << frames;
   }
 }
 
@@ -260,13 +260,13 @@ TEST(BackgroundLearner, NoiseFloorIsLearntWithoutBaseline) {
     const BackgroundModel& model = learner.model();
     if (baseline_mm == 0.0F) {
       EXPECT_NEAR(learner.noise_per_z2(), 1.03131e-3, 2e-8);
-      EXPECT_NEAR(model.spread_m[at(30, 20)], 4.1335e-3, 2e-7);
+      EXPECT_NEAR(model.spread_m[pixel_index(30, 20)], 4.1335e-3, 2e-7);
     } else {
       // 0.08 px / (200 px · 0.05 m) = 8e-3 per metre.
       EXPECT_NEAR(learner.noise_per_z2(), 8e-3, 1e-9);
-      EXPECT_NEAR(model.spread_m[at(30, 20)], 2.8284e-3, 1e-7);
+      EXPECT_NEAR(model.spread_m[pixel_index(30, 20)], 2.8284e-3, 1e-7);
     }
-    EXPECT_NEAR(model.mean_m[at(30, 20)], 2.002, 1e-6);
+    EXPECT_NEAR(model.mean_m[pixel_index(30, 20)], 2.002, 1e-6);
   }
 }
 
@@ -313,7 +313,7 @@ TEST(BackgroundLearner, MotionLimitUsesNoiseModelOnlyWithBaseline) {
     }
     EXPECT_EQ(status, baseline_mm > 0.0F ? Status::ready : Status::restarted) << baseline_mm;
     if (baseline_mm > 0.0F) {
-      EXPECT_NEAR(learner.model().spread_m[at(3, 3)], 0.05, 1e-6);
+      EXPECT_NEAR(learner.model().spread_m[pixel_index(3, 3)], 0.05, 1e-6);
     }
   }
 }

@@ -6,7 +6,7 @@
 // fail-safe side of preparing.
 
 #include "../support/decide.hpp"
-#include "../../src/segmentation/foreground_tables.hpp"
+#include "src/segmentation/foreground_tables.hpp"
 #include "synthetic_frames.hpp"
 
 #include "common/assembly.hpp"

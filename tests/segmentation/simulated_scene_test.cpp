@@ -12,10 +12,10 @@ namespace hrcsense {
 namespace {
 
 #if defined(__SANITIZE_ADDRESS__)
-constexpr int64_t kLearnFrames = 50;  // sanitizers: the same checks on fewer frames
+constexpr int64_t kSceneLearnFrames = 50;  // sanitizers: the same checks on fewer frames
 constexpr int64_t kEmptyFrames = 60;
 #else
-constexpr int64_t kLearnFrames = 100;
+constexpr int64_t kSceneLearnFrames = 100;
 constexpr int64_t kEmptyFrames = 500;
 #endif
 
@@ -43,11 +43,11 @@ Simulator cell(uint64_t seed, int64_t box_frame) {
   return sim;
 }
 
-/// Learns the background from the first kLearnFrames frames; the batch must be still.
+/// Learns the background from the first kSceneLearnFrames frames; the batch must be still.
 BackgroundModel learn(const Simulator& sim, Frame& frame) {
   BackgroundLearner learner;
-  learner.params.frames = static_cast<int>(kLearnFrames);
-  for (int64_t i = 0; i < kLearnFrames; ++i) {
+  learner.params.frames = static_cast<int>(kSceneLearnFrames);
+  for (int64_t i = 0; i < kSceneLearnFrames; ++i) {
     sim.render(i, frame);
     const BackgroundLearner::Status status = learner.add(frame);
     EXPECT_NE(status, BackgroundLearner::Status::restarted) << learner.message();
@@ -65,7 +65,7 @@ TEST(SimulatedScene, EmptyCellHasNoForeground) {
   extractor.set_background(background, frame.intrinsics.fx, frame.stereo_baseline_mm, frame.depth.depth_scale_m);
   Foreground fg;
   size_t worst = 0;
-  for (int64_t i = kLearnFrames; i < kLearnFrames + kEmptyFrames; ++i) {
+  for (int64_t i = kSceneLearnFrames; i < kSceneLearnFrames + kEmptyFrames; ++i) {
     sim.render(i, frame);
     ASSERT_TRUE(extractor.extract(frame, sim.T_base_camera, fg));
     worst = std::max(worst, fg.points_base.size());
@@ -77,13 +77,13 @@ TEST(SimulatedScene, EmptyCellHasNoForeground) {
 // with IoU >= 0.95 in every frame, for two noise seeds.
 TEST(SimulatedScene, AppearingBoxMatchesTruth) {
   for (const uint64_t seed : {3U, 11U}) {
-    const Simulator sim = cell(seed, kLearnFrames);
+    const Simulator sim = cell(seed, kSceneLearnFrames);
     Frame frame;
     const BackgroundModel background = learn(sim, frame);
     ForegroundExtractor extractor;
     extractor.set_background(background, frame.intrinsics.fx, frame.stereo_baseline_mm, frame.depth.depth_scale_m);
     Foreground fg;
-    for (int64_t i = kLearnFrames; i < kLearnFrames + 10; ++i) {
+    for (int64_t i = kSceneLearnFrames; i < kSceneLearnFrames + 10; ++i) {
       sim.render(i, frame);
       ASSERT_TRUE(extractor.extract(frame, sim.T_base_camera, fg));
       size_t both = 0;

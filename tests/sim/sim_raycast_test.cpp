@@ -4,9 +4,9 @@
 // plain reference: every shape's exact ray test (sim_geometry.hpp) at every pixel, in the base
 // frame, nearest hit wins. Also the colour image's writer against per-pixel colours.
 
-#include "../../src/sim/sim_color.hpp"
-#include "../../src/sim/sim_geometry.hpp"
-#include "../../src/sim/sim_raycast.hpp"
+#include "src/sim/sim_color.hpp"
+#include "src/sim/sim_geometry.hpp"
+#include "src/sim/sim_raycast.hpp"
 #include "hrcsense/camera.hpp"
 #include "hrcsense/sim.hpp"
 

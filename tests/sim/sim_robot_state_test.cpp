@@ -20,10 +20,10 @@ RobotTrajectory ramp() {
   return t;
 }
 
-std::string moving_cell() { return std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml"; }
+std::string moving_cell_path() { return std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml"; }
 
 TEST(SimRobotState, WithoutLatencyGivesTheTrajectoryAtTheFramesTimestamp) {
-  const Config config = load_config(moving_cell(), {"sim.noise=false", "sim.color=false"});
+  const Config config = load_config(moving_cell_path(), {"sim.noise=false", "sim.color=false"});
   Simulator sim = make_simulator(config);
   std::unique_ptr<RobotStateSource> states = make_robot_state_source(config);
   ASSERT_EQ(states->origin(), RobotStateOrigin::sim);

@@ -50,7 +50,7 @@ Simulator every_effect_scene() {
   return sim;
 }
 
-std::string scene_path(const char* name) { return std::string(HRCSENSE_SOURCE_DIR) + "/config/" + name; }
+std::string sensor_scene(const char* name) { return std::string(HRCSENSE_SOURCE_DIR) + "/config/" + name; }
 
 TEST(SimSensorModels, D435FramesAreTheUnchangedSimulators) {
   // The expected sums are the output of the unchanged simulator: recorded on main at caed12b,
@@ -62,8 +62,8 @@ TEST(SimSensorModels, D435FramesAreTheUnchangedSimulators) {
   correlated.params.correlated_noise_px = 0.1F;
   Simulator exact = every;
   exact.params.noise = false;
-  const Simulator walk = make_simulator(load_config(scene_path("walk.yaml"), {}));
-  const Simulator cell = make_simulator(load_config(scene_path("cell-ur5-moving.yaml"), {}));
+  const Simulator walk = make_simulator(load_config(sensor_scene("walk.yaml"), {}));
+  const Simulator cell = make_simulator(load_config(sensor_scene("cell-ur5-moving.yaml"), {}));
   EXPECT_EQ(frames_checksum(every, 0, 1, 3), 0x5c6fb096c6bcb46fULL);
   EXPECT_EQ(frames_checksum(correlated, 0, 1, 2), 0x736bff35de293a92ULL);
   EXPECT_EQ(frames_checksum(exact, 0, 1, 1), 0xf944ee820acb789fULL);

@@ -75,7 +75,7 @@ void expect_documented_defaults(const SimParams& p, const std::string& where) {
   EXPECT_EQ(p.correlated_cell_px, 32);
 }
 
-size_t valid_pixels(const Frame& f) {
+size_t count_valid_pixels(const Frame& f) {
   const auto valid = [](uint16_t raw) { return raw != 0; };
   return static_cast<size_t>(std::count_if(f.depth.pixels.begin(), f.depth.pixels.end(), valid));
 }
@@ -100,10 +100,10 @@ TEST(Simulator, DefaultsAreTheOnesDocsSimulatorMdPins) {
     Frame f;
     sim.scene.objects = {wall(0.97F * mode.min_range_m)};
     sim.render(0, f);
-    EXPECT_EQ(valid_pixels(f), 0U) << mode.width << "x" << mode.height;
+    EXPECT_EQ(count_valid_pixels(f), 0U) << mode.width << "x" << mode.height;
     sim.scene.objects = {wall(1.03F * mode.min_range_m)};
     sim.render(0, f);
-    EXPECT_GT(valid_pixels(f), f.depth.pixels.size() / 2) << mode.width << "x" << mode.height;
+    EXPECT_GT(count_valid_pixels(f), f.depth.pixels.size() / 2) << mode.width << "x" << mode.height;
   }
 }
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The ground truth's closest contact over rendered points (rendered_truth_contact), worked by
 // hand: it must not share code with src/proximity, whose searches are tested against it.
-#include "../../src/sim/sim_geometry.hpp"
+#include "src/sim/sim_geometry.hpp"
 
 #include <gtest/gtest.h>
 

@@ -20,7 +20,7 @@
 namespace hrcsense::view {
 namespace {
 
-Rgb pixel(const ColorImage& image, int u, int v) {
+Rgb rgb_at(const ColorImage& image, int u, int v) {
   const size_t i = 3 * (static_cast<size_t>(v) * image.width + u);
   return {image.rgb[i], image.rgb[i + 1], image.rgb[i + 2]};
 }
@@ -77,10 +77,10 @@ TEST(Equalise, ShareOfValidPixelsAtOrBelow) {
   ColorImage rgb;
   std::vector<uint32_t> lut;
   colorize_depth(depth, histogram, lut, rgb);
-  EXPECT_EQ(pixel(rgb, 0, 0), (Rgb{0, 0, 0}));     // invalid: black
-  EXPECT_EQ(pixel(rgb, 3, 0), (Rgb{50, 0, 0}));    // the farthest: the map's end
+  EXPECT_EQ(rgb_at(rgb, 0, 0), (Rgb{0, 0, 0}));     // invalid: black
+  EXPECT_EQ(rgb_at(rgb, 3, 0), (Rgb{50, 0, 0}));    // the farthest: the map's end
   // 2/3 of the way: between (255, 255, 0) at 1/2 and (255, 0, 0) at 3/4, f = 2/3 → g = 85.
-  EXPECT_EQ(pixel(rgb, 1, 0), (Rgb{255, 85, 0}));
+  EXPECT_EQ(rgb_at(rgb, 1, 0), (Rgb{255, 85, 0}));
 }
 
 TEST(RobotMask, HandSolvedCapsuleSilhouette) {
@@ -144,18 +144,18 @@ TEST(Compose, MarkersLandOnThePinholeProjections) {
   compose_2d(frame, 0.5F, 3, scratch, out);
   ASSERT_EQ(out.width, 200);
   ASSERT_EQ(out.height, 100);
-  EXPECT_EQ(pixel(out, 120, 60), kContactMarker);
-  EXPECT_EQ(pixel(out, 123, 60), kContactMarker);  // the disc's radius, either side
-  EXPECT_EQ(pixel(out, 117, 60), kContactMarker);
-  EXPECT_EQ(pixel(out, 120, 57), kContactMarker);
-  EXPECT_NE(pixel(out, 124, 60), kContactMarker);
-  EXPECT_NE(pixel(out, 120, 64), kContactMarker);
-  EXPECT_EQ(pixel(out, 70, 50), kRobotMarker);
-  EXPECT_EQ(pixel(out, 70, 47), kRobotMarker);
-  EXPECT_EQ(pixel(out, 95, 55), kContactLine);     // on the line between them, (95, 55) of (70, 50)-(120, 60)
+  EXPECT_EQ(rgb_at(out, 120, 60), kContactMarker);
+  EXPECT_EQ(rgb_at(out, 123, 60), kContactMarker);  // the disc's radius, either side
+  EXPECT_EQ(rgb_at(out, 117, 60), kContactMarker);
+  EXPECT_EQ(rgb_at(out, 120, 57), kContactMarker);
+  EXPECT_NE(rgb_at(out, 124, 60), kContactMarker);
+  EXPECT_NE(rgb_at(out, 120, 64), kContactMarker);
+  EXPECT_EQ(rgb_at(out, 70, 50), kRobotMarker);
+  EXPECT_EQ(rgb_at(out, 70, 47), kRobotMarker);
+  EXPECT_EQ(rgb_at(out, 95, 55), kContactLine);     // on the line between them, (95, 55) of (70, 50)-(120, 60)
   // Depth only, uniform: every valid pixel the map's end; the hole black.
-  EXPECT_EQ(pixel(out, 5, 5), (Rgb{0, 0, 0}));
-  EXPECT_EQ(pixel(out, 180, 90), (Rgb{50, 0, 0}));
+  EXPECT_EQ(rgb_at(out, 5, 5), (Rgb{0, 0, 0}));
+  EXPECT_EQ(rgb_at(out, 180, 90), (Rgb{50, 0, 0}));
 }
 
 TEST(Compose, DepthOverColourAndTheRobotOutline) {
@@ -176,16 +176,16 @@ TEST(Compose, DepthOverColourAndTheRobotOutline) {
   ColorImage out;
   compose_2d(frame, 0.5F, 3, scratch, out);
   // Half colour (10, 20, 30), half jet(1) = (50, 0, 0): (30, 10, 15).
-  EXPECT_EQ(pixel(out, 180, 90), (Rgb{30, 10, 15}));
+  EXPECT_EQ(rgb_at(out, 180, 90), (Rgb{30, 10, 15}));
   // The hole: half colour, half black.
-  EXPECT_EQ(pixel(out, 5, 5), (Rgb{5, 10, 15}));
+  EXPECT_EQ(rgb_at(out, 5, 5), (Rgb{5, 10, 15}));
   // The capsule of RobotMask.HandSolvedCapsuleSilhouette: rows 45..55 at u = 100, its top and
   // bottom rows the outline, the inside brightened halfway to white.
-  EXPECT_EQ(pixel(out, 100, 45), kRobotOutline);
-  EXPECT_EQ(pixel(out, 100, 55), kRobotOutline);
-  EXPECT_EQ(pixel(out, 130, 50), kRobotOutline);
-  EXPECT_EQ(pixel(out, 100, 50), (Rgb{142, 132, 135}));  // (30 + 255) / 2 ... rounded down
-  EXPECT_EQ(pixel(out, 100, 44), (Rgb{30, 10, 15}));
+  EXPECT_EQ(rgb_at(out, 100, 45), kRobotOutline);
+  EXPECT_EQ(rgb_at(out, 100, 55), kRobotOutline);
+  EXPECT_EQ(rgb_at(out, 130, 50), kRobotOutline);
+  EXPECT_EQ(rgb_at(out, 100, 50), (Rgb{142, 132, 135}));  // (30 + 255) / 2 ... rounded down
+  EXPECT_EQ(rgb_at(out, 100, 44), (Rgb{30, 10, 15}));
 }
 
 TEST(ShownState, NoDataWhenNothingOrTooOld) {
