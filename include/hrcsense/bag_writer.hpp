@@ -136,6 +136,9 @@ class BagWriter {
                     const Pose& T_stream_ref);
   int64_t bag_time(int64_t timestamp_ns);
   void flush_chunk();
+  /// Compresses chunk_ into packed_ (one LZ4 frame); returns the compressed size in bytes.
+  size_t compress_chunk_lz4();
+  void write_chunk_index();
 
   std::string path_;
   BagWriterParams params_;

@@ -106,6 +106,9 @@ class FolderSource : public Source {
   int64_t played_ = 0;
   std::string list_error_;  ///< the list's first malformed line, reported after the frames before it
   std::string error_;
+
+  bool read_depth(const std::string& file, DepthImage& depth);
+  bool read_color(const std::string& color_file, Frame& out);
 };
 
 class BagReader;

@@ -161,6 +161,16 @@ struct BackgroundLearner {
   std::vector<int32_t> fill_queue_;
   std::vector<uint16_t> fill_layer_;
 
+  /// Steps of add(): start (or restart) a batch for a width × height image; add one frame's
+  /// samples; summarise the completed batch into the model.
+  Status start_batch(int width, int height);
+  void accumulate(const DepthImage& depth, const RobotPixels* robot);
+  Status finish_batch(const Frame& frame, const MotionRegion* region);
+  /// Marks wide_ from moving_ and clears edge flicker (flicker_) from both.
+  void mark_wide_motion();
+  /// Noise floor, filled and flicker-covered pixels, unsettled pixels cleared: a still batch's
+  /// model made ready for use.
+  void settle_model(const segmentation_detail::BatchView& batch, int batch_frames, bool have_model);
   /// Marks moving_ (motion far from the robot cleared; edge flicker still in), flicker_,
   /// outside_; returns the number of reliable pixels.
   size_t find_motion(const segmentation_detail::BatchView& batch, const Intrinsics& intrinsics,

@@ -98,6 +98,11 @@ class SelfFilter {
   void prepare(const Frame& frame);
   void clear(const Rect& rect);
   void dilate(const Rect& rect);
+  /// Ray-casts one padded capsule (camera frame, radius r m) into entry_m_ and exit_m_ and
+  /// grows `drawn` by the rows and columns it may cover.
+  void draw_capsule(const Eigen::Vector3f& a, const Eigen::Vector3f& b, float r, const Intrinsics& intr, Rect& drawn);
+  /// Fills from_raw_ and to_raw_ inside `grown` from the dilated silhouette; returns its pixels.
+  size_t mark_robot_depths(const Frame& frame, const ForegroundParams& noise, const Rect& grown);
 };
 
 }  // namespace hrcsense

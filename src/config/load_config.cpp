@@ -167,13 +167,11 @@ void read_robot_and_safety(KeyReader& r, Config& c) {
   }
 }
 
-// `safety.mode: ssm` and the keys shared by both modes (docs/SAFETY.md for the defaults).
-void read_safety_behaviour(KeyReader& r, Config& c) {
-  SafetyParams& safety = c.pipeline.safety;
-  std::string mode = safety.mode == SafetyParams::Mode::ssm ? "ssm" : "zones";
-  r.choice("safety.mode", mode, {"zones", "ssm"});
-  safety.mode = mode == "ssm" ? SafetyParams::Mode::ssm : SafetyParams::Mode::zones;
-  SsmParams& ssm = safety.ssm;
+// S_p's terms (`safety.human_speed_mps` … `safety.robot_uncertainty_m`, docs/SAFETY.md), and
+// C's limit on the speckle threshold. Read in both modes, so the schema knows them all.
+void read_ssm_terms(KeyReader& r, Config& c) {
+  const SafetyParams& safety = c.pipeline.safety;
+  SsmParams& ssm = c.pipeline.safety.ssm;
   // Beyond 10 m/s no person walks; a speed of 0 would ignore the person's approach.
   r.number("safety.human_speed_mps", ssm.human_speed_mps, Bound::positive, 10.0F);
   r.number("safety.human_speed_near_mps", ssm.human_speed_near_mps, Bound::positive, 10.0F);
@@ -208,6 +206,15 @@ void read_safety_behaviour(KeyReader& r, Config& c) {
                     " > " + config_detail::float_text(max_min_object_mm) + " (detection_mm " +
                     config_detail::float_text(ssm.detection_mm) + ")");
   }
+}
+
+// `safety.mode: ssm` and the keys shared by both modes (docs/SAFETY.md for the defaults).
+void read_safety_behaviour(KeyReader& r, Config& c) {
+  SafetyParams& safety = c.pipeline.safety;
+  std::string mode = safety.mode == SafetyParams::Mode::ssm ? "ssm" : "zones";
+  r.choice("safety.mode", mode, {"zones", "ssm"});
+  safety.mode = mode == "ssm" ? SafetyParams::Mode::ssm : SafetyParams::Mode::zones;
+  read_ssm_terms(r, c);
   // Relaxing waits by default in ssm mode (a verdict that flickers between slow and run jerks
   // the arm); zones mode keeps the thesis's frame-by-frame rule unless told otherwise.
   if (safety.mode == SafetyParams::Mode::ssm) {

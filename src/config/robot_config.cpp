@@ -334,54 +334,71 @@ void read_robot_state(KeyReader& r, RobotStateConfig& s) {
   if (colon == 0 || !port_ok) r.fail("robot.state.listen", "expected host:port (e.g. 127.0.0.1:30010), not '" + s.listen + "'");
 }
 
-void read_robot(KeyReader& r, Config& c) {
+namespace {
+
+/// The `robot.*` keys that decide what is read next; the model, the base frame and the fixed
+/// joint angles go straight into the Config.
+struct RobotKeys {
+  YAML::Node description, tool, trajectory;
+  bool follow_link = false;
+  std::vector<Eigen::Vector3f> points_base;
+  std::vector<double> joints_list;  ///< robot.joints_rad as given: empty when absent
+};
+
+RobotKeys read_robot_keys(KeyReader& r, Config& c) {
   // Every key is read unconditionally first: known_keys() learns the schema from these reads.
+  RobotKeys keys;
   r.choice("robot.model", c.robot_model, {"points", "ur5", "ur5e", "ur10e", "custom"});
   read_robot_state(r, c.robot_state);
-  const YAML::Node description = r.raw("robot.description");
-  const YAML::Node tool = r.raw("robot.tool");
-  const YAML::Node trajectory = r.raw("robot.trajectory");
+  keys.description = r.raw("robot.description");
+  keys.tool = r.raw("robot.tool");
+  keys.trajectory = r.raw("robot.trajectory");
   // A key of its own (known to --set); its effective value is part of robot.trajectory's.
   const YAML::Node follow_link_node = r.raw("robot.trajectory.follow_link");
-  bool follow_link = false;
   if (follow_link_node.IsDefined() &&
-      (!follow_link_node.IsScalar() || !YAML::convert<bool>::decode(follow_link_node, follow_link))) {
+      (!follow_link_node.IsScalar() || !YAML::convert<bool>::decode(follow_link_node, keys.follow_link))) {
     r.fail("robot.trajectory.follow_link", "expected true or false");
   }
   // Default: the 2020 thesis's robot point (-0.5, 0.5, 0.5) m, given there with y up.
-  std::vector<Eigen::Vector3f> points_base{Eigen::Vector3f(-0.5F, -0.5F, 0.5F)};
-  r.vec3_list("robot.points_base", points_base, kMaxCoordinateM);
-  std::vector<double> joints_list;
-  r.number_list("robot.joints_rad", joints_list, kJointCount);
+  keys.points_base = {Eigen::Vector3f(-0.5F, -0.5F, 0.5F)};
+  r.vec3_list("robot.points_base", keys.points_base, kMaxCoordinateM);
+  r.number_list("robot.joints_rad", keys.joints_list, kJointCount);
   JointAngles& joints_rad = c.robot_state.joints_rad;
-  if (joints_list.size() == kJointCount) std::copy(joints_list.begin(), joints_list.end(), joints_rad.begin());
+  if (keys.joints_list.size() == kJointCount) std::copy(keys.joints_list.begin(), keys.joints_list.end(), joints_rad.begin());
   r.choice("robot.base_frame", c.robot_base_frame, {"base", "base_link"});
+  c.pipeline.robot.base_frame = c.robot_base_frame == "base_link" ? BaseFrame::base_link : BaseFrame::base;
+  return keys;
+}
+
+// robot.model points: padded points (spheres) stand for the robot; the arm's keys are refused.
+void read_point_robot(KeyReader& r, Config& c, const RobotKeys& keys) {
   RobotParams& robot = c.pipeline.robot;
-  robot.base_frame = c.robot_base_frame == "base_link" ? BaseFrame::base_link : BaseFrame::base;
-
-  if (c.robot_model == "points") {
-    if (description.IsDefined()) r.fail("robot.description", "is only read with robot.model custom");
-    if (tool.IsDefined()) r.fail("robot.tool", "is only read with an arm (robot.model ur5, ur5e, ur10e or custom)");
-    if (trajectory.IsDefined()) {
-      r.fail("robot.trajectory", "is only read with an arm (robot.model ur5, ur5e, ur10e or custom)");
-    }
-    if (c.robot_state.source == "sim") {
-      r.fail("robot.state.source", "sim moves an arm along robot.trajectory: it needs robot.model ur5, ur5e, ur10e or custom");
-    }
-    r.number("robot.padding_m", robot.padding_m, Bound::non_negative, kMaxCoordinateM);
-    // Without a robot every distance would be "infinite" and every verdict run: refuse.
-    if (points_base.empty()) r.fail("robot.points_base", "expected at least one point [x, y, z] for robot.model points");
-    robot.arm.reset();
-    robot.points = robot_points(points_base, robot.padding_m);
-    check_capsules(r, robot.points);
-    return;
+  if (keys.description.IsDefined()) r.fail("robot.description", "is only read with robot.model custom");
+  if (keys.tool.IsDefined()) r.fail("robot.tool", "is only read with an arm (robot.model ur5, ur5e, ur10e or custom)");
+  if (keys.trajectory.IsDefined()) {
+    r.fail("robot.trajectory", "is only read with an arm (robot.model ur5, ur5e, ur10e or custom)");
   }
+  if (c.robot_state.source == "sim") {
+    r.fail("robot.state.source", "sim moves an arm along robot.trajectory: it needs robot.model ur5, ur5e, ur10e or custom");
+  }
+  r.number("robot.padding_m", robot.padding_m, Bound::non_negative, kMaxCoordinateM);
+  // Without a robot every distance would be "infinite" and every verdict run: refuse.
+  if (keys.points_base.empty()) r.fail("robot.points_base", "expected at least one point [x, y, z] for robot.model points");
+  robot.arm.reset();
+  robot.points = robot_points(keys.points_base, robot.padding_m);
+  check_capsules(r, robot.points);
+}
 
-  RobotDescription arm = arm_description(r, c.robot_model, description);
-  if (tool.IsDefined()) {
+// An arm (built in or robot.model custom): its description, tool, padding, fixed pose and
+// trajectory, each checked against the arm's joint limits and reach.
+void read_arm(KeyReader& r, Config& c, const RobotKeys& keys) {
+  RobotParams& robot = c.pipeline.robot;
+  const JointAngles& joints_rad = c.robot_state.joints_rad;
+  RobotDescription arm = arm_description(r, c.robot_model, keys.description);
+  if (keys.tool.IsDefined()) {
     // A gripper on a built-in arm without copying its description; replaces the description's tool.
     const std::string prefix = "robot.";
-    arm.tool = DescriptionReader{{r.where(), prefix}}.capsules(tool, "tool");
+    arm.tool = DescriptionReader{{r.where(), prefix}}.capsules(keys.tool, "tool");
     r.set_effective("robot.tool", capsules_node(arm.tool));
   }
   robot.padding_m = arm.padding_m;  // the arm's own padding is the default
@@ -389,7 +406,7 @@ void read_robot(KeyReader& r, Config& c) {
   // No default pose: a wrong pose would put the arm where it is not, which is not fail-safe.
   // Live and simulated states bring their own; robot.joints_rad then only places the arm the
   // simulator renders when it has no trajectory.
-  if (joints_list.size() != kJointCount && c.robot_state.source == "fixed") {
+  if (keys.joints_list.size() != kJointCount && c.robot_state.source == "fixed") {
     r.fail("robot.joints_rad", "is required for robot.model " + c.robot_model +
                                    " with robot.state.source fixed: 6 joint angles in radians, joint 1 (base) first");
   }
@@ -400,10 +417,10 @@ void read_robot(KeyReader& r, Config& c) {
                                    double_text(joints_rad[j]) + " rad, outside its limits " +
                                    limit_text(arm.limits[j]));
   }
-  if (trajectory.IsDefined()) {
+  if (keys.trajectory.IsDefined()) {
     const std::string prefix = "robot.";
-    c.robot_state.trajectory = TrajectoryReader{{r.where(), prefix}}.trajectory(trajectory, arm);
-    c.robot_state.trajectory->follow_link = follow_link;
+    c.robot_state.trajectory = TrajectoryReader{{r.where(), prefix}}.trajectory(keys.trajectory, arm);
+    c.robot_state.trajectory->follow_link = keys.follow_link;
     r.set_effective("robot.trajectory", trajectory_node(*c.robot_state.trajectory));
   } else if (c.robot_state.source == "sim") {
     r.fail("robot.trajectory", "is required for robot.state.source sim: {interpolation: linear | cubic, loop, "
@@ -415,6 +432,17 @@ void read_robot(KeyReader& r, Config& c) {
   check_capsules(r, robot_model_at(robot, joints_rad));
   if (c.robot_state.trajectory) {
     for (const TrajectoryWaypoint& point : c.robot_state.trajectory->waypoints) check_capsules(r, robot_model_at(robot, point.q_rad));
+  }
+}
+
+}  // namespace
+
+void read_robot(KeyReader& r, Config& c) {
+  const RobotKeys keys = read_robot_keys(r, c);
+  if (c.robot_model == "points") {
+    read_point_robot(r, c, keys);
+  } else {
+    read_arm(r, c, keys);
   }
 }
 

@@ -30,6 +30,28 @@ int64_t to_ns(double seconds) { return static_cast<int64_t>(std::llround(seconds
 
 std::string system_error(const char* what) { return std::string(what) + ": " + std::strerror(errno); }
 
+// A DATA_PACKAGE as a robot state at `host_time_ns`, with the controller's own report.
+RobotState rtde_robot_state(const rtde::DataSample& data, int64_t host_time_ns, bool tcp_mismatch) {
+  RobotState state;
+  state.host_time_ns = host_time_ns;
+  state.q_rad = data.q;
+  state.qd_rad_s = data.qd;
+  state.valid = true;
+  state.origin = RobotStateOrigin::rtde;
+  state.status.known = true;
+  state.status.robot_mode = data.robot_mode;
+  state.status.safety_mode = data.safety_mode;
+  state.status.speed_scaling = data.speed_scaling;
+  state.status.target_speed_fraction = data.target_speed_fraction;
+  state.status.tcp_pose_mismatch = tcp_mismatch;
+  // The arm runs at the slider times the controller's own scaling of its programmed speed
+  // (specs/ur-rtde.md). A value outside 0..1 is no reading: the monitor falls back to the
+  // last scale it sent.
+  const double fraction = data.speed_scaling * data.target_speed_fraction;
+  if (fraction >= 0.0 && fraction <= 1.0) state.speed_fraction = fraction;
+  return state;
+}
+
 }  // namespace
 
 int rtde::connect_tcp(const std::string& host, int port_number, double timeout_s, const std::atomic<bool>& stop,
@@ -398,23 +420,8 @@ void RtdeRobotState::on_data(const rtde::Frame& frame, Connection& c) {
   status_.safety_mode = data.safety_mode;
   status_.speed_scaling = data.speed_scaling;
   status_.target_speed_fraction = data.target_speed_fraction;
-  RobotState state;
-  state.host_time_ns = c.clock_map.to_host(to_ns(data.timestamp_s), arrival_ns);
-  state.q_rad = data.q;
-  state.qd_rad_s = data.qd;
-  state.valid = true;
-  state.origin = RobotStateOrigin::rtde;
-  state.status.known = true;
-  state.status.robot_mode = data.robot_mode;
-  state.status.safety_mode = data.safety_mode;
-  state.status.speed_scaling = data.speed_scaling;
-  state.status.target_speed_fraction = data.target_speed_fraction;
-  state.status.tcp_pose_mismatch = tcp_mismatch;
-  // The arm runs at the slider times the controller's own scaling of its programmed speed
-  // (specs/ur-rtde.md). A value outside 0..1 is no reading: the monitor falls back to the
-  // last scale it sent.
-  const double fraction = data.speed_scaling * data.target_speed_fraction;
-  if (fraction >= 0.0 && fraction <= 1.0) state.speed_fraction = fraction;
+  const int64_t host_time_ns = c.clock_map.to_host(to_ns(data.timestamp_s), arrival_ns);
+  const RobotState state = rtde_robot_state(data, host_time_ns, tcp_mismatch);
   if (!history_.add(state)) {
     stats_.last_problem = "RTDE: DATA_PACKAGE at controller time " + std::to_string(data.timestamp_s) +
                           " s rejected: " + history_.last_rejection();

@@ -102,6 +102,46 @@ bool stop_requested(const RunOptions& options) {
   return options.stop_requested != nullptr && options.stop_requested->load();
 }
 
+// Whether capture is to end before frame n: a stop request or the frame limit (max_frames);
+// `outcome` then says which.
+bool capture_should_end(const RunOptions& options, int64_t n, CaptureOutcome& outcome) {
+  if (stop_requested(options)) {
+    outcome.end_code = ReasonCode::stop_requested;
+    outcome.final_reason = outcome.end_reason = "stop requested";
+    return true;
+  }
+  if (options.max_frames >= 0 && n >= options.max_frames) {
+    outcome.end_code = ReasonCode::frame_limit_reached;
+    outcome.final_reason = outcome.end_reason = "frame limit reached";
+    return true;
+  }
+  return false;
+}
+
+// The source's next frame into `frame`; a source that throws has failed, with the exception's
+// text as its error.
+Source::Status read_frame(Source& source, Frame& frame, std::string& error) {
+  Source::Status status = Source::Status::error;
+  frame.host_time_ns = 0;  // the buffer is reused: only a live source sets it again
+  try {
+    status = source.next(frame);
+    if (status == Source::Status::error) error = source.error();
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  return status;
+}
+
+// Stamps a frame with its delivery on the run's clock; the frame's age counts from its host
+// time when the source set one, and a frame without one gets the source's or the run's time.
+void stamp_delivery(Captured& slot, int64_t captured_ns, bool host_time_is_source_time) {
+  slot.captured_ns = captured_ns;
+  slot.seen_ns = slot.frame.host_time_ns != 0 ? std::min(slot.frame.host_time_ns, slot.captured_ns) : slot.captured_ns;
+  if (slot.frame.host_time_ns == 0) {
+    slot.frame.host_time_ns = host_time_is_source_time ? slot.frame.timestamp_ns : slot.captured_ns;
+  }
+}
+
 // Reads the source until it ends, fails, or the run is stopped; then closes `frames`. Paced
 // waits are the clock's sleep_until, which a stop request (SIGINT, SIGTERM) ends.
 void capture_loop(Source& source, const RunOptions& options, RunClock& clock, double max_frame_age_s,
@@ -113,25 +153,9 @@ void capture_loop(Source& source, const RunOptions& options, RunClock& clock, do
   int64_t previous_ns = 0;
   bool resync = true;  // pace from now: at the first frame and after a silence (a paused replay)
   for (int64_t n = 0;; ++n) {
-    if (stop_requested(options)) {
-      outcome.end_code = ReasonCode::stop_requested;
-      outcome.final_reason = outcome.end_reason = "stop requested";
-      break;
-    }
-    if (options.max_frames >= 0 && n >= options.max_frames) {
-      outcome.end_code = ReasonCode::frame_limit_reached;
-      outcome.final_reason = outcome.end_reason = "frame limit reached";
-      break;
-    }
-    Source::Status status = Source::Status::error;
+    if (capture_should_end(options, n, outcome)) break;
     std::string error;
-    slot.frame.host_time_ns = 0;  // the buffer is reused: only a live source sets it again
-    try {
-      status = source.next(slot.frame);
-      if (status == Source::Status::error) error = source.error();
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
+    const Source::Status status = read_frame(source, slot.frame, error);
     if (status == Source::Status::end) {
       // A live source's wait (an unplugged camera) ends with `end` on a stop request: say so.
       if (stop_requested(options)) {
@@ -161,11 +185,7 @@ void capture_loop(Source& source, const RunOptions& options, RunClock& clock, do
       resync = false;
       clock.sleep_until(due_ns, options.stop_requested);
     }
-    slot.captured_ns = clock.now_ns();
-    slot.seen_ns = slot.frame.host_time_ns != 0 ? std::min(slot.frame.host_time_ns, slot.captured_ns) : slot.captured_ns;
-    if (slot.frame.host_time_ns == 0) {
-      slot.frame.host_time_ns = host_time_is_source_time ? slot.frame.timestamp_ns : slot.captured_ns;
-    }
+    stamp_delivery(slot, clock.now_ns(), host_time_is_source_time);
     // Paced: latest wins, a frame not yet taken is dropped and counted. Unpaced: wait for
     // processing. Either fails once processing is gone.
     if (!(options.pace ? frames.put(slot) : frames.put_wait(slot))) break;
@@ -333,6 +353,39 @@ FrameResult output_loop(Sink& sink, const Source& source, const RunClock& clock,
   return last;
 }
 
+// The first failure is the run's error: the output's, else processing's, else the source's;
+// it is then the final stop's reason and the summary's end_reason too.
+void settle_run_error(const std::string& output_error, const ProcessingStats& stats, CaptureOutcome& outcome,
+                      RunSummary& summary) {
+  summary.end_code = outcome.end_code;
+  if (!output_error.empty()) {
+    summary.end_code = ReasonCode::output_error;
+    summary.error = output_error;
+  } else if (!stats.error.empty()) {
+    summary.end_code = ReasonCode::processing_error;
+    summary.error = stats.error;
+  } else {
+    summary.error = outcome.error;
+  }
+  if (!summary.error.empty()) outcome.final_reason = outcome.end_reason = summary.error;
+}
+
+// Fail safe: whatever ended the run, the last word to the robot is a stop (a failed sink
+// gets it too: it may still reach a file whose pipe reader left); the summary follows it.
+void write_run_end(Sink& sink, const FrameResult& last, const std::string& final_reason, const RunClock& clock,
+                   int64_t start_ns, RunSummary& summary) {
+  try {
+    FrameResult scratch;
+    write_stop(sink, scratch, last, stop_verdict(summary.end_code, final_reason));
+    summary.wall_s = ns_to_seconds(clock.now_ns() - start_ns);
+    summary.fps = summary.wall_s > 0.0 ? static_cast<double>(summary.frames_processed) / summary.wall_s : 0.0;
+    sink.summary(summary);
+  } catch (const std::exception& e) {
+    if (summary.error.empty()) summary.error = std::string("output error: ") + e.what();
+  }
+  if (summary.error.empty() && sink.failed()) summary.error = "output failed: " + sink.failure();
+}
+
 }  // namespace
 
 bool host_time_is_source_time(RobotStateOrigin origin, bool paced) {
@@ -374,18 +427,7 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
   processing.join();
   capture.join();
 
-  // The first failure is the run's error: the output's, else processing's, else the source's.
-  summary.end_code = outcome.end_code;
-  if (!output_error.empty()) {
-    summary.end_code = ReasonCode::output_error;
-    summary.error = output_error;
-  } else if (!stats.error.empty()) {
-    summary.end_code = ReasonCode::processing_error;
-    summary.error = stats.error;
-  } else {
-    summary.error = outcome.error;
-  }
-  if (!summary.error.empty()) outcome.final_reason = outcome.end_reason = summary.error;
+  settle_run_error(output_error, stats, outcome, summary);
   summary.frames_in = outcome.frames_in;
   summary.frames_processed = stats.processed;
   summary.frames_dropped = frames.dropped() + results.dropped();
@@ -396,18 +438,7 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
   summary.end_reason = outcome.end_reason;
   summary.latency_p50_us = stats.latencies.percentile(0.50);
   summary.latency_p99_us = stats.latencies.percentile(0.99);
-  // Fail safe: whatever ended the run, the last word to the robot is a stop (a failed sink
-  // gets it too: it may still reach a file whose pipe reader left).
-  try {
-    FrameResult scratch;
-    write_stop(sink, scratch, last, stop_verdict(summary.end_code, outcome.final_reason));
-    summary.wall_s = ns_to_seconds(clock.now_ns() - start_ns);
-    summary.fps = summary.wall_s > 0.0 ? static_cast<double>(summary.frames_processed) / summary.wall_s : 0.0;
-    sink.summary(summary);
-  } catch (const std::exception& e) {
-    if (summary.error.empty()) summary.error = std::string("output error: ") + e.what();
-  }
-  if (summary.error.empty() && sink.failed()) summary.error = "output failed: " + sink.failure();
+  write_run_end(sink, last, outcome.final_reason, clock, start_ns, summary);
   return summary;
 }
 

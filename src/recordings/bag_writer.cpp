@@ -4,6 +4,8 @@
 
 #include "hrcsense/camera.hpp"
 
+#include "bag_writer_messages.hpp"
+
 #include <lz4frame.h>
 
 #include <algorithm>
@@ -12,6 +14,21 @@
 
 namespace hrcsense {
 namespace {
+
+using bag_write::camera_info_message;
+using bag_write::extrinsics_pose;
+using bag_write::f32_message;
+using bag_write::key_value_message;
+using bag_write::put32;
+using bag_write::put64;
+using bag_write::put_f32;
+using bag_write::put_f64;
+using bag_write::put_string;
+using bag_write::put_time;
+using bag_write::stream_info_message;
+using bag_write::string_message;
+using bag_write::transform_message;
+using bag_write::u32_message;
 
 // Message MD5 sums the SDK writes (spec §3); JointState's is the ROS message's.
 constexpr const char* kImageMd5 = "060021388200f6f0f447d0fcd9c64743";
@@ -33,36 +50,6 @@ constexpr int64_t kStaticTimeNs = 1;
 constexpr int64_t kFirstStreamTimeNs = 2;
 constexpr size_t kBagHeaderBytes = 4096;  // header + data of the bag header record
 constexpr char kMagic[] = "#ROSBAG V2.0\n";
-
-void put32(std::vector<uint8_t>& b, uint32_t v) {
-  const uint8_t bytes[4] = {static_cast<uint8_t>(v), static_cast<uint8_t>(v >> 8), static_cast<uint8_t>(v >> 16),
-                            static_cast<uint8_t>(v >> 24)};
-  b.insert(b.end(), bytes, bytes + 4);
-}
-void put64(std::vector<uint8_t>& b, uint64_t v) {
-  put32(b, static_cast<uint32_t>(v));
-  put32(b, static_cast<uint32_t>(v >> 32));
-}
-void put_f32(std::vector<uint8_t>& b, float v) {
-  uint32_t bits = 0;
-  std::memcpy(&bits, &v, 4);
-  put32(b, bits);
-}
-void put_f64(std::vector<uint8_t>& b, double v) {
-  uint64_t bits = 0;
-  std::memcpy(&bits, &v, 8);
-  put64(b, bits);
-}
-void put_string(std::vector<uint8_t>& b, const std::string& s) {
-  put32(b, static_cast<uint32_t>(s.size()));
-  b.insert(b.end(), s.begin(), s.end());
-}
-// ROS time: uint32 sec, uint32 nsec (times before 1970 cannot be written: clamped to 0).
-void put_time(std::vector<uint8_t>& b, int64_t ns) {
-  const int64_t t = std::max<int64_t>(ns, 0);
-  put32(b, static_cast<uint32_t>(t / 1000000000LL));
-  put32(b, static_cast<uint32_t>(t % 1000000000LL));
-}
 
 // A record header under construction: `name=value` fields with uint32 length prefixes.
 struct Fields {
@@ -111,78 +98,6 @@ void put_connection(std::vector<uint8_t>& out, uint32_t id, const std::string& t
   // No message definitions: the SDK's playback checks type and md5 only.
   data.text("type", type).text("md5sum", md5).text("message_definition", "");
   put_record(out, h, data.bytes.data(), data.bytes.size());
-}
-
-std::vector<uint8_t> camera_info_message(const Intrinsics& in) {
-  std::vector<uint8_t> b;
-  put32(b, 0);  // header: seq, stamp, frame_id (the SDK leaves it default)
-  put_time(b, 0);
-  put_string(b, "");
-  put32(b, static_cast<uint32_t>(in.height));
-  put32(b, static_cast<uint32_t>(in.width));
-  put_string(b, std::string(distortion_name(in.model)));
-  put32(b, 5);
-  for (float c : in.coeffs) put_f64(b, c);
-  const double k[9] = {in.fx, 0.0, in.ppx, 0.0, in.fy, in.ppy, 0.0, 0.0, 1.0};
-  for (double v : k) put_f64(b, v);
-  for (int i = 0; i < 9 + 12; ++i) put_f64(b, 0.0);  // R, P: the SDK leaves them zero
-  put32(b, 0);                                      // binning_x, binning_y
-  put32(b, 0);
-  for (int i = 0; i < 4; ++i) put32(b, 0);  // roi
-  b.push_back(0);
-  return b;
-}
-
-std::vector<uint8_t> transform_message(const Pose& T) {
-  std::vector<uint8_t> b;
-  const Eigen::Quaterniond q(T.linear());
-  for (double v : {T.translation().x(), T.translation().y(), T.translation().z(), q.x(), q.y(), q.z(), q.w()}) {
-    put_f64(b, v);
-  }
-  return b;
-}
-
-std::vector<uint8_t> stream_info_message(uint32_t fps, const std::string& encoding) {
-  std::vector<uint8_t> b;
-  put32(b, fps);
-  put_string(b, encoding);
-  b.push_back(1);  // is_recommended
-  return b;
-}
-
-std::vector<uint8_t> key_value_message(const std::string& key, const std::string& value) {
-  std::vector<uint8_t> b;
-  put_string(b, key);
-  put_string(b, value);
-  return b;
-}
-
-std::vector<uint8_t> string_message(const std::string& text) {
-  std::vector<uint8_t> b;
-  put_string(b, text);
-  return b;
-}
-
-std::vector<uint8_t> u32_message(uint32_t v) {
-  std::vector<uint8_t> b;
-  put32(b, v);
-  return b;
-}
-
-std::vector<uint8_t> f32_message(float v) {
-  std::vector<uint8_t> b;
-  put_f32(b, v);
-  return b;
-}
-
-// Frame::depth_to_color (the SDK's column-major rs2_extrinsics) as a pose.
-Pose extrinsics_pose(const Extrinsics& e) {
-  Pose T = Pose::Identity();
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) T.linear()(i, j) = e.rotation[static_cast<size_t>(3 * j + i)];
-  }
-  T.translation() = Eigen::Vector3d(e.translation_m[0], e.translation_m[1], e.translation_m[2]);
-  return T;
 }
 
 }  // namespace
@@ -442,31 +357,9 @@ void BagWriter::flush_chunk() {
   const uint8_t* data = chunk_.data();
   size_t size = chunk_.size();
   if (params_.compression == BagCompression::lz4) {
-    // One LZ4 frame as roslz4 writes it (spec §2): 1 MiB independent blocks, content checksum.
     compression = "lz4";
-    LZ4F_preferences_t prefs{};
-    prefs.frameInfo.blockSizeID = LZ4F_max1MB;
-    prefs.frameInfo.blockMode = LZ4F_blockIndependent;
-    prefs.frameInfo.contentChecksumFlag = LZ4F_contentChecksumEnabled;
-    prefs.autoFlush = 1;  // every block goes out in compressUpdate: End only adds the checksum
-    if (!lz4_) {
-      LZ4F_cctx* context = nullptr;
-      const size_t made = LZ4F_createCompressionContext(&context, LZ4F_VERSION);
-      if (LZ4F_isError(made)) throw BagWriteError(path_ + ": lz4: " + LZ4F_getErrorName(made));
-      lz4_.reset(context);
-    }
-    packed_.resize(LZ4F_compressFrameBound(chunk_.size(), &prefs));
-    const auto check = [this](size_t made) {
-      if (LZ4F_isError(made)) throw BagWriteError(path_ + ": lz4 compression failed: " + LZ4F_getErrorName(made));
-      return made;
-    };
-    uint8_t* out = packed_.data();
-    const size_t room = packed_.size();
-    size_t n = check(LZ4F_compressBegin(lz4_.get(), out, room, &prefs));
-    n += check(LZ4F_compressUpdate(lz4_.get(), out + n, room - n, chunk_.data(), chunk_.size(), nullptr));
-    n += check(LZ4F_compressEnd(lz4_.get(), out + n, room - n, nullptr));
+    size = compress_chunk_lz4();
     data = packed_.data();
-    size = n;
   }
   current_.pos = position_;
   std::vector<uint8_t> head;
@@ -477,6 +370,45 @@ void BagWriter::flush_chunk() {
   put32(head, static_cast<uint32_t>(size));
   write(head.data(), head.size());
   write(data, size);
+  write_chunk_index();
+  // A killed recorder leaves every closed chunk in the file (the kernel has it after fflush).
+  if (std::fflush(file_.get()) != 0) {
+    throw BagWriteError(path_ + ": write failed at byte " + std::to_string(position_) + ": " + std::strerror(errno));
+  }
+  chunk_infos_.push_back(current_);
+  current_ = ChunkInfo{};
+  chunk_.clear();
+  in_chunk_.clear();
+}
+
+// One LZ4 frame as roslz4 writes it (spec §2): 1 MiB independent blocks, content checksum.
+size_t BagWriter::compress_chunk_lz4() {
+  LZ4F_preferences_t prefs{};
+  prefs.frameInfo.blockSizeID = LZ4F_max1MB;
+  prefs.frameInfo.blockMode = LZ4F_blockIndependent;
+  prefs.frameInfo.contentChecksumFlag = LZ4F_contentChecksumEnabled;
+  prefs.autoFlush = 1;  // every block goes out in compressUpdate: End only adds the checksum
+  if (!lz4_) {
+    LZ4F_cctx* context = nullptr;
+    const size_t made = LZ4F_createCompressionContext(&context, LZ4F_VERSION);
+    if (LZ4F_isError(made)) throw BagWriteError(path_ + ": lz4: " + LZ4F_getErrorName(made));
+    lz4_.reset(context);
+  }
+  packed_.resize(LZ4F_compressFrameBound(chunk_.size(), &prefs));
+  const auto check = [this](size_t made) {
+    if (LZ4F_isError(made)) throw BagWriteError(path_ + ": lz4 compression failed: " + LZ4F_getErrorName(made));
+    return made;
+  };
+  uint8_t* out = packed_.data();
+  const size_t room = packed_.size();
+  size_t n = check(LZ4F_compressBegin(lz4_.get(), out, room, &prefs));
+  n += check(LZ4F_compressUpdate(lz4_.get(), out + n, room - n, chunk_.data(), chunk_.size(), nullptr));
+  n += check(LZ4F_compressEnd(lz4_.get(), out + n, room - n, nullptr));
+  return n;
+}
+
+// The index data records after a chunk: per connection, each message's time and offset in it.
+void BagWriter::write_chunk_index() {
   std::vector<uint8_t> index;
   for (const auto& [conn, entries] : in_chunk_) {
     Fields ih;
@@ -489,14 +421,6 @@ void BagWriter::flush_chunk() {
     put_record(index, ih, body.data(), body.size());
   }
   write(index.data(), index.size());
-  // A killed recorder leaves every closed chunk in the file (the kernel has it after fflush).
-  if (std::fflush(file_.get()) != 0) {
-    throw BagWriteError(path_ + ": write failed at byte " + std::to_string(position_) + ": " + std::strerror(errno));
-  }
-  chunk_infos_.push_back(current_);
-  current_ = ChunkInfo{};
-  chunk_.clear();
-  in_chunk_.clear();
 }
 
 void BagWriter::close() {

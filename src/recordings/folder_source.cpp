@@ -254,21 +254,7 @@ Source::Status FolderSource::next(Frame& out) {
   }
   const int64_t lap = played_ / count;
   const auto i = static_cast<size_t>(played_ % count);
-  const std::string& file = files_[i];
-  try {
-    // A list may name anything; a device or a pipe would block or never end.
-    require_regular_file(file, "depth image");
-    read_depth_png(file, out.depth, intrinsics_.width, intrinsics_.height);
-  } catch (const IoError& e) {
-    error_ = "frame " + std::to_string(played_) + ": " + e.what();
-    return Status::error;
-  }
-  if (out.depth.width != intrinsics_.width || out.depth.height != intrinsics_.height) {
-    error_ = "frame " + std::to_string(played_) + ": " + file + ": image is " + std::to_string(out.depth.width) + "x" +
-             std::to_string(out.depth.height) + " but the intrinsics say " + std::to_string(intrinsics_.width) + "x" +
-             std::to_string(intrinsics_.height);
-    return Status::error;
-  }
+  if (!read_depth(files_[i], out.depth)) return Status::error;
   out.depth.depth_scale_m = depth_scale_m_;
   out.index = played_;
   const auto period_ns = static_cast<int64_t>(1e9 / kNominalFps);
@@ -287,22 +273,49 @@ Source::Status FolderSource::next(Frame& out) {
     out.color.reset();
     out.color_intrinsics = Intrinsics{};
     out.depth_to_color.reset();
-  } else {
-    if (!out.color) out.color.emplace();
-    try {
-      require_regular_file(color_file, "colour image");
-      read_color_image(color_file, *out.color);
-    } catch (const IoError& e) {
-      error_ = "frame " + std::to_string(played_) + ": colour: " + e.what();
-      return Status::error;
-    }
-    out.color_intrinsics = color_intrinsics_;
-    out.color_intrinsics.width = out.color->width;
-    out.color_intrinsics.height = out.color->height;
-    out.depth_to_color = depth_to_color_;
+  } else if (!read_color(color_file, out)) {
+    return Status::error;
   }
   ++played_;
   return Status::frame;
+}
+
+// The current frame's depth image, which must have the intrinsics' size; false with error_
+// naming the frame and the file otherwise.
+bool FolderSource::read_depth(const std::string& file, DepthImage& depth) {
+  try {
+    // A list may name anything; a device or a pipe would block or never end.
+    require_regular_file(file, "depth image");
+    read_depth_png(file, depth, intrinsics_.width, intrinsics_.height);
+  } catch (const IoError& e) {
+    error_ = "frame " + std::to_string(played_) + ": " + e.what();
+    return false;
+  }
+  if (depth.width != intrinsics_.width || depth.height != intrinsics_.height) {
+    error_ = "frame " + std::to_string(played_) + ": " + file + ": image is " + std::to_string(depth.width) + "x" +
+             std::to_string(depth.height) + " but the intrinsics say " + std::to_string(intrinsics_.width) + "x" +
+             std::to_string(intrinsics_.height);
+    return false;
+  }
+  return true;
+}
+
+// The current frame's colour image with its intrinsics (the image's own size) and the
+// depth-to-colour extrinsics; false with error_ when it cannot be read.
+bool FolderSource::read_color(const std::string& color_file, Frame& out) {
+  if (!out.color) out.color.emplace();
+  try {
+    require_regular_file(color_file, "colour image");
+    read_color_image(color_file, *out.color);
+  } catch (const IoError& e) {
+    error_ = "frame " + std::to_string(played_) + ": colour: " + e.what();
+    return false;
+  }
+  out.color_intrinsics = color_intrinsics_;
+  out.color_intrinsics.width = out.color->width;
+  out.color_intrinsics.height = out.color->height;
+  out.depth_to_color = depth_to_color_;
+  return true;
 }
 
 }  // namespace hrcsense

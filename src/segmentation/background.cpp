@@ -283,25 +283,31 @@ size_t keep_motion_near_robot(const BackgroundModel& model, const Intrinsics& in
 BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const MotionRegion* region,
                                                  const RobotPixels* robot) {
   if (ready_) return Status::ready;
-  const DepthImage& depth = frame.depth;
-  const size_t n = static_cast<size_t>(depth.width) * static_cast<size_t>(depth.height);
-  Status status = Status::learning;
+  const Status status = start_batch(frame.depth.width, frame.depth.height);
+  accumulate(frame.depth, robot);
+  ++count_;
+  if (count_ < std::max(params.frames, 1)) return status;
+  return finish_batch(frame, region);
+}
 
-  const bool new_size = depth.width != model_.width || depth.height != model_.height;
-  if (new_size) {
+// Sizes the buffers for a new image size (the only allocations: the first frame of a size) or
+// zeroes the sums for a new batch of the same size.
+BackgroundLearner::Status BackgroundLearner::start_batch(int width, int height) {
+  const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
+  Status status = Status::learning;
+  if (width != model_.width || height != model_.height) {
     // A batch in progress mixes two geometries: it cannot be finished, start over.
     if (count_ > 0) {
-      message_ = size_changed_message(model_.width, model_.height, depth.width, depth.height);
+      message_ = size_changed_message(model_.width, model_.height, width, height);
       status = Status::restarted;
     }
-    // The only allocations: the first frame of a size.
     sum_.assign(n, 0.0);
     sum_sq_.assign(n, 0.0);
     valid_count_.assign(n, 0U);
     nearest_raw_.assign(n, 0);
     farthest_raw_.assign(n, 0);
-    model_.width = depth.width;
-    model_.height = depth.height;
+    model_.width = width;
+    model_.height = height;
     model_.mean_m.assign(n, 0.0F);
     model_.spread_m.assign(n, 0.0F);
     model_.valid_ratio.assign(n, 0.0F);
@@ -323,10 +329,14 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
     std::fill(nearest_raw_.begin(), nearest_raw_.end(), uint16_t{0});
     std::fill(farthest_raw_.begin(), farthest_raw_.end(), uint16_t{0});
   }
+  return status;
+}
 
-  // Raw units are integers, so the sums stay exact in double (65535² · 2^20 < 2^53).
+// Adds one frame's raw samples to the batch's sums. Raw units are integers, so the sums stay
+// exact in double (65535² · 2^20 < 2^53). The robot's own pixels are no samples, as if invalid.
+void BackgroundLearner::accumulate(const DepthImage& depth, const RobotPixels* robot) {
+  const size_t n = static_cast<size_t>(depth.width) * static_cast<size_t>(depth.height);
   const uint16_t* raw = depth.pixels.data();
-  // The robot's own pixels are no samples, as if invalid.
   for (size_t i = 0; i < n; ++i) {
     const uint16_t sample = robot != nullptr && robot->contains(i, raw[i]) ? uint16_t{0} : raw[i];
     const double r = sample;
@@ -336,9 +346,13 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
     nearest_raw_[i] = nearer_sample(nearest_raw_[i], sample);
     farthest_raw_[i] = std::max(farthest_raw_[i], sample);
   }
-  ++count_;
-  if (count_ < std::max(params.frames, 1)) return status;
+}
 
+// Turns the completed batch into the model: statistics, noise, then motion, which restarts
+// learning when it covers too much; otherwise the model is finished and ready.
+BackgroundLearner::Status BackgroundLearner::finish_batch(const Frame& frame, const MotionRegion* region) {
+  const DepthImage& depth = frame.depth;
+  const size_t n = static_cast<size_t>(depth.width) * static_cast<size_t>(depth.height);
   const BatchSums sums{sum_.data(), sum_sq_.data(), valid_count_.data(), n, count_};
   const int batch_frames = count_;
   count_ = 0;
@@ -360,14 +374,7 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
       reliable = find_motion(batch, frame.intrinsics, region);
     }
   }
-  // Wide motion is judged before flicker leaves it: flicker in the middle of a wider band of
-  // change (someone swaying) must not make the band thin.
-  erode_motion(moving_.data(), depth.width, depth.height, params.motion_min_width_px, eroded_.data(), wide_.data());
-  for (size_t i = 0; i < n; ++i) {
-    if (flicker_[i] == 0) continue;
-    moving_[i] = 0;
-    wide_[i] = 0;
-  }
+  mark_wide_motion();
   const ObjectMotion motion =
       object_motion(batch, moving_.data(), wide_.data(), frame.intrinsics.fx, min_object_mm, fill_queue_, seen_);
   const double moving_share = reliable == 0 ? 0.0 : static_cast<double>(motion.counted) / static_cast<double>(reliable);
@@ -376,6 +383,26 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
     unsettled_ = 0;  // counts the batch that was learnt
     return Status::restarted;
   }
+  settle_model(batch, batch_frames, have_model);
+  ready_ = true;
+  return Status::ready;
+}
+
+// Marks wide_ (motion wider than motion_min_width_px) and clears edge flicker from both masks.
+// Wide motion is judged before flicker leaves it: flicker in the middle of a wider band of
+// change (someone swaying) must not make the band thin.
+void BackgroundLearner::mark_wide_motion() {
+  erode_motion(moving_.data(), model_.width, model_.height, params.motion_min_width_px, eroded_.data(), wide_.data());
+  for (size_t i = 0; i < moving_.size(); ++i) {
+    if (flicker_[i] == 0) continue;
+    moving_[i] = 0;
+    wide_[i] = 0;
+  }
+}
+
+// Finishes a still batch's model: the noise floor, the background of unreliable and flickering
+// pixels, and no background where motion far from the robot never settled.
+void BackgroundLearner::settle_model(const BatchView& batch, int batch_frames, bool have_model) {
   // With a baseline the foreground test adds the stereo model itself.
   if (!have_model) apply_noise_floor(model_, noise_per_z2_, params.min_valid_ratio);
   const bool keep_unseen = batch_frames >= params.unseen_min_frames;
@@ -384,14 +411,12 @@ BackgroundLearner::Status BackgroundLearner::add(const Frame& frame, const Motio
   cover_flicker(batch);
   // What moved far from the robot never settled: its background is unknown, not its mean.
   if (unsettled_ > 0) {
-    for (size_t i = 0; i < n; ++i) {
+    for (size_t i = 0; i < model_.mean_m.size(); ++i) {
       if (outside_[i] == 0) continue;
       model_.mean_m[i] = 0.0F;
       model_.spread_m[i] = 0.0F;
     }
   }
-  ready_ = true;
-  return Status::ready;
 }
 
 size_t BackgroundLearner::find_motion(const BatchView& batch, const Intrinsics& intrinsics, const MotionRegion* region) {

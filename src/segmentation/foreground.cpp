@@ -280,6 +280,42 @@ void transform_points(const Eigen::Matrix3f& R, const Eigen::Vector3f& t, const 
   }
 }
 
+/// Where the background is unknown (kUnknown), only the configured workspace says whether a
+/// pixel matters: kCandidate inside `workspace_base`, else kNone. Rows that had unknown pixels
+/// may now hold candidates, and their `row_states` say so.
+void keep_unknown_in_workspace(const DepthImage& depth, const Rays& rays, const Eigen::Matrix3f& R,
+                               const Eigen::Vector3f& t, const AlignedBox& workspace_base, uint8_t* mask,
+                               uint8_t* row_states) {
+  const size_t width = static_cast<size_t>(depth.width);
+  const size_t height = static_cast<size_t>(depth.height);
+  for_each_marked_in_rows(mask, row_states, width, 0, height, kUnknown, [&](size_t i) {
+    const int u = static_cast<int>(i % width);
+    const int v = static_cast<int>(i / width);
+    Eigen::Vector3f p_camera;
+    const bool ok = camera_point(rays, u, v, static_cast<float>(depth.pixels[i]) * depth.depth_scale_m, p_camera);
+    mask[i] = ok && workspace_base.contains(R * p_camera + t) ? kCandidate : kNone;
+  });
+  for (size_t v = 0; v < height; ++v) {
+    if ((row_states[v] & kUnknown) != 0) row_states[v] |= kCandidate;
+  }
+}
+
+/// Clears the candidates that are the robot's own pixels (SelfFilter::robot_pixels()); returns
+/// how many. Done before speckle removal, so that the fringe the self-filter leaves around the
+/// arm is judged by its own size, not as part of the arm's blob.
+size_t remove_robot_pixels(const DepthImage& depth, const RobotPixels& robot, const uint8_t* row_states,
+                           uint8_t* mask) {
+  size_t removed = 0;
+  const size_t width = static_cast<size_t>(depth.width);
+  for_each_marked_in_rows(mask, row_states, width, 0, static_cast<size_t>(depth.height), kCandidate, [&](size_t i) {
+    if (robot.contains(i, depth.pixels[i])) {
+      mask[i] = kNone;
+      ++removed;
+    }
+  });
+  return removed;
+}
+
 }  // namespace
 
 void ForegroundExtractor::set_background(const BackgroundModel& background, float fx_px, float stereo_baseline_mm,
@@ -343,30 +379,8 @@ bool ForegroundExtractor::extract(const Frame& frame, const Pose& T_base_camera,
   const Eigen::Vector3f t = T_base_camera.translation().cast<float>();
   uint8_t* mask = out.mask.data();
   classify(depth, nearer_count_.data(), unknown_.data(), mask, row_states_.data());
-
-  // Where the background is unknown, only the configured workspace says whether it matters.
-  for_each_marked_in_rows(mask, row_states_.data(), width, 0, height, kUnknown, [&](size_t i) {
-    const int u = static_cast<int>(i % width);
-    const int v = static_cast<int>(i / width);
-    Eigen::Vector3f p_camera;
-    const bool ok = camera_point(rays, u, v, static_cast<float>(depth.pixels[i]) * depth.depth_scale_m, p_camera);
-    mask[i] = ok && params.workspace_base.contains(R * p_camera + t) ? kCandidate : kNone;
-  });
-  for (size_t v = 0; v < height; ++v) {
-    if ((row_states_[v] & kUnknown) != 0) row_states_[v] |= kCandidate;
-  }
-  // The robot's own pixels go before speckle removal, so that the fringe the self-filter leaves
-  // around the arm is judged by its own size, not as part of the arm's blob.
-  if (robot != nullptr) {
-    size_t removed = 0;
-    for_each_marked_in_rows(mask, row_states_.data(), width, 0, height, kCandidate, [&](size_t i) {
-      if (robot->contains(i, depth.pixels[i])) {
-        mask[i] = kNone;
-        ++removed;
-      }
-    });
-    out.self_filtered_pixels = removed;
-  }
+  keep_unknown_in_workspace(depth, rays, R, t, params.workspace_base, mask, row_states_.data());
+  if (robot != nullptr) out.self_filtered_pixels = remove_robot_pixels(depth, *robot, row_states_.data(), mask);
 
   const Kept kept = remove_speckles(frame, jump_limit_raw_.data(), params.min_object_mm, row_states_.data(), mask,
                                     stack_.data());

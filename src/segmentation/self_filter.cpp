@@ -300,60 +300,12 @@ void SelfFilter::render(const Frame& frame, const Pose& T_base_camera, const For
   silhouette_pixels_ = 0;
   if (pose_count_ == 0 || width_ == 0 || height_ == 0) return;
 
-  const Intrinsics& intr = frame.intrinsics;
   const Eigen::Matrix3f R = T_base_camera.linear().transpose().cast<float>();  // camera ← base
   const Eigen::Vector3f t = -(R * T_base_camera.translation().cast<float>());
-  const size_t w = static_cast<size_t>(width_);
   Rect drawn{width_, height_, 0, 0};  // the union of the capsules' boxes
-
   for (int p = 0; p < pose_count_; ++p) {
     for (const Capsule& capsule : ring_[static_cast<size_t>(p)].capsules) {
-      const Eigen::Vector3f a = R * capsule.a + t;
-      const Eigen::Vector3f b = R * capsule.b + t;
-      const float r = capsule.radius_m;
-      // A bare segment has no surface to see; nothing behind the camera is in the image.
-      if (!(r > 0.0F) || std::max(a.z(), b.z()) + r <= 0.0F) continue;
-      // Which pixels of each row the capsule can cover: the row's span of the convex hull of
-      // its end spheres' projected bounding boxes (the capsule is the hull of the spheres, each
-      // inside its box, and projection keeps hulls). The whole image when a box reaches behind
-      // the camera or a distortion makes the pinhole projection unreliable.
-      const ImageHull hull = pinhole_ ? capsule_hull(a, b, r, intr) : ImageHull{};
-      const CapsuleRayTerms terms = ray_terms(a, b, r);
-      const int v_begin = hull.valid ? std::max(static_cast<int>(std::floor(hull.v_min)) - 1, 0) : 0;
-      const int v_end = hull.valid ? std::min(static_cast<int>(std::ceil(hull.v_max)) + 2, height_) : height_;
-      for (int v = v_begin; v < v_end; ++v) {
-        int u0 = 0, u1 = width_;
-        if (hull.valid) {
-          float lo_u = 0.0F, hi_u = 0.0F;
-          if (!hull.row_span(static_cast<float>(v), lo_u, hi_u)) continue;
-          // One pixel of slack each side for the float rounding of the projection.
-          u0 = static_cast<int>(std::clamp(std::floor(lo_u) - 1.0F, 0.0F, static_cast<float>(width_)));
-          u1 = static_cast<int>(std::clamp(std::ceil(hi_u) + 2.0F, 0.0F, static_cast<float>(width_)));
-          if (u0 >= u1) continue;
-        }
-        float* __restrict entry = entry_m_.data() + static_cast<size_t>(v) * w;
-        float* __restrict exit = exit_m_.data() + static_cast<size_t>(v) * w;
-        if (pinhole_) {
-          const float* __restrict xs = ray_x_.data();
-          const float y = ray_y_[static_cast<size_t>(v)];
-          for (int u = u0; u < u1; ++u) {
-            const RayInterval in = capsule_interval(xs[u], y, terms);
-            entry[u] = std::min(entry[u], in.entry);
-            exit[u] = std::max(exit[u], in.exit);
-          }
-        } else {
-          const float* __restrict xs = ray_x_.data() + static_cast<size_t>(v) * w;
-          const float* __restrict ys = ray_y_.data() + static_cast<size_t>(v) * w;
-          for (int u = u0; u < u1; ++u) {
-            // NaN rays (a distortion without inverse) compare false: no hit.
-            const RayInterval in = capsule_interval(xs[u], ys[u], terms);
-            entry[u] = in.entry < entry[u] ? in.entry : entry[u];
-            exit[u] = in.exit > exit[u] ? in.exit : exit[u];
-          }
-        }
-        drawn.u0 = std::min(drawn.u0, u0), drawn.u1 = std::max(drawn.u1, u1);
-        drawn.v0 = std::min(drawn.v0, v), drawn.v1 = std::max(drawn.v1, v + 1);
-      }
+      draw_capsule(R * capsule.a + t, R * capsule.b + t, capsule.radius_m, frame.intrinsics, drawn);
     }
   }
   if (drawn.empty()) return;
@@ -362,13 +314,65 @@ void SelfFilter::render(const Frame& frame, const Pose& T_base_camera, const For
                    std::min(drawn.v1 + k, height_)};
   dilate(grown);
   dirty_ = grown;
+  silhouette_pixels_ = mark_robot_depths(frame, noise, grown);
+}
 
-  // The margin at depth z never undercuts the foreground test there: max(margin_m,
-  // min_margin_m, k_sigma · σ(z)), σ(z) = z² · subpixel / (fx · baseline) (no stereo term
-  // without a baseline).
+void SelfFilter::draw_capsule(const Eigen::Vector3f& a, const Eigen::Vector3f& b, float r, const Intrinsics& intr,
+                              Rect& drawn) {
+  // A bare segment has no surface to see; nothing behind the camera is in the image.
+  if (!(r > 0.0F) || std::max(a.z(), b.z()) + r <= 0.0F) return;
+  const size_t w = static_cast<size_t>(width_);
+  // Which pixels of each row the capsule can cover: the row's span of the convex hull of
+  // its end spheres' projected bounding boxes (the capsule is the hull of the spheres, each
+  // inside its box, and projection keeps hulls). The whole image when a box reaches behind
+  // the camera or a distortion makes the pinhole projection unreliable.
+  const ImageHull hull = pinhole_ ? capsule_hull(a, b, r, intr) : ImageHull{};
+  const CapsuleRayTerms terms = ray_terms(a, b, r);
+  const int v_begin = hull.valid ? std::max(static_cast<int>(std::floor(hull.v_min)) - 1, 0) : 0;
+  const int v_end = hull.valid ? std::min(static_cast<int>(std::ceil(hull.v_max)) + 2, height_) : height_;
+  for (int v = v_begin; v < v_end; ++v) {
+    int u0 = 0, u1 = width_;
+    if (hull.valid) {
+      float lo_u = 0.0F, hi_u = 0.0F;
+      if (!hull.row_span(static_cast<float>(v), lo_u, hi_u)) continue;
+      // One pixel of slack each side for the float rounding of the projection.
+      u0 = static_cast<int>(std::clamp(std::floor(lo_u) - 1.0F, 0.0F, static_cast<float>(width_)));
+      u1 = static_cast<int>(std::clamp(std::ceil(hi_u) + 2.0F, 0.0F, static_cast<float>(width_)));
+      if (u0 >= u1) continue;
+    }
+    float* __restrict entry = entry_m_.data() + static_cast<size_t>(v) * w;
+    float* __restrict exit = exit_m_.data() + static_cast<size_t>(v) * w;
+    if (pinhole_) {
+      const float* __restrict xs = ray_x_.data();
+      const float y = ray_y_[static_cast<size_t>(v)];
+      for (int u = u0; u < u1; ++u) {
+        const RayInterval in = capsule_interval(xs[u], y, terms);
+        entry[u] = std::min(entry[u], in.entry);
+        exit[u] = std::max(exit[u], in.exit);
+      }
+    } else {
+      const float* __restrict xs = ray_x_.data() + static_cast<size_t>(v) * w;
+      const float* __restrict ys = ray_y_.data() + static_cast<size_t>(v) * w;
+      for (int u = u0; u < u1; ++u) {
+        // NaN rays (a distortion without inverse) compare false: no hit.
+        const RayInterval in = capsule_interval(xs[u], ys[u], terms);
+        entry[u] = in.entry < entry[u] ? in.entry : entry[u];
+        exit[u] = in.exit > exit[u] ? in.exit : exit[u];
+      }
+    }
+    drawn.u0 = std::min(drawn.u0, u0), drawn.u1 = std::max(drawn.u1, u1);
+    drawn.v0 = std::min(drawn.v0, v), drawn.v1 = std::max(drawn.v1, v + 1);
+  }
+}
+
+// The margin at depth z never undercuts the foreground test there: max(margin_m,
+// min_margin_m, k_sigma · σ(z)), σ(z) = z² · subpixel / (fx · baseline) (no stereo term
+// without a baseline).
+size_t SelfFilter::mark_robot_depths(const Frame& frame, const ForegroundParams& noise, const Rect& grown) {
+  const size_t w = static_cast<size_t>(width_);
   const float floor_m = std::max(params.margin_m, noise.min_margin_m);
   // The frame's own focal length, as the foreground test takes it (after decimation too).
-  const float fx = intr.fx;
+  const float fx = frame.intrinsics.fx;
   const float sigma_per_z2 =
       frame.stereo_baseline_mm > 0.0F && fx > 0.0F
           ? static_cast<float>(stereo_depth_sigma_m(1.0, fx, frame.stereo_baseline_mm, noise.subpixel_rms_px))
@@ -393,7 +397,7 @@ void SelfFilter::render(const Frame& frame, const Pose& T_base_camera, const For
       ++silhouette;
     }
   }
-  silhouette_pixels_ = silhouette;
+  return silhouette;
 }
 
 }  // namespace hrcsense

@@ -281,6 +281,90 @@ void cast_camera(const PixelRect& r, const SimRays& rays, uint16_t id, Hit hit, 
   }
 }
 
+/// A plane as seen from the camera: w = n_camera / (n_camera · p_camera), so that the inverse
+/// depth along the ray (x, y, 1) is w · (x, y, 1). False for a shape that is no plane and for a
+/// plane through the camera centre (seen edge-on, never hit).
+bool plane_w(const Shape& s, uint16_t id, const PoseF& T_camera_base, PlaneW& out) {
+  if (s.type != Shape::Type::plane) return false;
+  const Eigen::Vector3f n_camera = T_camera_base.R * s.normal;
+  const float num = n_camera.dot(T_camera_base.apply(s.point));
+  if (num == 0.0F) return false;
+  const Eigen::Vector3f w = n_camera / num;
+  out = {w.x(), w.y(), w.z(), id};
+  return true;
+}
+
+/// Casts every plane of the scene; planes come first, since they initialise every pixel of
+/// both buffers (kNoHit and id 0 where no plane is in front).
+void cast_all_planes(const std::vector<Shape>& shapes_base, const std::vector<uint16_t>& shape_ids,
+                     const SimRays& rays, const PoseF& T_camera_base, bool pinhole, float* z_m, uint16_t* ids) {
+  // Fixed-size batches, so that casting does not allocate.
+  std::array<PlaneW, 16> batch{};
+  size_t count = 0;
+  size_t total = 0;
+  for (size_t k = 0; k < shapes_base.size(); ++k) {
+    PlaneW p{};
+    if (!plane_w(shapes_base[k], shape_ids[k], T_camera_base, p)) continue;
+    if (count < batch.size()) batch[count++] = p;
+    ++total;
+  }
+  if (pinhole && total <= batch.size()) {
+    cast_planes_pinhole(batch.data(), count, rays, z_m, ids);
+    return;
+  }
+  const size_t n = rays.x.size();
+  std::fill(z_m, z_m + n, 0.0F);  // inverse depth meanwhile
+  std::fill(ids, ids + n, uint16_t{0});
+  count = 0;
+  for (size_t k = 0; k < shapes_base.size(); ++k) {
+    if (!plane_w(shapes_base[k], shape_ids[k], T_camera_base, batch[count])) continue;
+    if (++count == batch.size()) {
+      cast_planes_w(batch.data(), count, rays, z_m, ids);
+      count = 0;
+    }
+  }
+  if (count > 0) cast_planes_w(batch.data(), count, rays, z_m, ids);
+  for (size_t i = 0; i < n; ++i) {
+    // 1 / +0 = +inf = kNoHit where no plane is in front (w = 0). max rather than a select,
+    // which GCC would keep as a branch; this loop should vectorise.
+    z_m[i] = 1.0F / std::max(0.0F, z_m[i]);
+  }
+}
+
+/// Z-buffers one shape other than a plane over the pixels its bounding box may cover. Boxes
+/// are axis-aligned in the base frame, so they are cast there; the rest in the camera frame,
+/// where every ray starts at the origin.
+void cast_solid(const Shape& s, uint16_t id, const SimRays& rays, const PoseF& T_base_camera,
+                const PoseF& T_camera_base, bool pinhole, float* z_m, uint16_t* ids) {
+  const PixelRect r = screen_bounds(s, rays.intrinsics, T_camera_base);
+  if (r.u0 >= r.u1 || r.v0 >= r.v1) return;
+  const Eigen::Vector3f origin_base = T_base_camera.t;
+  const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
+  Shape c = s;
+  c.point = T_camera_base.apply(s.point);
+  c.a = T_camera_base.apply(s.a);
+  c.b = T_camera_base.apply(s.b);
+  switch (s.type) {
+    case Shape::Type::plane:
+      break;
+    case Shape::Type::box:
+      if (pinhole) {
+        cast_box_pinhole(r, rays, T_base_camera.R, origin_base, s, id, z_m, ids);
+      } else {
+        cast(r, rays, T_base_camera.R, id, [&](const Eigen::Vector3f& d) { return hit_box(s, origin_base, d); }, z_m,
+             ids);
+      }
+      break;
+    case Shape::Type::sphere:
+      cast_camera(r, rays, id, [&](const Eigen::Vector3f& d) { return hit_sphere(c.point, c.radius_m, zero, d); },
+                  z_m, ids);
+      break;
+    case Shape::Type::capsule:
+      cast_camera(r, rays, id, CapsuleHit{c}, z_m, ids);
+      break;
+  }
+}
+
 }  // namespace
 
 void ensure_rays(SimRays& rays, const Intrinsics& in) {
@@ -308,84 +392,12 @@ void cast_shapes(const std::vector<Shape>& shapes_base, const std::vector<uint16
                  const PoseF& T_base_camera, float* z_m, uint16_t* ids) {
   const PoseF T_camera_base = T_base_camera.inverse();
   const Intrinsics& in = rays.intrinsics;
-  // Planes first: they initialise every pixel of both buffers.
-  const auto plane_w = [&](size_t k, PlaneW& out) {
-    const Shape& s = shapes_base[k];
-    if (s.type != Shape::Type::plane) return false;
-    const Eigen::Vector3f n_camera = T_camera_base.R * s.normal;
-    const float num = n_camera.dot(T_camera_base.apply(s.point));
-    if (num == 0.0F) return false;  // through the camera centre: seen edge-on, never hit
-    const Eigen::Vector3f w = n_camera / num;
-    out = {w.x(), w.y(), w.z(), shape_ids[k]};
-    return true;
-  };
-  // Fixed-size batches, so that casting does not allocate.
-  std::array<PlaneW, 16> batch{};
-  size_t count = 0;
-  size_t total = 0;
-  for (size_t k = 0; k < shapes_base.size(); ++k) {
-    PlaneW p{};
-    if (!plane_w(k, p)) continue;
-    if (count < batch.size()) batch[count++] = p;
-    ++total;
-  }
   // The row paths need x to grow along a row, as it does for every real camera (fx > 0).
   const bool pinhole = is_pinhole(in) && in.fx > 0.0F;
-  if (pinhole && total <= batch.size()) {
-    cast_planes_pinhole(batch.data(), count, rays, z_m, ids);
-  } else {
-    const size_t n = rays.x.size();
-    std::fill(z_m, z_m + n, 0.0F);  // inverse depth meanwhile
-    std::fill(ids, ids + n, uint16_t{0});
-    count = 0;
-    for (size_t k = 0; k < shapes_base.size(); ++k) {
-      if (!plane_w(k, batch[count])) continue;
-      if (++count == batch.size()) {
-        cast_planes_w(batch.data(), count, rays, z_m, ids);
-        count = 0;
-      }
-    }
-    if (count > 0) cast_planes_w(batch.data(), count, rays, z_m, ids);
-    for (size_t i = 0; i < n; ++i) {
-      // 1 / +0 = +inf = kNoHit where no plane is in front (w = 0). max rather than a select,
-      // which GCC would keep as a branch; this loop should vectorise.
-      z_m[i] = 1.0F / std::max(0.0F, z_m[i]);
-    }
-  }
-
-  const Eigen::Vector3f origin_base = T_base_camera.t;
-  const Eigen::Vector3f zero = Eigen::Vector3f::Zero();
+  cast_all_planes(shapes_base, shape_ids, rays, T_camera_base, pinhole, z_m, ids);
   for (size_t k = 0; k < shapes_base.size(); ++k) {
-    const Shape& s = shapes_base[k];
-    if (s.type == Shape::Type::plane) continue;
-    const uint16_t id = shape_ids[k];
-    const PixelRect r = screen_bounds(s, in, T_camera_base);
-    if (r.u0 >= r.u1 || r.v0 >= r.v1) continue;
-    // Boxes are axis-aligned in the base frame, so they are cast there; the rest in the camera
-    // frame, where every ray starts at the origin.
-    Shape c = s;
-    c.point = T_camera_base.apply(s.point);
-    c.a = T_camera_base.apply(s.a);
-    c.b = T_camera_base.apply(s.b);
-    switch (s.type) {
-      case Shape::Type::plane:
-        break;
-      case Shape::Type::box:
-        if (pinhole) {
-          cast_box_pinhole(r, rays, T_base_camera.R, origin_base, s, id, z_m, ids);
-        } else {
-          cast(r, rays, T_base_camera.R, id, [&](const Eigen::Vector3f& d) { return hit_box(s, origin_base, d); }, z_m,
-               ids);
-        }
-        break;
-      case Shape::Type::sphere:
-        cast_camera(r, rays, id, [&](const Eigen::Vector3f& d) { return hit_sphere(c.point, c.radius_m, zero, d); },
-                    z_m, ids);
-        break;
-      case Shape::Type::capsule:
-        cast_camera(r, rays, id, CapsuleHit{c}, z_m, ids);
-        break;
-    }
+    if (shapes_base[k].type == Shape::Type::plane) continue;
+    cast_solid(shapes_base[k], shape_ids[k], rays, T_base_camera, T_camera_base, pinhole, z_m, ids);
   }
 }
 

@@ -327,6 +327,45 @@ void apply_working_range(const SimParams& p, float min_range_m, bool dropouts, u
   }
 }
 
+/// Exact depth, rounded to the unit, where the stereo geometry gives any (noise off).
+void write_exact_depth(const float* z_m, const float* disparity_px, const uint8_t* hidden, float inv_scale, size_t n,
+                       uint16_t* raw) {
+  for (size_t i = 0; i < n; ++i) {
+    const float r = z_m[i] * inv_scale + 0.5F;
+    const bool ok = disparity_px[i] > 0.0F && hidden[i] == 0 && r >= 1.0F && r < 65536.0F;
+    raw[i] = ok ? static_cast<uint16_t>(r) : 0;
+  }
+}
+
+/// The dense pass, branch-free so that it vectorises: every visible pixel (d_true > 0, not
+/// hidden) gets its noisy depth, drawn from the true disparity d_true (px), the correlated
+/// part (px, or none) and one normal draw `g`; every other pixel 0.
+void write_noisy_depth(NoisyDepth to_raw, const float* d_true, const float* correlated, const float* g,
+                       const uint8_t* hidden, size_t n, uint16_t* raw) {
+  const float step = to_raw.step_px;
+  if (correlated != nullptr || !(step > 0.0F)) {
+    for (size_t i = 0; i < n; ++i) {
+      const uint16_t r = to_raw(d_true[i] + (correlated != nullptr ? correlated[i] : 0.0F), g[i]);
+      raw[i] = d_true[i] > 0.0F && hidden[i] == 0 ? r : 0;
+    }
+    return;
+  }
+  // The default: quantised, no correlated part. Written out so that it vectorises.
+  const float fxb = to_raw.fxb;
+  const float inv_scale = to_raw.inv_scale;
+  const float sigma = to_raw.sigma_px;
+  const float inv_step = 1.0F / step;
+  for (size_t i = 0; i < n; ++i) {
+    const float d = static_cast<float>(static_cast<int32_t>((d_true[i] + sigma * g[i]) * inv_step + 0.5F)) * step;
+    const float r = fxb / std::max(std::numeric_limits<float>::min(), d) * inv_scale + 0.5F;
+    // Bitwise & and integer masks instead of selects, a clamped conversion: branch-free, so
+    // that it vectorises (GCC keeps float selects as branches under trapping math).
+    const int ok = (d_true[i] > 0.0F) & (hidden[i] == 0) & (d > 0.0F) & (r >= 1.0F) & (r < 65536.0F);
+    const auto value = static_cast<int32_t>(std::min(r, 65535.0F));
+    raw[i] = static_cast<uint16_t>(value & -ok);
+  }
+}
+
 }  // namespace
 
 float sensor_min_range_m(const SimParams& p, float fx_px) {
@@ -354,12 +393,7 @@ void write_sensor_depth(const SimParams& p, float fx_px, int64_t index, const fl
   const uint64_t frame_seed = mix64(mix64(p.seed) ^ (static_cast<uint64_t>(index) * kGolden));
   uint16_t* raw = depth.pixels.data();
   if (!p.noise) {
-    // Exact depth, rounded to the unit, where the stereo geometry gives any.
-    for (size_t i = 0; i < n; ++i) {
-      const float r = z_m[i] * inv_scale + 0.5F;
-      const bool ok = scratch.disparity_px[i] > 0.0F && scratch.hidden[i] == 0 && r >= 1.0F && r < 65536.0F;
-      raw[i] = ok ? static_cast<uint16_t>(r) : 0;
-    }
+    write_exact_depth(z_m, scratch.disparity_px.data(), scratch.hidden.data(), inv_scale, n, raw);
     if (p.max_range_m > 0.0F) apply_working_range(p, min_range, false, frame_seed, n, raw);
     return;
   }
@@ -370,29 +404,10 @@ void write_sensor_depth(const SimParams& p, float fx_px, int64_t index, const fl
   const float* correlated = p.correlated_noise_px > 0.0F ? scratch.correlated_px.data() : nullptr;
   const float step = p.disparity_step_px;
   const NoisyDepth to_raw{fxb, p.disparity_noise_px, step, step > 0.0F ? 1.0F / step : 0.0F, inv_scale};
-  // Dense pass, branch-free so that it vectorises: every visible pixel gets its noisy depth.
   const float* d_true = scratch.disparity_px.data();
   const float* g = scratch.normal_draws.data();
   const uint8_t* hidden = scratch.hidden.data();
-  if (correlated != nullptr || !(step > 0.0F)) {
-    for (size_t i = 0; i < n; ++i) {
-      const uint16_t r = to_raw(d_true[i] + (correlated != nullptr ? correlated[i] : 0.0F), g[i]);
-      raw[i] = d_true[i] > 0.0F && hidden[i] == 0 ? r : 0;
-    }
-  } else {
-    // The default: quantised, no correlated part. Written out so that it vectorises.
-    const float sigma = p.disparity_noise_px;
-    const float inv_step = 1.0F / step;
-    for (size_t i = 0; i < n; ++i) {
-      const float d = static_cast<float>(static_cast<int32_t>((d_true[i] + sigma * g[i]) * inv_step + 0.5F)) * step;
-      const float r = fxb / std::max(std::numeric_limits<float>::min(), d) * inv_scale + 0.5F;
-      // Bitwise & and integer masks instead of selects, a clamped conversion: branch-free, so
-      // that it vectorises (GCC keeps float selects as branches under trapping math).
-      const int ok = (d_true[i] > 0.0F) & (hidden[i] == 0) & (d > 0.0F) & (r >= 1.0F) & (r < 65536.0F);
-      const auto value = static_cast<int32_t>(std::min(r, 65535.0F));
-      raw[i] = static_cast<uint16_t>(value & -ok);
-    }
-  }
+  write_noisy_depth(to_raw, d_true, correlated, g, hidden, n, raw);
   // Sparse fix-ups. Flying pixels first (they re-compute a value); dropouts only ever zero one.
   apply_edges(p, frame_seed, width, height, d_true, correlated, g, hidden, to_raw, raw, scratch.row_steps);
   apply_materials(p, width, height, scratch.object_ids.data(), scratch.material_of_id.data(), raw);

@@ -6,10 +6,10 @@
 #include "hrcsense/camera.hpp"
 #include "hrcsense/robot_state.hpp"
 
+#include "jsonl_text.hpp"
+
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <string_view>
 
 #ifndef HRCSENSE_VERSION
@@ -22,139 +22,11 @@
 namespace hrcsense {
 namespace {
 
-void put_string(std::string& line, std::string_view text) {
-  line += '"';
-  for (char ch : text) {
-    const auto byte = static_cast<unsigned char>(ch);
-    if (ch == '"' || ch == '\\') {
-      line += '\\';
-      line += ch;
-    } else if (byte < 0x20) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\u%04x", byte);
-      line += escaped;
-    } else {
-      line += ch;
-    }
-  }
-  line += '"';
-}
-
-void put_key(std::string& line, const char* key) {
-  if (line.back() != '{') line += ',';
-  put_string(line, key);
-  line += ':';
-}
-
-// Shortest text that reads back as the same float: 9 significant digits at most, which
-// keeps metres far below 0.1 mm. JSON has no NaN or infinity: those become null.
-void put_float(std::string& line, float value) {
-  if (!std::isfinite(value)) {
-    line += "null";
-    return;
-  }
-  char buffer[32];
-  for (int digits = 6; digits <= 9; ++digits) {
-    std::snprintf(buffer, sizeof buffer, "%.*g", digits, static_cast<double>(value));
-    if (std::strtof(buffer, nullptr) == value) break;
-  }
-  line += buffer;
-}
-
-void put_double(std::string& line, double value) {
-  if (!std::isfinite(value)) {
-    line += "null";
-    return;
-  }
-  char buffer[40];
-  for (int digits = 6; digits <= 17; ++digits) {
-    std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
-    if (std::strtod(buffer, nullptr) == value) break;
-  }
-  line += buffer;
-}
-
-void put_int(std::string& line, int64_t value) {
-  char buffer[24];
-  std::snprintf(buffer, sizeof buffer, "%lld", static_cast<long long>(value));
-  line += buffer;
-}
-
-// Seconds from integer nanoseconds, exactly: "3.4" rather than 3.4000000000000004.
-void put_seconds(std::string& line, int64_t timestamp_ns) {
-  if (timestamp_ns < 0) {
-    put_double(line, static_cast<double>(timestamp_ns) * 1e-9);
-    return;
-  }
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, "%lld.%09lld", static_cast<long long>(timestamp_ns / 1000000000),
-                static_cast<long long>(timestamp_ns % 1000000000));
-  std::string_view text(buffer);
-  while (text.back() == '0' && text[text.size() - 2] != '.') text.remove_suffix(1);
-  line += text;
-}
-
-void put_vec3(std::string& line, const Eigen::Vector3f& v) {
-  line += '[';
-  put_float(line, v.x());
-  line += ',';
-  put_float(line, v.y());
-  line += ',';
-  put_float(line, v.z());
-  line += ']';
-}
-
-/// Appends `"key":value` members to a line, one call per member, so that each field of the
-/// output is one line here. Values a contact lacks are written as null.
-struct Members {
-  std::string& line;
-
-  void text(const char* key, std::string_view value) {
-    put_key(line, key);
-    put_string(line, value);
-  }
-  void integer(const char* key, int64_t value) {
-    put_key(line, key);
-    put_int(line, value);
-  }
-  void number(const char* key, float value) {
-    put_key(line, key);
-    put_float(line, value);
-  }
-  void number(const char* key, double value) {
-    put_key(line, key);
-    put_double(line, value);
-  }
-  void boolean(const char* key, bool value) {
-    put_key(line, key);
-    line += value ? "true" : "false";
-  }
-  void null(const char* key) {
-    put_key(line, key);
-    line += "null";
-  }
-  template <typename T>
-  void number_or_null(const char* key, bool present, T value) {
-    if (present) {
-      number(key, value);
-    } else {
-      null(key);
-    }
-  }
-  void point_or_null(const char* key, bool present, const Eigen::Vector3f& value) {
-    put_key(line, key);
-    if (present) {
-      put_vec3(line, value);
-    } else {
-      line += "null";
-    }
-  }
-  void open(const char* key) {
-    put_key(line, key);
-    line += '{';
-  }
-  void close() { line += '}'; }
-};
+using jsonl_detail::Members;
+using jsonl_detail::put_double;
+using jsonl_detail::put_float;
+using jsonl_detail::put_key;
+using jsonl_detail::put_seconds;
 
 // `governing_link` and `links`: per link with a measured contact its distance, speed towards
 // the contact, Z_d and S_p at its own speed; [] and null without a contact.
@@ -204,6 +76,166 @@ void put_filters(Members& m, const RunHeader::Filters& filters) {
   m.close();
 }
 
+// `source`: what the frames come from; the camera's name, serial and firmware when known.
+void put_source(Members& m, const SourceInfo& source) {
+  m.open("source");
+  m.text("type", source.type);
+  m.text("description", source.description);
+  m.integer("frame_count", source.frame_count);
+  m.number("nominal_fps", source.nominal_fps);
+  m.number("stereo_baseline_mm", source.stereo_baseline_mm);
+  m.text_or_null("sensor_model", source.sensor_model);
+  if (!source.camera_serial.empty() || !source.camera_name.empty()) {
+    m.text("name", source.camera_name);
+    m.text("serial", source.camera_serial);
+    m.text("firmware", source.camera_firmware);
+  }
+  m.close();
+}
+
+// `intrinsics`: the source's pinhole, distortion model and coefficients.
+void put_intrinsics(Members& m, const Intrinsics& in) {
+  m.open("intrinsics");
+  put_pinhole(m, in);
+  m.text("model", distortion_name(in.model));
+  put_key(m.line, "coeffs");
+  m.line += '[';
+  for (size_t i = 0; i < in.coeffs.size(); ++i) {
+    if (i > 0) m.line += ',';
+    put_float(m.line, in.coeffs[i]);
+  }
+  m.line += ']';
+  m.close();
+}
+
+
+// `ssm`: S_p's terms (safety.mode ssm, a frame with a contact); null otherwise.
+void put_ssm(Members& m, const std::optional<SsmTerms>& ssm) {
+  if (!ssm) {
+    m.null("ssm");
+    return;
+  }
+  m.open("ssm");
+  m.number("s_h_m", ssm->s_h_m);
+  m.number("s_r_m", ssm->s_r_m);
+  m.number("s_s_m", ssm->s_s_m);
+  m.number("c_m", ssm->c_m);
+  m.number("z_d_m", ssm->z_d_m);
+  m.number("z_r_m", ssm->z_r_m);
+  m.number("reaction_time_s", ssm->reaction_time_s);
+  m.number("stop_time_s", ssm->stop_time_s);
+  m.close();
+}
+
+// The closest pair in the camera, base and robot base frames; null without a contact.
+void put_contact(Members& m, const Contact& contact) {
+  m.point_or_null("closest_camera", contact.valid, contact.closest_camera);
+  m.point_or_null("closest_base", contact.valid, contact.closest_base);
+  m.point_or_null("closest_robot_base", contact.valid, contact.closest_robot_base);
+  if (contact.valid) {
+    m.integer("robot_link", contact.robot_link);
+    m.boolean("inside", contact.inside);  // a foreground point inside (or on) a capsule: distance 0
+  } else {
+    m.null("robot_link");
+    m.null("inside");
+  }
+}
+
+// `joints_rad`: the joints the robot's capsules were built from; null without a valid robot state.
+void put_joints(Members& m, const RobotState& state) {
+  put_key(m.line, "joints_rad");
+  if (!state.valid) {
+    m.line += "null";
+    return;
+  }
+  m.line += '[';
+  for (size_t j = 0; j < kJointCount; ++j) {
+    if (j > 0) m.line += ',';
+    put_double(m.line, state.q_rad[j]);
+  }
+  m.line += ']';
+}
+
+// `robot_status`: the controller's own report (rtde): present where the source has one, null in
+// frames without a valid state from such a source (`announced`), absent for sources that have none.
+void put_robot_status(Members& m, const RobotStatus& status, bool announced) {
+  if (status.known) {
+    m.open("robot_status");
+    m.integer("robot_mode", status.robot_mode);
+    m.text("robot_mode_name", robot_mode_name(status.robot_mode));
+    m.integer("safety_mode", status.safety_mode);
+    m.text("safety_mode_name", safety_mode_name(status.safety_mode));
+    m.number("speed_scaling", status.speed_scaling);
+    m.number_or_null("target_speed_fraction", std::isfinite(status.target_speed_fraction),
+                     status.target_speed_fraction);
+    m.boolean("tcp_pose_mismatch", status.tcp_pose_mismatch);
+    m.close();
+  } else if (announced) {
+    m.null("robot_status");
+  }
+}
+
+// `truth`: the simulator's exact contact and per-link distances; absent for other sources.
+void put_truth(Members& m, const FrameResult& result) {
+  if (!result.truth) return;
+  m.open("truth");
+  m.number_or_null("distance_m", result.truth->valid, result.truth->distance_m);
+  m.point_or_null("closest_base", result.truth->valid, result.truth->closest_base);
+  if (result.truth_contact_label != nullptr) {
+    m.text("contact_label", result.truth_contact_label);
+  } else {
+    m.null("contact_label");
+  }
+  std::string& line = m.line;
+  put_key(line, "links");
+  line += '[';
+  for (const LinkTruth& link : result.truth_links) {
+    if (line.back() != '[') line += ',';
+    line += '{';
+    m.integer("link", link.link);
+    m.number("distance_m", link.distance_m);
+    m.number("speed_towards_mps", link.speed_towards_mps);
+    line += '}';
+  }
+  line += ']';
+  m.close();
+}
+
+
+/// `robot_state`: the robot state source's sample counters and the controller's reports.
+void put_robot_state_counters(Members& m, const RobotStateStats& robot, const RobotStatusCounts& status) {
+  m.open("robot_state");
+  m.integer("accepted", robot.samples.accepted);
+  m.integer("rejected_non_finite", robot.samples.rejected_non_finite);
+  m.integer("rejected_backwards", robot.samples.rejected_backwards);
+  m.integer("rejected_jump", robot.samples.rejected_jump);
+  m.integer("rejected_limits", robot.samples.rejected_limits);
+  m.integer("connections", robot.connections);
+  m.integer("disconnects", robot.disconnects);
+  m.integer("malformed", robot.malformed);
+  m.integer("frames_with_status", status.frames_reported);
+  m.integer("frames_not_running", status.frames_not_running);
+  m.integer("frames_protective_stop", status.frames_protective_stop);
+  m.integer("mode_changes", status.mode_changes);
+  m.integer("frames_tcp_pose_mismatch", status.frames_tcp_pose_mismatch);
+  m.text_or_null("last_problem", robot.last_problem);
+  m.close();
+}
+
+/// `record`: the recorder's counters, null when the run recorded nothing.
+void put_record_counters(Members& m, const std::optional<RecordCounters>& record) {
+  if (!record) {
+    m.null("record");
+    return;
+  }
+  m.open("record");
+  m.integer("frames_recorded", record->frames_recorded);
+  m.integer("frames_dropped", record->frames_dropped);
+  m.texts("files", record->files);
+  m.text_or_null("error", record->error);
+  m.close();
+}
+
 }  // namespace
 
 void JsonLinesSink::header(const RunHeader& header) {
@@ -223,50 +255,14 @@ void JsonLinesSink::header(const RunHeader& header) {
   m.text("safety_notice", kSafetyNotice);
   if (!header.robot_state.empty()) {
     m.text("robot_state", header.robot_state);
-    put_key(line_, "robot_state_reports");
-    line_ += '[';
-    for (size_t i = 0; i < header.robot_state_reports.size(); ++i) {
-      if (i > 0) line_ += ',';
-      put_string(line_, header.robot_state_reports[i]);
-    }
-    line_ += ']';
+    m.texts("robot_state_reports", header.robot_state_reports);
   }
   robot_status_announced_ = std::find(header.robot_state_reports.begin(), header.robot_state_reports.end(),
                                       "robot_status") != header.robot_state_reports.end();
   m.number_or_null("unknown_background_share", header.unknown_background_share >= 0.0,
                    header.unknown_background_share);
-
-  const SourceInfo& source = header.source;
-  m.open("source");
-  m.text("type", source.type);
-  m.text("description", source.description);
-  m.integer("frame_count", source.frame_count);
-  m.number("nominal_fps", source.nominal_fps);
-  m.number("stereo_baseline_mm", source.stereo_baseline_mm);
-  if (source.sensor_model.empty()) {
-    m.null("sensor_model");
-  } else {
-    m.text("sensor_model", source.sensor_model);
-  }
-  if (!source.camera_serial.empty() || !source.camera_name.empty()) {
-    m.text("name", source.camera_name);
-    m.text("serial", source.camera_serial);
-    m.text("firmware", source.camera_firmware);
-  }
-  m.close();
-
-  const Intrinsics& in = source.intrinsics;
-  m.open("intrinsics");
-  put_pinhole(m, in);
-  m.text("model", distortion_name(in.model));
-  put_key(line_, "coeffs");
-  line_ += '[';
-  for (size_t i = 0; i < in.coeffs.size(); ++i) {
-    if (i > 0) line_ += ',';
-    put_float(line_, in.coeffs[i]);
-  }
-  line_ += ']';
-  m.close();
+  put_source(m, header.source);
+  put_intrinsics(m, header.source.intrinsics);
   put_filters(m, header.filters);
   line_ += "}\n";
   write_line();
@@ -286,24 +282,9 @@ void JsonLinesSink::frame(const FrameResult& result) {
   m.text("verdict_reason", result.verdict.reason);
   m.text("reason_code", reason_code_name(result.verdict.code));
   m.number("speed_scale", result.verdict.speed_scale);
-
   m.number_or_null("distance_m", contact.valid, contact.distance_m);
   m.number("protective_distance_m", result.verdict.protective_distance_m);
-  // S_p's terms (safety.mode ssm, a frame with a contact); null otherwise.
-  if (result.ssm) {
-    m.open("ssm");
-    m.number("s_h_m", result.ssm->s_h_m);
-    m.number("s_r_m", result.ssm->s_r_m);
-    m.number("s_s_m", result.ssm->s_s_m);
-    m.number("c_m", result.ssm->c_m);
-    m.number("z_d_m", result.ssm->z_d_m);
-    m.number("z_r_m", result.ssm->z_r_m);
-    m.number("reaction_time_s", result.ssm->reaction_time_s);
-    m.number("stop_time_s", result.ssm->stop_time_s);
-    m.close();
-  } else {
-    m.null("ssm");
-  }
+  put_ssm(m, result.ssm);
   m.number_or_null("distance_uncertainty_m", std::isfinite(result.distance_uncertainty_m),
                    result.distance_uncertainty_m);
   m.number_or_null("robot_speed_towards_mps", std::isfinite(result.robot_speed_towards_mps),
@@ -313,16 +294,7 @@ void JsonLinesSink::frame(const FrameResult& result) {
   m.number_or_null("robot_speed_fraction", std::isfinite(result.robot_speed_fraction), result.robot_speed_fraction);
   m.number_or_null("unknown_distance_m", std::isfinite(result.unknown_distance_m), result.unknown_distance_m);
   put_links(m, result);
-  m.point_or_null("closest_camera", contact.valid, contact.closest_camera);
-  m.point_or_null("closest_base", contact.valid, contact.closest_base);
-  m.point_or_null("closest_robot_base", contact.valid, contact.closest_robot_base);
-  if (contact.valid) {
-    m.integer("robot_link", contact.robot_link);
-    m.boolean("inside", contact.inside);  // a foreground point inside (or on) a capsule: distance 0
-  } else {
-    m.null("robot_link");
-    m.null("inside");
-  }
+  put_contact(m, contact);
   // The backend that searched (auto's pick), else the configured one.
   m.text("backend", result.backend != nullptr ? result.backend : backend_.c_str());
   m.integer("foreground_points", static_cast<int64_t>(result.foreground_points));
@@ -331,93 +303,17 @@ void JsonLinesSink::frame(const FrameResult& result) {
   m.number("valid_share", result.valid_share);
   m.integer("host_time_ns", result.host_time_ns);
   m.number("frame_age_s", result.frame_age_s);  // when the monitor decided it: what T_r counted
-  // The joints the robot's capsules were built from; null without a valid robot state.
-  put_key(line_, "joints_rad");
-  if (result.robot_state.valid) {
-    line_ += '[';
-    for (size_t j = 0; j < kJointCount; ++j) {
-      if (j > 0) line_ += ',';
-      put_double(line_, result.robot_state.q_rad[j]);
-    }
-    line_ += ']';
-  } else {
-    line_ += "null";
-  }
+  put_joints(m, result.robot_state);
   m.number("robot_state_age_ms", result.robot_state_age_ms);
-  // The controller's own report (rtde): present where the source has one, null in frames
-  // without a valid state from such a source, absent for sources that have none.
-  const RobotStatus& status = result.robot_state.status;
-  if (status.known) {
-    m.open("robot_status");
-    m.integer("robot_mode", status.robot_mode);
-    m.text("robot_mode_name", robot_mode_name(status.robot_mode));
-    m.integer("safety_mode", status.safety_mode);
-    m.text("safety_mode_name", safety_mode_name(status.safety_mode));
-    m.number("speed_scaling", status.speed_scaling);
-    m.number_or_null("target_speed_fraction", std::isfinite(status.target_speed_fraction),
-                     status.target_speed_fraction);
-    m.boolean("tcp_pose_mismatch", status.tcp_pose_mismatch);
-    m.close();
-  } else if (robot_status_announced_) {
-    m.null("robot_status");
-  }
+  put_robot_status(m, result.robot_state.status, robot_status_announced_);
   m.number("latency_us", result.latency_us);
   m.open("timings_us");
   for (const StageTiming& timing : result.timings) m.number(timing.stage, timing.us);
   m.close();
-  if (result.truth) {
-    m.open("truth");
-    m.number_or_null("distance_m", result.truth->valid, result.truth->distance_m);
-    m.point_or_null("closest_base", result.truth->valid, result.truth->closest_base);
-    if (result.truth_contact_label != nullptr) {
-      m.text("contact_label", result.truth_contact_label);
-    } else {
-      m.null("contact_label");
-    }
-    put_key(line_, "links");
-    line_ += '[';
-    for (const LinkTruth& link : result.truth_links) {
-      if (line_.back() != '[') line_ += ',';
-      line_ += '{';
-      m.integer("link", link.link);
-      m.number("distance_m", link.distance_m);
-      m.number("speed_towards_mps", link.speed_towards_mps);
-      line_ += '}';
-    }
-    line_ += ']';
-    m.close();
-  }
+  put_truth(m, result);
   line_ += "}\n";
   write_line();
 }
-
-namespace {
-
-/// `record`: the recorder's counters, null when the run recorded nothing.
-void put_record_counters(Members& m, const std::optional<RecordCounters>& record) {
-  if (!record) {
-    m.null("record");
-    return;
-  }
-  m.open("record");
-  m.integer("frames_recorded", record->frames_recorded);
-  m.integer("frames_dropped", record->frames_dropped);
-  put_key(m.line, "files");
-  m.line += '[';
-  for (size_t i = 0; i < record->files.size(); ++i) {
-    if (i > 0) m.line += ',';
-    put_string(m.line, record->files[i]);
-  }
-  m.line += ']';
-  if (record->error.empty()) {
-    m.null("error");
-  } else {
-    m.text("error", record->error);
-  }
-  m.close();
-}
-
-}  // namespace
 
 void JsonLinesSink::summary(const RunSummary& summary) {
   line_.assign("{");
@@ -444,11 +340,7 @@ void JsonLinesSink::summary(const RunSummary& summary) {
   m.number_or_null("min_distance_m", summary.min_distance_m >= 0.0F, summary.min_distance_m);
   m.text("end_reason", summary.end_reason);
   m.text("end_reason_code", reason_code_name(summary.end_code));
-  if (summary.error.empty()) {
-    m.null("error");
-  } else {
-    m.text("error", summary.error);
-  }
+  m.text_or_null("error", summary.error);
   m.integer("timestamps_backwards", summary.timestamps.backwards);
   m.integer("timestamps_repeated", summary.timestamps.repeated);
   m.integer("timestamp_gaps", summary.timestamps.gaps);
@@ -456,28 +348,7 @@ void JsonLinesSink::summary(const RunSummary& summary) {
   m.integer("timestamp_jumps", summary.timestamps.jumps);
   m.number_or_null("unknown_background_share", summary.unknown_background_share >= 0.0,
                    summary.unknown_background_share);
-  const RobotStateStats& robot = summary.robot_state;
-  m.open("robot_state");
-  m.integer("accepted", robot.samples.accepted);
-  m.integer("rejected_non_finite", robot.samples.rejected_non_finite);
-  m.integer("rejected_backwards", robot.samples.rejected_backwards);
-  m.integer("rejected_jump", robot.samples.rejected_jump);
-  m.integer("rejected_limits", robot.samples.rejected_limits);
-  m.integer("connections", robot.connections);
-  m.integer("disconnects", robot.disconnects);
-  m.integer("malformed", robot.malformed);
-  const RobotStatusCounts& status = summary.robot_status;
-  m.integer("frames_with_status", status.frames_reported);
-  m.integer("frames_not_running", status.frames_not_running);
-  m.integer("frames_protective_stop", status.frames_protective_stop);
-  m.integer("mode_changes", status.mode_changes);
-  m.integer("frames_tcp_pose_mismatch", status.frames_tcp_pose_mismatch);
-  if (robot.last_problem.empty()) {
-    m.null("last_problem");
-  } else {
-    m.text("last_problem", robot.last_problem);
-  }
-  m.close();
+  put_robot_state_counters(m, summary.robot_state, summary.robot_status);
   put_record_counters(m, summary.record);
   line_ += "}\n";
   write_line();
