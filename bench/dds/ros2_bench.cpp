@@ -4,6 +4,7 @@
 // its CameraInfo) to the Frame out of Ros2CameraSource::next(), p50 and p99, at the D435's
 // top rate of 90 frames/s, and the rate it keeps up with unpaced. Needs CYCLONEDDS_URI set to
 // tests/dds/cyclonedds-loopback.xml (docs/BENCHMARKS.md has the command).
+#include "../common/percentile.hpp"
 #include "dds/ros2_camera_source.hpp"
 #include "dds/ros2_publisher.hpp"
 
@@ -43,11 +44,7 @@ Frame walk_frame() {
   return frame;
 }
 
-double percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  return values[static_cast<size_t>(q * static_cast<double>(values.size() - 1))];
-}
+using bench::percentile;
 
 // What the publisher process and the benchmark share (an anonymous shared mapping made
 // before fork): the steady_clock send times (CLOCK_MONOTONIC is one clock for the whole

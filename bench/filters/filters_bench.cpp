@@ -22,7 +22,7 @@
 namespace hrcsense {
 namespace {
 
-constexpr int kFrames = 4;  // consecutive frames, cycled, so the temporal filter sees a sequence
+constexpr int kSequenceFrames = 4;  // consecutive frames, cycled, so the temporal filter sees a sequence
 
 Shape capsule(Eigen::Vector3f a, Eigen::Vector3f b, float radius_m) {
   Shape s;
@@ -98,9 +98,9 @@ const Inputs& inputs(int width, int height) {
   Inputs& in = cache[{width, height}];
   if (in.frames.empty()) {
     const Simulator sim = walk_simulator(width, height);
-    in.frames.resize(kFrames);
-    in.disparities.resize(kFrames);
-    for (int i = 0; i < kFrames; ++i) {
+    in.frames.resize(kSequenceFrames);
+    in.disparities.resize(kSequenceFrames);
+    for (int i = 0; i < kSequenceFrames; ++i) {
       Frame& frame = in.frames[static_cast<size_t>(i)];
       sim.render(15 + i, frame);
       frame.truth.reset();
@@ -125,7 +125,7 @@ void bm_threshold(benchmark::State& state, int w, int h) {
   DepthImage work = in.frames[0].depth;
   size_t i = 0;
   for (auto _ : state) {
-    fresh_copy(state, in.frames[i++ % kFrames].depth, work);
+    fresh_copy(state, in.frames[i++ % kSequenceFrames].depth, work);
     apply_threshold(ThresholdParams{}, work);
     benchmark::DoNotOptimize(work.pixels.data());
   }
@@ -137,7 +137,7 @@ void bm_decimation(benchmark::State& state, int w, int h) {
   Intrinsics out_intrinsics;
   size_t i = 0;
   for (auto _ : state) {
-    const Frame& frame = in.frames[i++ % kFrames];
+    const Frame& frame = in.frames[i++ % kSequenceFrames];
     decimate(DecimationParams{2}, frame.depth, frame.intrinsics, out, out_intrinsics);
     benchmark::DoNotOptimize(out.pixels.data());
   }
@@ -148,7 +148,7 @@ void bm_to_disparity(benchmark::State& state, int w, int h) {
   DisparityImage out;
   size_t i = 0;
   for (auto _ : state) {
-    depth_to_disparity(in.frames[i++ % kFrames].depth, in.factor, out);
+    depth_to_disparity(in.frames[i++ % kSequenceFrames].depth, in.factor, out);
     benchmark::DoNotOptimize(out.pixels.data());
   }
 }
@@ -158,7 +158,7 @@ void bm_to_depth(benchmark::State& state, int w, int h) {
   DepthImage out;
   size_t i = 0;
   for (auto _ : state) {
-    disparity_to_depth(in.disparities[i++ % kFrames], in.factor, out);
+    disparity_to_depth(in.disparities[i++ % kSequenceFrames], in.factor, out);
     benchmark::DoNotOptimize(out.pixels.data());
   }
 }
@@ -170,7 +170,7 @@ void bm_spatial_disparity(benchmark::State& state, int w, int h) {
   SpatialScratch scratch;
   size_t i = 0;
   for (auto _ : state) {
-    fresh_copy(state, in.disparities[i++ % kFrames], work);
+    fresh_copy(state, in.disparities[i++ % kSequenceFrames], work);
     spatial_filter(SpatialParams{}, work, scratch);
     benchmark::DoNotOptimize(work.pixels.data());
   }
@@ -182,7 +182,7 @@ void bm_spatial_depth(benchmark::State& state, int w, int h) {
   SpatialScratch scratch;
   size_t i = 0;
   for (auto _ : state) {
-    fresh_copy(state, in.frames[i++ % kFrames].depth, work);
+    fresh_copy(state, in.frames[i++ % kSequenceFrames].depth, work);
     spatial_filter(SpatialParams{}, work, scratch);
     benchmark::DoNotOptimize(work.pixels.data());
   }
@@ -194,7 +194,7 @@ void bm_temporal_disparity(benchmark::State& state, int w, int h) {
   DisparityImage work;
   size_t i = 0;
   for (auto _ : state) {
-    fresh_copy(state, in.disparities[i++ % kFrames], work);
+    fresh_copy(state, in.disparities[i++ % kSequenceFrames], work);
     filter.apply(work);
     benchmark::DoNotOptimize(work.pixels.data());
   }
@@ -206,7 +206,7 @@ void bm_temporal_depth(benchmark::State& state, int w, int h) {
   DepthImage work = in.frames[0].depth;
   size_t i = 0;
   for (auto _ : state) {
-    fresh_copy(state, in.frames[i++ % kFrames].depth, work);
+    fresh_copy(state, in.frames[i++ % kSequenceFrames].depth, work);
     filter.apply(work);
     benchmark::DoNotOptimize(work.pixels.data());
   }
@@ -217,7 +217,7 @@ void bm_hole_filling(benchmark::State& state, int w, int h, int mode) {
   DepthImage work = in.frames[0].depth;
   size_t i = 0;
   for (auto _ : state) {
-    fresh_copy(state, in.frames[i++ % kFrames].depth, work);
+    fresh_copy(state, in.frames[i++ % kSequenceFrames].depth, work);
     fill_holes(HoleFillingParams{mode}, work);
     benchmark::DoNotOptimize(work.pixels.data());
   }
@@ -231,7 +231,7 @@ void bm_chain(benchmark::State& state, int w, int h, const char* preset) {
   Frame out;
   size_t i = 0;
   for (auto _ : state) {
-    chain.process(in.frames[i++ % kFrames], out);
+    chain.process(in.frames[i++ % kSequenceFrames], out);
     benchmark::DoNotOptimize(out.depth.pixels.data());
   }
 }
@@ -263,7 +263,7 @@ void bm_chain_no_decimation(benchmark::State& state, int w, int h) {
   Frame out;
   size_t i = 0;
   for (auto _ : state) {
-    chain.process(in.frames[i++ % kFrames], out);
+    chain.process(in.frames[i++ % kSequenceFrames], out);
     benchmark::DoNotOptimize(out.depth.pixels.data());
   }
 }
@@ -273,7 +273,7 @@ void bm_reference_spatial_disparity(benchmark::State& state, int w, int h) {
   DisparityImage work;
   size_t i = 0;
   for (auto _ : state) {
-    fresh_copy(state, in.disparities[i++ % kFrames], work);
+    fresh_copy(state, in.disparities[i++ % kSequenceFrames], work);
     reference::spatial_disparity(SpatialParams{}, work);
     benchmark::DoNotOptimize(work.pixels.data());
   }
@@ -285,7 +285,7 @@ void bm_reference_temporal_disparity(benchmark::State& state, int w, int h) {
   DisparityImage work;
   size_t i = 0;
   for (auto _ : state) {
-    fresh_copy(state, in.disparities[i++ % kFrames], work);
+    fresh_copy(state, in.disparities[i++ % kSequenceFrames], work);
     filter.apply(work.pixels);
     benchmark::DoNotOptimize(work.pixels.data());
   }
@@ -297,7 +297,7 @@ void bm_reference_spatial_depth(benchmark::State& state, int w, int h) {
   DepthImage work = in.frames[0].depth;
   size_t i = 0;
   for (auto _ : state) {
-    fresh_copy(state, in.frames[i++ % kFrames].depth, work);
+    fresh_copy(state, in.frames[i++ % kSequenceFrames].depth, work);
     reference::spatial_depth(SpatialParams{}, work);
     benchmark::DoNotOptimize(work.pixels.data());
   }
@@ -309,7 +309,7 @@ void bm_reference_temporal_depth(benchmark::State& state, int w, int h) {
   DepthImage work = in.frames[0].depth;
   size_t i = 0;
   for (auto _ : state) {
-    fresh_copy(state, in.frames[i++ % kFrames].depth, work);
+    fresh_copy(state, in.frames[i++ % kSequenceFrames].depth, work);
     filter.apply(work.pixels);
     benchmark::DoNotOptimize(work.pixels.data());
   }

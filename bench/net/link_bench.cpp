@@ -7,6 +7,7 @@
 //   sends the frame's JSON line.
 // - Link/heartbeat_period: heartbeats at the default 20 Hz with no frames; the intervals
 //   between their arrivals against the nominal 50 ms (jitter p50, p99, max) and their mean.
+#include "../common/percentile.hpp"
 #include "hrcsense/link.hpp"
 
 #include "hrcsense/clock.hpp"
@@ -31,12 +32,7 @@
 namespace hrcsense {
 namespace {
 
-double percentile(std::vector<double> values, double p) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const auto index = static_cast<size_t>(std::llround(p * static_cast<double>(values.size() - 1)));
-  return values[index];
-}
+using bench::percentile;
 
 // A socket on 127.0.0.1 (ephemeral port) and a thread that stamps each datagram's arrival on
 // the steady clock, until `expected` arrived or 200 ms passed without one.

@@ -21,16 +21,16 @@
 namespace hrcsense {
 namespace {
 
-constexpr int kDistinctFrames = 30;
+constexpr int kDistinctRecordFrames = 30;
 constexpr int kFramesPerFile = 300;
 
 const std::vector<Frame>& cell_frames() {
   static const std::vector<Frame> frames = [] {
     const Config config = load_config(std::string(HRCSENSE_BENCH_SOURCE_DIR) + "/config/cell-ur5.yaml", {});
     const Simulator sim = make_simulator(config);
-    std::vector<Frame> out(kDistinctFrames);
+    std::vector<Frame> out(kDistinctRecordFrames);
     // Frames 150..: the person is in view, so the images are not just the empty cell.
-    for (int i = 0; i < kDistinctFrames; ++i) sim.render(150 + i, out[static_cast<size_t>(i)]);
+    for (int i = 0; i < kDistinctRecordFrames; ++i) sim.render(150 + i, out[static_cast<size_t>(i)]);
     return out;
   }();
   return frames;
@@ -53,7 +53,7 @@ void record(benchmark::State& state, BagCompression compression) {
       }
       writer = std::make_unique<BagWriter>(path, params);
     }
-    Frame& frame = frames[static_cast<size_t>(written % kDistinctFrames)];
+    Frame& frame = frames[static_cast<size_t>(written % kDistinctRecordFrames)];
     frame.index = written;
     frame.timestamp_ns = written * 33'333'333LL;
     writer->add_frame(frame);

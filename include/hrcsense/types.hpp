@@ -15,6 +15,9 @@
 
 namespace hrcsense {
 
+/// π, for angles in degrees and for disc areas.
+inline constexpr double kPi = 3.14159265358979323846;
+
 /// Lens distortion models with the RealSense SDK's numeric values (rs2_distortion).
 enum class Distortion : int {
   none = 0,

@@ -17,7 +17,6 @@ namespace {
 using config_detail::Bound;
 using config_detail::KeyReader;
 
-constexpr double kPi = 3.14159265358979323846;
 using config_detail::kMaxCoordinateM;
 /// Simulated frames: a year at 30 frames/s; with sim.fps >= 1 every timestamp (index · 1e9 /
 /// fps ns) stays below 1e18, inside int64.

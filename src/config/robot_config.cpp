@@ -16,8 +16,6 @@ namespace hrcsense {
 namespace config_detail {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // Degrees in the file, radians inside; (deg / 180) · π keeps ±90° and ±360° exact.
 double rad_from_deg(double deg) { return (deg / 180.0) * kPi; }
 double deg_from_rad(double rad) { return (rad / kPi) * 180.0; }
@@ -277,7 +275,6 @@ void check_capsules(const KeyReader& r, const RobotModel& robot) {
     }
   }
 }
-
 
 }  // namespace
 

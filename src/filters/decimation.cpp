@@ -2,6 +2,7 @@
 // hrcsense filters — decimation (spec §4): lower median of the non-zero pixels of each block
 // for magnitudes 2–3, their truncated integer mean otherwise; output padded to multiples of 4.
 #include "hrcsense/filters.hpp"
+#include "isa.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -28,9 +29,8 @@ uint16_t lower_median(uint16_t* values, int n) {
 }
 
 #if defined(__SSE2__)
-// Unsigned 16-bit min and max from SSE2's saturating subtraction.
-inline __m128i min_u16(__m128i a, __m128i b) { return _mm_sub_epi16(a, _mm_subs_epu16(a, b)); }
-inline __m128i max_u16(__m128i a, __m128i b) { return _mm_add_epi16(b, _mm_subs_epu16(a, b)); }
+using filters_detail::max_u16;
+using filters_detail::min_u16;
 
 // Even and odd uint16 of 16 consecutive values, each as 8 lanes (the low or high halves of the
 // 32-bit lanes, sign-extended so that the signed saturating pack passes them on).

@@ -54,12 +54,10 @@ void fill_from_around(T* pixels, int w, int h, bool farthest) {
 }
 
 #if defined(__SSE2__)
-inline __m128i load8(const uint16_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
-inline __m128i select(__m128i mask, __m128i a, __m128i b) {
-  return _mm_or_si128(_mm_and_si128(mask, a), _mm_andnot_si128(mask, b));
-}
-inline __m128i min_u16(__m128i a, __m128i b) { return _mm_sub_epi16(a, _mm_subs_epu16(a, b)); }
-inline __m128i max_u16(__m128i a, __m128i b) { return _mm_add_epi16(b, _mm_subs_epu16(a, b)); }
+inline __m128i load_u16x8(const uint16_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
+using filters_detail::select;
+using filters_detail::max_u16;
+using filters_detail::min_u16;
 
 // Mode 0, 8 pixels at a time: each hole takes the nearest non-hole to its left, found in three
 // doubling steps (1, 2, 4 lanes); lanes shifted in from before the block, and holes with no
@@ -71,7 +69,7 @@ void fill_from_left(uint16_t* pixels, int w, int h) {
     uint16_t* row = pixels + static_cast<size_t>(v) * w;
     int u = 1;
     for (; u + 8 <= w; u += 8) {
-      __m128i x = load8(row + u);
+      __m128i x = load_u16x8(row + u);
       if (_mm_movemask_epi8(_mm_cmpeq_epi16(x, zero)) == 0) continue;
       const __m128i carry = _mm_set1_epi16(static_cast<int16_t>(row[u - 1]));
       x = select(_mm_cmpeq_epi16(x, zero), _mm_or_si128(_mm_slli_si128(x, 2), _mm_srli_si128(carry, 14)), x);
@@ -100,12 +98,12 @@ void fill_from_around(uint16_t* pixels, int w, int h, bool farthest) {
     const uint16_t* down = row + w;
     int u = 1;
     for (; u + 8 <= w; u += 8) {
-      const __m128i current = load8(row + u);
+      const __m128i current = load_u16x8(row + u);
       const __m128i hole = _mm_cmpeq_epi16(current, zero);
       const int holes = _mm_movemask_epi8(hole);
       if (holes == 0) continue;
-      const __m128i above = load8(up + u);
-      const __m128i n0 = load8(up + u - 1), n1 = load8(row + u - 1), n2 = load8(down + u - 1), n3 = load8(down + u);
+      const __m128i above = load_u16x8(up + u);
+      const __m128i n0 = load_u16x8(up + u - 1), n1 = load_u16x8(row + u - 1), n2 = load_u16x8(down + u - 1), n3 = load_u16x8(down + u);
       __m128i candidate;
       if (farthest) {
         candidate = max_u16(max_u16(max_u16(above, n0), max_u16(n1, n2)), n3);

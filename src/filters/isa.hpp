@@ -19,4 +19,14 @@ namespace hrcsense::filters_detail {
 /// portable path. Always false on other architectures.
 bool use_avx2();
 
+#if HRCSENSE_FILTERS_X86
+// Unsigned 16-bit min and max from SSE2's saturating subtraction (one instruction only from SSE4.1).
+inline __m128i min_u16(__m128i a, __m128i b) { return _mm_sub_epi16(a, _mm_subs_epu16(a, b)); }
+inline __m128i max_u16(__m128i a, __m128i b) { return _mm_add_epi16(b, _mm_subs_epu16(a, b)); }
+// Per bit: a where mask is set, b elsewhere.
+inline __m128i select(__m128i mask, __m128i a, __m128i b) {
+  return _mm_or_si128(_mm_and_si128(mask, a), _mm_andnot_si128(mask, b));
+}
+#endif
+
 }  // namespace hrcsense::filters_detail

@@ -49,9 +49,7 @@ inline __m128i blend8(__m128i current, __m128i neighbour, __m128 alpha, __m128 o
   return _mm_xor_si128(_mm_packs_epi32(low, high), _mm_set1_epi16(static_cast<int16_t>(0x8000)));
 }
 
-inline __m128i select(__m128i mask, __m128i a, __m128i b) {
-  return _mm_or_si128(_mm_and_si128(mask, a), _mm_andnot_si128(mask, b));
-}
+using filters_detail::select;
 
 inline __m128i abs_difference(__m128i a, __m128i b) {
   return _mm_or_si128(_mm_subs_epu16(a, b), _mm_subs_epu16(b, a));

@@ -81,9 +81,7 @@ inline __m128i persistence_allows(__m128i history, const PersistenceRule& rule) 
   }
 }
 
-inline __m128i select(__m128i mask, __m128i a, __m128i b) {
-  return _mm_or_si128(_mm_and_si128(mask, a), _mm_andnot_si128(mask, b));
-}
+using filters_detail::select;
 
 // Four pixels as 32-bit lanes: float bits, or uint16 widened.
 inline __m128i load4(const float* p) { return _mm_castps_si128(_mm_loadu_ps(p)); }

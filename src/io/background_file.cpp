@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "hrcsense/io.hpp"
+#include "io_fail.hpp"
 
 namespace hrcsense {
 namespace {
@@ -32,9 +33,7 @@ constexpr size_t kChecksumBytes = 4;
 /// even before it is compared with the file length.
 constexpr uint32_t kMaxSidePx = 16384;
 
-[[noreturn]] void fail(const std::string& path, const std::string& problem) {
-  throw IoError(path + ": " + problem);
-}
+using io_detail::fail;
 
 std::array<uint32_t, 256> make_crc_table() {
   std::array<uint32_t, 256> table{};

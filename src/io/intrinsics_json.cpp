@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "hrcsense/camera.hpp"
+#include "io_fail.hpp"
 #include "hrcsense/io.hpp"
 
 namespace hrcsense {
@@ -46,9 +47,7 @@ std::string number_text(double value) {
   return text;
 }
 
-[[noreturn]] void fail(const std::string& what, const std::string& problem) {
-  throw IoError(what + ": " + problem);
-}
+using io_detail::fail;
 
 const Json& field(const Json& root, const char* name, const std::string& what) {
   const auto it = root.find(name);

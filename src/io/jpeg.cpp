@@ -2,6 +2,7 @@
 // hrcsense — JPEG colour images in and out with libturbojpeg (optional: without it, every call
 // is an IoError naming the file, and folders with JPEG colour still play their depth).
 #include "hrcsense/io.hpp"
+#include "io_fail.hpp"
 
 #include <cstdio>
 #include <memory>
@@ -31,7 +32,7 @@ struct FileCloser {
   void operator()(std::FILE* file) const { std::fclose(file); }
 };
 
-[[noreturn]] void fail(const std::string& path, const std::string& problem) { throw IoError(path + ": " + problem); }
+using io_detail::fail;
 
 std::vector<unsigned char> read_file(const std::string& path) {
   std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "hrcsense/io.hpp"
+#include "io_fail.hpp"
 
 namespace hrcsense {
 namespace {
@@ -23,7 +24,7 @@ namespace {
 
 /// Largest image side we accept: far above any depth camera, small enough that a corrupt or
 /// hostile header cannot make us allocate gigabytes.
-constexpr png_uint_32 kMaxSidePx = 16384;
+constexpr png_uint_32 kMaxPngSidePx = 16384;
 
 struct PngErrorState {
   char message[256] = {};
@@ -51,10 +52,10 @@ std::string describe(const PngErrorState& state) {
   return text;
 }
 
-struct FileCloser {
+struct PngFileCloser {
   void operator()(std::FILE* file) const { std::fclose(file); }
 };
-using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
+using FilePtr = std::unique_ptr<std::FILE, PngFileCloser>;
 
 struct PngReadStructs {
   png_structp png = nullptr;
@@ -77,9 +78,7 @@ struct PngHeader {
 
 constexpr bool kLittleEndianHost = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
 
-[[noreturn]] void fail(const std::string& path, const std::string& problem) {
-  throw IoError(path + ": " + problem);
-}
+using io_detail::fail;
 
 const char* color_type_name(int color_type) {
   switch (color_type) {
@@ -104,7 +103,7 @@ bool read_png_header(png_structp png, png_infop info, std::FILE* file, PngHeader
   }
   png_init_io(png, file);
   png_set_sig_bytes(png, 8);
-  png_set_user_limits(png, kMaxSidePx, kMaxSidePx);
+  png_set_user_limits(png, kMaxPngSidePx, kMaxPngSidePx);
   png_read_info(png, info);
   int interlace = 0;
   png_get_IHDR(png, info, &header->width, &header->height, &header->bit_depth, &header->color_type,
@@ -164,8 +163,8 @@ bool write_png_rows(png_structp png, png_infop info, std::FILE* file, const Writ
 }
 
 void check_write_size(const std::string& path, int width, int height, size_t samples, size_t samples_per_px) {
-  if (width <= 0 || height <= 0 || static_cast<png_uint_32>(width) > kMaxSidePx ||
-      static_cast<png_uint_32>(height) > kMaxSidePx) {
+  if (width <= 0 || height <= 0 || static_cast<png_uint_32>(width) > kMaxPngSidePx ||
+      static_cast<png_uint_32>(height) > kMaxPngSidePx) {
     fail(path, "cannot write an image of size " + std::to_string(width) + "x" + std::to_string(height));
   }
   const size_t expected = static_cast<size_t>(width) * static_cast<size_t>(height) * samples_per_px;
@@ -264,7 +263,7 @@ void read_depth_png(const std::string& path, DepthImage& out, int expected_width
     fail(path, "image is " + std::to_string(header.width) + "x" + std::to_string(header.height) + ", expected " +
                    std::to_string(expected_width) + "x" + std::to_string(expected_height) + " (wrong size)");
   }
-  // Sizes are bounded by kMaxSidePx through png_set_user_limits, so this cannot overflow.
+  // Sizes are bounded by kMaxPngSidePx through png_set_user_limits, so this cannot overflow.
   out.resize(static_cast<int>(header.width), static_cast<int>(header.height));
   if (!read_png_rows16(reader.structs.png, reader.structs.info, out.pixels.data(), header.width, header.height)) {
     fail(path, "damaged or truncated PNG data: " + describe(reader.error));

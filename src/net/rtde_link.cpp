@@ -20,7 +20,7 @@ namespace hrcsense {
 namespace {
 
 constexpr int kSliceMs = 20;  // every wait of the writer looks at the stop request this often
-constexpr size_t kReceiveChunk = 4096;
+constexpr size_t kLinkReceiveChunk = 4096;
 
 const char* mode_name(RtdeLinkParams::Mode mode) {
   return mode == RtdeLinkParams::Mode::speed_slider ? "speed_slider" : "register";
@@ -34,7 +34,7 @@ std::chrono::nanoseconds seconds(double s) { return std::chrono::nanoseconds(std
 struct RtdeLinkSink::Connection {
   int fd = -1;
   uint8_t recipe_id = 0;
-  std::vector<uint8_t> buffer = std::vector<uint8_t>(2 * kReceiveChunk);
+  std::vector<uint8_t> buffer = std::vector<uint8_t>(2 * kLinkReceiveChunk);
   size_t begin = 0, end = 0;
   std::string error;       // why the connection ended
   bool malformed = false;  // ...because the controller sent something unparseable
@@ -75,7 +75,7 @@ struct RtdeLinkSink::Connection {
       end -= begin;
       begin = 0;
     }
-    if (buffer.size() - end < kReceiveChunk) buffer.resize(end + 2 * kReceiveChunk);  // a package is < 64 KiB
+    if (buffer.size() - end < kLinkReceiveChunk) buffer.resize(end + 2 * kLinkReceiveChunk);  // a package is < 64 KiB
     pollfd p{fd, POLLIN, 0};
     const int rc = ::poll(&p, 1, wait_ms);
     if (rc <= 0) return 0;

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 namespace hrcsense::proximity_detail {
 
@@ -153,6 +154,13 @@ inline float lower_bound_m(const CapsuleBound& c, const Box& box) {
   const float by_centre = std::sqrt(axis_distance_sq(c.segment, centre[0], centre[1], centre[2])) -
                           std::sqrt(half_diag2);
   return std::max(std::sqrt(gap2), by_centre) - c.segment.radius_m;
+}
+
+// The smallest of lower_bound_m over every capsule: no point in `box` is nearer to the arm.
+inline float min_lower_bound_m(const std::vector<CapsuleBound>& capsules, const Box& box) {
+  float lb = kInf;
+  for (const CapsuleBound& c : capsules) lb = std::min(lb, lower_bound_m(c, box));
+  return lb;
 }
 
 // How far a float lower bound may lie above the float distance it bounds: rounding in the

@@ -11,7 +11,7 @@
 #include <utility>
 
 namespace hrcsense::proximity_detail {
-namespace {
+// Not in an anonymous namespace: KdTree::Impl holds these types as members.
 
 // nanoflann's dataset interface on the SoA cloud: it reads the caller's arrays in place.
 struct CloudAdaptor {
@@ -71,15 +71,7 @@ struct Entry {
   Box box;
 };
 
-bool heap_order(const Entry& a, const Entry& b) { return a.lower_bound_m > b.lower_bound_m; }
-
-float min_lower_bound_m(const std::vector<CapsuleBound>& capsules, const Box& box) {
-  float lb = kInf;
-  for (const CapsuleBound& c : capsules) lb = std::min(lb, lower_bound_m(c, box));
-  return lb;
-}
-
-}  // namespace
+bool entry_heap_order(const Entry& a, const Entry& b) { return a.lower_bound_m > b.lower_bound_m; }
 
 struct KdTree::Impl {
   CloudAdaptor cloud;
@@ -113,7 +105,7 @@ struct KdTree::Impl {
     queue.clear();
     queue.push_back({min_lower_bound_m(capsules, root), tree.root_node, root});
     while (!queue.empty()) {
-      std::pop_heap(queue.begin(), queue.end(), heap_order);
+      std::pop_heap(queue.begin(), queue.end(), entry_heap_order);
       const Entry entry = queue.back();
       queue.pop_back();
       if (prunable(entry.lower_bound_m, best.distance_m, max_radius_m)) break;  // the rest lie farther
@@ -132,7 +124,7 @@ struct KdTree::Impl {
         const float lb = min_lower_bound_m(capsules, box);
         if (prunable(lb, best.distance_m, max_radius_m)) continue;
         queue.push_back({lb, child, box});
-        std::push_heap(queue.begin(), queue.end(), heap_order);
+        std::push_heap(queue.begin(), queue.end(), entry_heap_order);
       }
     }
     return best;

@@ -95,12 +95,6 @@ CellGrid make_grid(const Box& box, int height) {
   return g;
 }
 
-float min_lower_bound_m(const std::vector<CapsuleBound>& capsules, const Box& box) {
-  float lb = kInf;
-  for (const CapsuleBound& c : capsules) lb = std::min(lb, lower_bound_m(c, box));
-  return lb;
-}
-
 // Min-heap on the lower bound (std heaps are max-heaps).
 bool heap_order(const Octree::Entry& a, const Octree::Entry& b) { return a.lower_bound_m > b.lower_bound_m; }
 

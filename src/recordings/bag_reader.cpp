@@ -26,8 +26,11 @@ uint32_t le32(const uint8_t* p) {
 }
 uint64_t le64(const uint8_t* p) { return static_cast<uint64_t>(le32(p)) | static_cast<uint64_t>(le32(p + 4)) << 32; }
 
-/// The fields of a record header (or of a connection record's data) that hrcsense uses.
-struct Fields {
+}  // namespace
+
+/// The fields of a record header (or of a connection record's data) that hrcsense uses. Not in
+/// the anonymous namespace: BagReader::Record holds one.
+struct BagHeaderFields {
   int op = -1;
   uint32_t conn = 0, count = 0, size = 0, conn_count = 0, chunk_count = 0;
   uint64_t index_pos = 0, chunk_pos = 0;
@@ -36,8 +39,10 @@ struct Fields {
   bool has_conn = false;
 };
 
+namespace {
+
 /// Parses `name=value` fields, each prefixed by its uint32 length; "" or what is wrong.
-std::string parse_fields(const uint8_t* p, size_t n, Fields& f) {
+std::string parse_fields(const uint8_t* p, size_t n, BagHeaderFields& f) {
   size_t pos = 0;
   while (pos < n) {
     if (n - pos < 4) return "header field length cut off";
@@ -88,7 +93,7 @@ std::string parse_fields(const uint8_t* p, size_t n, Fields& f) {
 
 /// A record's header, parsed, and where its data lies in the file.
 struct BagReader::Record {
-  Fields fields;
+  BagHeaderFields fields;
   uint64_t data_offset = 0;
   uint32_t data_len = 0;
   uint64_t end = 0;  ///< offset of the next record
@@ -116,7 +121,7 @@ BagReader::BagReader(std::string path, BagLimits limits) : path_(std::move(path)
   }
   data_start_ = header.end;
   scan_pos_ = data_start_;
-  const Fields& f = header.fields;
+  const BagHeaderFields& f = header.fields;
   if (f.index_pos == 0) {
     index_problem_ = "no index (the recording was not closed)";
   } else if (f.index_pos < data_start_ || f.index_pos >= file_size_) {
@@ -160,7 +165,7 @@ bool BagReader::read_record(uint64_t offset, Record& record, bool whole_data) {
   if (std::fread(header_.data(), 1, header_len, file_.get()) != header_len || std::fread(len, 1, 4, file_.get()) != 4) {
     fail(offset, "cannot read the record header");
   }
-  record.fields = Fields{};
+  record.fields = BagHeaderFields{};
   const std::string problem = parse_fields(header_.data(), header_len, record.fields);
   if (!problem.empty()) fail(offset, problem);
   record.data_len = le32(len);
@@ -193,7 +198,7 @@ void BagReader::read_index(uint64_t index_pos, uint32_t conn_count, uint32_t chu
   for (uint32_t i = 0; i < conn_count; ++i) {
     if (!read_record(pos, record, true) || record.fields.op != kOpConnection) fail(pos, "expected a connection record");
     add_connection(record, pos);
-    Fields data;
+    BagHeaderFields data;
     const std::string problem = parse_fields(packed_.data(), packed_.size(), data);
     if (!problem.empty()) fail(pos, "connection data: " + problem);
     connections_[record.fields.conn].type = std::string(data.type);
@@ -218,7 +223,7 @@ void BagReader::read_index(uint64_t index_pos, uint32_t conn_count, uint32_t chu
 }
 
 void BagReader::load_chunk(uint64_t offset, const Record& record) {
-  const Fields& f = record.fields;
+  const BagHeaderFields& f = record.fields;
   const std::string_view compression = f.compression;
   if (compression != "none" && compression != "lz4" && compression != "bz2") {
     fail(offset, "unknown chunk compression '" + std::string(compression) + "'");
@@ -280,14 +285,14 @@ bool BagReader::next(BagMessage& out) {
         fail(chunk_offset_, "record at byte " + std::to_string(at) + " of the decompressed chunk runs past its end");
       }
       const uint32_t data_len = le32(&chunk_[at + 4 + header_len]);
-      record.fields = Fields{};
+      record.fields = BagHeaderFields{};
       const std::string problem = parse_fields(&chunk_[at + 4], header_len, record.fields);
       if (!problem.empty()) fail(chunk_offset_, "in chunk at byte " + std::to_string(at) + ": " + problem);
       const uint8_t* data = &chunk_[at + 8 + header_len];
       chunk_pos_ = at + 8 + header_len + data_len;
       if (record.fields.op == kOpConnection) {
         add_connection(record, chunk_offset_);
-        Fields meta;
+        BagHeaderFields meta;
         if (parse_fields(data, data_len, meta).empty()) {
           connections_[record.fields.conn].type = std::string(meta.type);
           connections_[record.fields.conn].md5sum = std::string(meta.md5sum);

@@ -49,7 +49,7 @@ constexpr const char* kJointStatesTopic = "/hrcsense/joint_states";
 constexpr int64_t kStaticTimeNs = 1;
 constexpr int64_t kFirstStreamTimeNs = 2;
 constexpr size_t kBagHeaderBytes = 4096;  // header + data of the bag header record
-constexpr char kMagic[] = "#ROSBAG V2.0\n";
+constexpr char kBagMagic[] = "#ROSBAG V2.0\n";
 
 // A record header under construction: `name=value` fields with uint32 length prefixes.
 struct Fields {
@@ -117,7 +117,7 @@ BagWriter::BagWriter(std::string path, BagWriterParams params) : path_(std::move
   file_.reset(std::fopen(path_.c_str(), "wb"));
   if (!file_) throw BagWriteError(path_ + ": cannot create: " + std::strerror(errno));
   // Large chunks go out in one fwrite each; a small stdio buffer is enough.
-  write(reinterpret_cast<const uint8_t*>(kMagic), sizeof kMagic - 1);
+  write(reinterpret_cast<const uint8_t*>(kBagMagic), sizeof kBagMagic - 1);
   write_bag_header(0, 0, 0);  // index_pos 0 until close(): an unclosed bag says so
   write_static_info();
 }
@@ -446,7 +446,7 @@ void BagWriter::close() {
       }
       write(out.data(), out.size());
       const uint64_t end = position_;
-      if (std::fseek(file_.get(), static_cast<long>(sizeof kMagic - 1), SEEK_SET) != 0) {
+      if (std::fseek(file_.get(), static_cast<long>(sizeof kBagMagic - 1), SEEK_SET) != 0) {
         throw BagWriteError(path_ + ": cannot seek to the bag header: " + std::strerror(errno));
       }
       write_bag_header(index_pos, static_cast<uint32_t>(connections_.size()),

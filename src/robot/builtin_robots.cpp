@@ -9,8 +9,6 @@
 namespace hrcsense {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // The real arm's radii (its visual geometry), each no larger than the capsule that covers it.
 struct UrBody {
   double base_radius_m, shoulder_radius_m, upper_arm_radius_m, elbow_radius_m, forearm_radius_m, wrist_radius_m;

@@ -11,8 +11,6 @@
 namespace hrcsense::segmentation_detail {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 bool reliable(const BatchView& batch, size_t i) {
   const float ratio = batch.model.valid_ratio[i];
   return ratio > 0.0F && ratio >= batch.min_valid_ratio;

@@ -28,7 +28,6 @@ constexpr uint8_t kUnknown = 4;     // valid depth where the background was neve
 constexpr uint8_t kVisited = 8;     // in the blob being flood-filled
 
 constexpr uint64_t kEveryByte = 0x0101010101010101ULL;
-constexpr double kPi = 3.14159265358979323846;
 
 /// Whether any of the 16 mask bytes starting at `i` has a bit of `bits` (repeated per byte) set.
 bool any_bits16(const uint8_t* mask, size_t i, uint64_t bits) {

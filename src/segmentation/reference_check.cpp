@@ -19,8 +19,6 @@
 namespace hrcsense {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 using segmentation_detail::distance_to_capsules;
 
 // The learnt background's means as raw depth; unknown (0, NaN) stays 0, "no data".
