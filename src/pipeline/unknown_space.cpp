@@ -3,12 +3,12 @@
 //
 // Speed (issue A4): most of a frame is measured background or needs no more than counting, so
 // pixels are classified 16 at a time into bit masks (unknown_space_blocks.hpp) and only the
-// envelope, the foreground and reliable gaps are visited; and most unknown rays pass far from
-// the robot, so each ray is first
-// tested against spheres around the whole robot and around each capsule, and the exact
+// foreground, reliable gaps and (where a gap follows) the envelope are visited. Most unknown
+// rays pass far from the robot, so a block's rays are tested together, then one by one,
+// against spheres around the whole robot and around each capsule, and the exact
 // segment-to-capsule distance is computed only where a sphere comes nearer than the smallest
 // distance found so far. The distance reported is the same, bit for bit: what is skipped
-// cannot be smaller than what was found.
+// cannot be smaller than what was found, and the minimum does not depend on the order.
 
 #include "hrcsense/unknown_space.hpp"
 
