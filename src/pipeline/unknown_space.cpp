@@ -1,13 +1,33 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — unknown space near the robot (unknown_space.hpp).
+//
+// Speed (issue A4): most of a frame is measured background or needs no more than counting, so
+// pixels are classified 16 at a time into bit masks (unknown_space_blocks.hpp) and only the
+// foreground, reliable gaps and (where a gap follows) the envelope are visited. Most unknown
+// rays pass far from the robot, so a block's rays are tested together, then one by one,
+// against spheres around the whole robot and around each capsule, and the exact
+// segment-to-capsule distance is computed only where a sphere comes nearer than the smallest
+// distance found so far. The distance reported is the same, bit for bit: what is skipped
+// cannot be smaller than what was found, and the minimum does not depend on the order.
 
 #include "hrcsense/unknown_space.hpp"
 
+#include "unknown_space_blocks.hpp"
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace hrcsense {
 namespace {
+
+// A sphere skips a ray only when it stays this much farther than the smallest distance found:
+// far above the float rounding of both the bound and the exact path (~1e-6 m at cell scale),
+// so a skipped capsule could never have given a smaller distance.
+constexpr float kSkipMargin_m = 1e-3F;
+// Capsules with a sphere of their own; a larger robot is bounded by its enclosing sphere only
+// and measured exactly against every capsule (no allocation on the hot path).
+constexpr size_t kMaxBoundedCapsules = 32;
 
 // Squared distance between segments [p0, p1] and [q0, q1]: the closest pair's parameters
 // clamped to [0, 1] (the usual two-step clamp), in double so that nearly parallel segments
@@ -40,6 +60,257 @@ double segment_segment_distance_sq(const Eigen::Vector3d& p0, const Eigen::Vecto
   return ((p0 + s * d1) - (q0 + t * d2)).squaredNorm();
 }
 
+// The distance from segment [a, b] to one capsule's surface, as segment_capsule_distance takes
+// its minimum: every path computes it with this one function.
+double capsule_surface_distance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Capsule& capsule) {
+  const double d = std::sqrt(segment_segment_distance_sq(a, b, capsule.a.cast<double>(), capsule.b.cast<double>()));
+  return std::max(0.0, d - capsule.radius_m);
+}
+
+// A sphere enclosing a capsule (or the whole robot), its centre relative to the camera's
+// centre in the base frame.
+struct Sphere {
+  Eigen::Vector3f centre_from_camera = Eigen::Vector3f::Zero();
+  float radius_m = 0.0F;
+};
+
+// What the per-ray test needs, gathered once per frame. A ray's segment is
+// camera + z·direction for z in [z0, z1], with direction = linear·((u − ppx)/fx, (v − ppy)/fy, 1)
+// in the base frame: the same points ray_segment computes.
+struct RayBounds {
+  Eigen::Vector3f camera_base = Eigen::Vector3f::Zero();
+  Eigen::Matrix3f linear = Eigen::Matrix3f::Identity();
+  float ppx = 0.0F, ppy = 0.0F, inv_fx = 1.0F, inv_fy = 1.0F;
+  float column_x_norm = 1.0F;  ///< |linear·(1, 0, 0)|: how far rays part per unit of x
+  Sphere robot;
+  std::array<Sphere, kMaxBoundedCapsules> capsules{};
+  bool per_capsule = false;  ///< capsules[] holds one sphere per capsule of the robot
+};
+
+RayBounds make_ray_bounds(const Intrinsics& intrinsics, const Pose& T_base_camera, const RobotModel& robot) {
+  RayBounds bounds;
+  bounds.camera_base = T_base_camera.translation().cast<float>();
+  bounds.linear = T_base_camera.linear().cast<float>();
+  bounds.ppx = intrinsics.ppx;
+  bounds.ppy = intrinsics.ppy;
+  bounds.inv_fx = 1.0F / intrinsics.fx;
+  bounds.inv_fy = 1.0F / intrinsics.fy;
+  bounds.column_x_norm = bounds.linear.col(0).norm();
+  Eigen::Vector3f lo = robot.capsules.front().a, hi = lo;
+  for (const Capsule& c : robot.capsules) {
+    lo = lo.cwiseMin(c.a).cwiseMin(c.b);
+    hi = hi.cwiseMax(c.a).cwiseMax(c.b);
+  }
+  const Eigen::Vector3f centre = 0.5F * (lo + hi);
+  float radius_m = 0.0F;
+  for (const Capsule& c : robot.capsules) {
+    radius_m = std::max(radius_m, std::max((c.a - centre).norm(), (c.b - centre).norm()) + c.radius_m);
+  }
+  bounds.robot = {centre - bounds.camera_base, radius_m};
+  bounds.per_capsule = robot.capsules.size() <= kMaxBoundedCapsules;
+  for (size_t i = 0; bounds.per_capsule && i < robot.capsules.size(); ++i) {
+    const Capsule& c = robot.capsules[i];
+    bounds.capsules[i] = {0.5F * (c.a + c.b) - bounds.camera_base, 0.5F * (c.b - c.a).norm() + c.radius_m};
+  }
+  return bounds;
+}
+
+// True when the ray's segment stays farther than reach_m from the sphere's surface: its point
+// nearest the centre (the projection, clamped to [z0, z1]) is. NaN anywhere never skips.
+bool beyond(const Eigen::Vector3f& direction, float inv_direction_sq, float z0_m, float z1_m, const Sphere& sphere,
+            float reach_m) {
+  const Eigen::Vector3f& w = sphere.centre_from_camera;
+  const float z = std::clamp(w.dot(direction) * inv_direction_sq, z0_m, z1_m);
+  const float limit_m = sphere.radius_m + reach_m;
+  return (w - z * direction).squaredNorm() > limit_m * limit_m;
+}
+
+// One frame's inputs to the pixel loop.
+struct PixelScan {
+  unknown_space_detail::BlockInputs blocks;
+  const DepthImage* depth = nullptr;
+  const uint8_t* no_depth_frames = nullptr;  ///< null: every gap counts at once
+  double fx_b = 0.0;                         ///< px·m: shadow width = fx·B·(1/z_fg − 1/z_bg)
+  UnknownSpaceParams params;
+  // For measure_ray.
+  const Intrinsics* intrinsics = nullptr;
+  const Pose* T_base_camera = nullptr;
+  const RobotModel* robot = nullptr;
+  RayBounds bounds;
+};
+
+constexpr float kNoRay = std::numeric_limits<float>::quiet_NaN();
+
+// The nearest envelope pixel to the right in the row being scanned (right to left).
+struct Envelope {
+  int u = -1;
+  float z_m = 0.0F;
+};
+
+// One unknown ray of a block's row: pixel column u, from depth z0 to z1 (m).
+struct Ray {
+  int u = 0;
+  float z0_m = 0.0F;
+  float z1_m = 0.0F;
+};
+
+struct RayGroup {
+  std::array<Ray, unknown_space_detail::kBlockPx> rays{};
+  int count = 0;
+};
+
+// The base-frame direction of the ray through (u, v): its points are camera + z·direction.
+Eigen::Vector3f ray_direction(const RayBounds& b, float u, int v) {
+  const float x = (u - b.ppx) * b.inv_fx;
+  const float y = (static_cast<float>(v) - b.ppy) * b.inv_fy;
+  return b.linear * Eigen::Vector3f(x, y, 1.0F);
+}
+
+// Lowers best_m to the ray's distance to the capsules in `near` (bit c: capsule c), measuring
+// exactly (ray_segment, segment-to-capsule in double) those its own bound does not skip. A
+// skipped capsule is farther than best_m, so leaving it out of the minimum cannot change
+// min(best_m, the ray's distance to every capsule).
+void measure_ray(const PixelScan& scan, int v, const Ray& ray, uint32_t near, float& best_m) {
+  const RayBounds& b = scan.bounds;
+  const Eigen::Vector3f direction = ray_direction(b, static_cast<float>(ray.u), v);
+  const float inv_direction_sq = 1.0F / direction.squaredNorm();
+  const float reach_m = best_m + kSkipMargin_m;  // infinite until a ray was measured: no skips
+  uint32_t measured = 0;
+  for (; near != 0; near &= near - 1) {
+    const int c = __builtin_ctz(near);
+    if (!beyond(direction, inv_direction_sq, ray.z0_m, ray.z1_m, b.capsules[c], reach_m)) measured |= 1U << c;
+  }
+  if (measured == 0) return;
+  const RaySegment s = ray_segment(*scan.intrinsics, *scan.T_base_camera, ray.u, v, ray.z0_m, ray.z1_m);
+  const Eigen::Vector3d from = s.from_base.cast<double>(), to = s.to_base.cast<double>();
+  double ray_best = std::numeric_limits<double>::infinity();
+  for (; measured != 0; measured &= measured - 1) {
+    ray_best = std::min(ray_best, capsule_surface_distance(from, to, scan.robot->capsules[__builtin_ctz(measured)]));
+  }
+  best_m = std::min(best_m, static_cast<float>(ray_best));
+}
+
+// The rays of one block, tested together first: each lies within slack_m of the group's middle
+// ray at the same depth, so a sphere farther than reach + slack from the middle ray over all
+// their depths is farther than reach from every one of them.
+void measure_rays(const PixelScan& scan, int v, const RayGroup& group, float& best_m) {
+  if (group.count == 0) return;
+  const RayBounds& b = scan.bounds;
+  int u_min = group.rays[0].u, u_max = u_min;
+  float z0_m = group.rays[0].z0_m, z1_m = group.rays[0].z1_m;
+  for (int r = 1; r < group.count; ++r) {
+    u_min = std::min(u_min, group.rays[r].u);
+    u_max = std::max(u_max, group.rays[r].u);
+    z0_m = std::min(z0_m, group.rays[r].z0_m);
+    z1_m = std::max(z1_m, group.rays[r].z1_m);
+  }
+  const Eigen::Vector3f middle = ray_direction(b, 0.5F * static_cast<float>(u_min + u_max), v);
+  const float inv_middle_sq = 1.0F / middle.squaredNorm();
+  const float slack_m = std::max(std::fabs(z0_m), std::fabs(z1_m)) * 0.5F * static_cast<float>(u_max - u_min) *
+                        std::fabs(b.inv_fx) * b.column_x_norm;
+  const float reach_m = best_m + kSkipMargin_m + slack_m;
+  if (beyond(middle, inv_middle_sq, z0_m, z1_m, b.robot, reach_m)) return;
+  if (!b.per_capsule) {  // too many capsules for spheres of their own: measure every one
+    for (int r = 0; r < group.count; ++r) {
+      const Ray& ray = group.rays[r];
+      const RaySegment s = ray_segment(*scan.intrinsics, *scan.T_base_camera, ray.u, v, ray.z0_m, ray.z1_m);
+      best_m = std::min(best_m, segment_capsule_distance(s.from_base, s.to_base, *scan.robot));
+    }
+    return;
+  }
+  uint32_t near = 0;
+  for (size_t c = 0; c < scan.robot->capsules.size(); ++c) {
+    if (!beyond(middle, inv_middle_sq, z0_m, z1_m, b.capsules[c], reach_m)) near |= 1U << c;
+  }
+  for (int r = 0; near != 0 && r < group.count; ++r) measure_ray(scan, v, group.rays[r], near, best_m);
+}
+
+// Set bits; without a POPCNT instruction in the baseline x86-64 target __builtin_popcount is
+// a library call, and most masks here are 0.
+size_t count_bits(uint32_t bits) {
+  size_t count = 0;
+  for (; bits != 0; bits &= bits - 1) ++count;
+  return count;
+}
+
+// A pixel without depth now over a reliable background (column u): the robot's stereo shadow,
+// a dropout or unknown, counted in `out`; the depth (m) its unknown ray starts at, or kNoRay.
+float gap_ray_start(const PixelScan& scan, size_t i, int u, const Envelope& envelope, UnknownSpace& out) {
+  const float bg = scan.blocks.background_m[i];
+  // The robot's stereo shadow lies immediately left of its envelope (docs/SAFETY.md).
+  if (envelope.u >= 0 && envelope.z_m > 0.0F && bg > envelope.z_m) {
+    const double shadow_px = scan.fx_b * (1.0 / envelope.z_m - 1.0 / bg);
+    if (envelope.u - u <= static_cast<int>(std::ceil(shadow_px)) + 1) {
+      ++out.robot_shadow_pixels;
+      return kNoRay;
+    }
+  }
+  // A pixel that only just lost its depth is most likely the sensor's random dropout (a far
+  // wall loses 1-4 % of its pixels each frame); what stays without depth is unknown.
+  if (scan.no_depth_frames != nullptr && scan.no_depth_frames[i] < scan.params.min_no_depth_frames) {
+    ++out.dropout_pixels;
+    return kNoRay;
+  }
+  ++out.no_depth_pixels;
+  return scan.params.near_m;
+}
+
+void set_envelope(const PixelScan& scan, size_t i, int u, Envelope& envelope) {
+  envelope.u = u;
+  envelope.z_m = static_cast<float>(scan.blocks.envelope_from_raw[i]) * scan.depth->depth_scale_m;
+}
+
+// The block of pixels from column first_u: counts its kinds and measures its unknown rays,
+// visiting the pixels that need it from right to left (the shadow lies left of the envelope).
+// No depth where the background was not reliable was unknown when the cell was taught (a
+// far wall, a shiny table): it is only counted.
+void visit_block(const PixelScan& scan, const unknown_space_detail::BlockKinds& kinds, size_t row_start, int first_u,
+                 int v, Envelope& envelope, UnknownSpace& out, float& best_m) {
+  out.never_valid_pixels += count_bits(kinds.never_valid);
+  out.hidden_pixels += count_bits(kinds.hidden);
+  // The envelope matters to the gaps left of it only: without one in the block, its leftmost
+  // envelope pixel is all that the blocks to the left need.
+  uint32_t todo = kinds.hidden | kinds.gap | (kinds.gap != 0 ? kinds.envelope : 0U);
+  RayGroup group;
+  while (todo != 0) {
+    const int k = 31 - __builtin_clz(todo);  // the rightmost pixel left to visit
+    const uint32_t bit = 1U << k;
+    todo &= ~bit;
+    const int u = first_u + k;
+    const size_t i = row_start + static_cast<size_t>(u);
+    if ((kinds.envelope & bit) != 0) {  // the arm and its edges
+      set_envelope(scan, i, u, envelope);
+      continue;
+    }
+    const float z0_m = (kinds.hidden & bit) != 0 ? static_cast<float>(scan.blocks.raw[i]) * scan.depth->depth_scale_m
+                                                 : gap_ray_start(scan, i, u, envelope, out);
+    const float bg = scan.blocks.background_m[i];
+    if (!(bg > z0_m)) continue;  // no ray (NaN), or nothing hidden behind it
+    group.rays[static_cast<size_t>(group.count++)] = Ray{u, z0_m, bg};
+  }
+  if (kinds.envelope != 0 && kinds.gap == 0) {
+    const int u = first_u + __builtin_ctz(kinds.envelope);
+    set_envelope(scan, row_start + static_cast<size_t>(u), u, envelope);
+  }
+  measure_rays(scan, v, group, best_m);
+}
+
+void scan_row(const PixelScan& scan, int v, UnknownSpace& out, float& best_m) {
+  using unknown_space_detail::kBlockPx;
+  const int width = scan.depth->width;
+  const size_t row_start = static_cast<size_t>(v) * static_cast<size_t>(width);
+  Envelope envelope;
+  for (int last = width - 1; last >= 0; last -= kBlockPx) {
+    const int first = std::max(0, last + 1 - kBlockPx);
+    const size_t i = row_start + static_cast<size_t>(first);
+    const unknown_space_detail::BlockBits bits = last + 1 - first == kBlockPx
+                                                     ? unknown_space_detail::block_bits(scan.blocks, i)
+                                                     : unknown_space_detail::block_bits_plain(scan.blocks, i, last + 1 - first);
+    if ((bits.no_depth | bits.envelope | bits.foreground) == 0) continue;  // measured background only
+    visit_block(scan, unknown_space_detail::kinds_of(bits), row_start, first, v, envelope, out, best_m);
+  }
+}
+
 }  // namespace
 
 RaySegment ray_segment(const Intrinsics& in, const Pose& T_base_camera, int u, int v, float z0_m, float z1_m) {
@@ -55,83 +326,49 @@ RaySegment ray_segment(const Intrinsics& in, const Pose& T_base_camera, int u, i
 float segment_capsule_distance(const Eigen::Vector3f& p0, const Eigen::Vector3f& p1, const RobotModel& robot) {
   double best = std::numeric_limits<double>::infinity();
   const Eigen::Vector3d a = p0.cast<double>(), b = p1.cast<double>();
-  for (const Capsule& capsule : robot.capsules) {
-    const double d = std::sqrt(segment_segment_distance_sq(a, b, capsule.a.cast<double>(), capsule.b.cast<double>()));
-    best = std::min(best, std::max(0.0, d - capsule.radius_m));
-  }
+  for (const Capsule& capsule : robot.capsules) best = std::min(best, capsule_surface_distance(a, b, capsule));
   return static_cast<float>(best);
 }
 
 void count_no_depth_frames(const DepthImage& depth, std::vector<uint8_t>& no_depth_frames) {
   if (no_depth_frames.size() != depth.pixels.size()) no_depth_frames.assign(depth.pixels.size(), 0);
-  for (size_t i = 0; i < depth.pixels.size(); ++i) {
-    const uint8_t frames = no_depth_frames[i];
-    no_depth_frames[i] = depth.pixels[i] != 0 ? 0 : static_cast<uint8_t>(frames < 255 ? frames + 1 : 255);
+  // Raw pointers and a branch-free body: through the vectors, every uint8_t store could alias
+  // the vectors' own bookkeeping and the loop stayed scalar.
+  const uint16_t* raw = depth.pixels.data();
+  uint8_t* frames = no_depth_frames.data();
+  const size_t n = depth.pixels.size();
+  for (size_t i = 0; i < n; ++i) {
+    const uint8_t next = static_cast<uint8_t>(frames[i] + (frames[i] < 255 ? 1 : 0));
+    frames[i] = raw[i] != 0 ? 0 : next;
   }
 }
+
 
 UnknownSpace unknown_space(const DepthImage& depth, const Intrinsics& intrinsics, const BackgroundModel& background,
                            const std::vector<uint8_t>& foreground_mask, const RobotPixels* robot_pixels,
                            const Pose& T_base_camera, const RobotModel& robot, float stereo_baseline_m,
                            const std::vector<uint8_t>& no_depth_frames, const UnknownSpaceParams& params) {
-  const float near_m = params.near_m;
-  const float min_valid_ratio = params.min_valid_ratio;
-  const int min_no_depth_frames = params.min_no_depth_frames;
   UnknownSpace out;
   const size_t n = depth.pixels.size();
   if (background.mean_m.size() != n || depth.width <= 0 || robot.capsules.empty()) return out;
-  const bool have_mask = foreground_mask.size() == n;
-  const double fx_b = static_cast<double>(intrinsics.fx) * stereo_baseline_m;  // px·m: shadow width = fx·B·(1/z_fg − 1/z_bg)
-  float best = std::numeric_limits<float>::infinity();
-  for (int v = 0; v < depth.height; ++v) {
-    // Right to left, remembering the nearest envelope pixel to the right: the robot's stereo
-    // shadow lies immediately left of it (docs/SAFETY.md).
-    int envelope_u = -1;
-    float envelope_z = 0.0F;
-    for (int u = depth.width - 1; u >= 0; --u) {
-      const size_t i = static_cast<size_t>(v) * static_cast<size_t>(depth.width) + static_cast<size_t>(u);
-      if (robot_pixels != nullptr && robot_pixels->from_raw[i] != 0) {  // the arm and its edges
-        envelope_u = u;
-        envelope_z = static_cast<float>(robot_pixels->from_raw[i]) * depth.depth_scale_m;
-        continue;
-      }
-      const uint16_t raw = depth.pixels[i];
-      const float bg = background.mean_m[i];
-      float z0 = 0.0F;
-      if (raw == 0) {
-        // No depth now is news only where depth was always there while learning; where it came
-        // and went (a far wall, a shiny table) it was unknown when the cell was taught.
-        if (!(bg > 0.0F) || !(background.valid_ratio.size() == n && background.valid_ratio[i] >= min_valid_ratio)) {
-          ++out.never_valid_pixels;
-          continue;
-        }
-        if (envelope_u >= 0 && envelope_z > 0.0F && bg > envelope_z) {
-          const double shadow_px = fx_b * (1.0 / envelope_z - 1.0 / bg);
-          if (envelope_u - u <= static_cast<int>(std::ceil(shadow_px)) + 1) {
-            ++out.robot_shadow_pixels;
-            continue;
-          }
-        }
-        // A pixel that only just lost its depth is most likely the sensor's random dropout (a
-        // far wall loses 1-4 % of its pixels each frame); what stays without depth is unknown.
-        if (no_depth_frames.size() == n && no_depth_frames[i] < min_no_depth_frames) {
-          ++out.dropout_pixels;
-          continue;
-        }
-        ++out.no_depth_pixels;
-        z0 = near_m;
-      } else if (have_mask && foreground_mask[i] != 0) {
-        ++out.hidden_pixels;
-        z0 = static_cast<float>(raw) * depth.depth_scale_m;
-      } else {
-        continue;
-      }
-      if (!(bg > z0)) continue;  // nothing hidden behind it
-      const RaySegment s = ray_segment(intrinsics, T_base_camera, u, v, z0, bg);
-      best = std::min(best, segment_capsule_distance(s.from_base, s.to_base, robot));
-    }
-  }
-  if (std::isfinite(best)) out.distance_m = best;
+  PixelScan scan;
+  scan.blocks.raw = depth.pixels.data();
+  scan.blocks.foreground_mask = foreground_mask.size() == n ? foreground_mask.data() : nullptr;
+  scan.blocks.envelope_from_raw = robot_pixels != nullptr ? robot_pixels->from_raw : nullptr;
+  scan.blocks.background_m = background.mean_m.data();
+  scan.blocks.valid_ratio = background.valid_ratio.size() == n ? background.valid_ratio.data() : nullptr;
+  scan.blocks.min_valid_ratio = params.min_valid_ratio;
+  scan.depth = &depth;
+  scan.no_depth_frames = no_depth_frames.size() == n ? no_depth_frames.data() : nullptr;
+  scan.fx_b = static_cast<double>(intrinsics.fx) * stereo_baseline_m;
+  scan.params = params;
+  scan.intrinsics = &intrinsics;
+  scan.T_base_camera = &T_base_camera;
+  scan.robot = &robot;
+  scan.bounds = make_ray_bounds(intrinsics, T_base_camera, robot);
+  float best_m = std::numeric_limits<float>::infinity();
+  for (int v = 0; v < depth.height; ++v) scan_row(scan, v, out, best_m);
+  if (std::isfinite(best_m)) out.distance_m = best_m;
   return out;
 }
 

@@ -1,0 +1,123 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — unknown space, the pixel kinds of a block of 16 pixels at once (internal to
+// src/pipeline/unknown_space.cpp; tests/pipeline checks the SSE2 variant against the plain one).
+//
+// Most of a frame is measured background and most of the rest is one of a few kinds that need
+// no further work (the table that was never reliably seen, the robot's envelope); classifying
+// pixel by pixel cost a branch per pixel, and those branches follow the sensor's noise, so they
+// were mispredicted. A block's kinds are bit masks (bit k = pixel first + k) combined without
+// branches; only the pixels that need work are then visited.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace hrcsense::unknown_space_detail {
+
+inline constexpr int kBlockPx = 16;
+
+/// One frame's per-pixel inputs; the optional ones are null where absent.
+struct BlockInputs {
+  const uint16_t* raw = nullptr;                ///< depth now, 0 = no depth
+  const uint8_t* foreground_mask = nullptr;     ///< 1 = foreground (optional)
+  const uint16_t* envelope_from_raw = nullptr;  ///< the robot's envelope: nonzero inside (optional)
+  const float* background_m = nullptr;          ///< background mean, m (> 0: known)
+  const float* valid_ratio = nullptr;           ///< share of learning frames with depth (optional)
+  float min_valid_ratio = 0.95F;
+};
+
+/// The raw tests of a block, one bit per pixel.
+struct BlockBits {
+  uint32_t no_depth = 0;    ///< raw == 0
+  uint32_t envelope = 0;    ///< in the robot's envelope
+  uint32_t foreground = 0;  ///< in the foreground mask
+  /// Background > 0 and valid_ratio ≥ min; only where no_depth outside the envelope, else 0.
+  uint32_t reliable = 0;
+};
+
+/// The kinds unknown_space() treats differently, disjoint, one bit per pixel.
+struct BlockKinds {
+  uint32_t envelope = 0;     ///< the arm and its edges: never unknown, and where its shadow starts
+  uint32_t hidden = 0;       ///< foreground: unknown behind it
+  uint32_t gap = 0;          ///< no depth over a reliable background: shadow, dropout or unknown
+  uint32_t never_valid = 0;  ///< no depth over a background that was not reliable
+};
+
+inline BlockKinds kinds_of(const BlockBits& b) {
+  BlockKinds k;
+  k.envelope = b.envelope;
+  k.hidden = ~b.envelope & ~b.no_depth & b.foreground;
+  k.gap = ~b.envelope & b.no_depth & b.reliable;
+  k.never_valid = ~b.envelope & b.no_depth & ~b.reliable;
+  return k;
+}
+
+/// The tests of pixels [first, first + count), count ≤ kBlockPx, one at a time.
+inline BlockBits block_bits_plain(const BlockInputs& in, size_t first, int count) {
+  BlockBits b;
+  for (int k = 0; k < count; ++k) {
+    const size_t i = first + static_cast<size_t>(k);
+    const uint32_t bit = 1U << k;
+    if (in.raw[i] == 0) b.no_depth |= bit;
+    const bool envelope = in.envelope_from_raw != nullptr && in.envelope_from_raw[i] != 0;
+    if (envelope) b.envelope |= bit;
+    if (in.foreground_mask != nullptr && in.foreground_mask[i] != 0) b.foreground |= bit;
+    // Written as the per-pixel test was: NaN is neither known nor reliable.
+    if (in.raw[i] == 0 && !envelope && in.background_m[i] > 0.0F && in.valid_ratio != nullptr &&
+        in.valid_ratio[i] >= in.min_valid_ratio) {
+      b.reliable |= bit;
+    }
+  }
+  return b;
+}
+
+#if defined(__SSE2__)
+/// The same bits for a whole block with SSE2 (every x86-64 CPU): compares on 8 or 16 lanes,
+/// narrowed to bytes and gathered with movemask. The background is read only for a block with
+/// a pixel without depth outside the envelope.
+inline BlockBits block_bits_sse2(const BlockInputs& in, size_t first) {
+  const __m128i zero = _mm_setzero_si128();
+  const auto load = [](const void* p) { return _mm_loadu_si128(static_cast<const __m128i*>(p)); };
+  const auto zero_words = [&](const uint16_t* p) {  // 16 words → 16 bytes, 0xFF where 0
+    return _mm_packs_epi16(_mm_cmpeq_epi16(load(p), zero), _mm_cmpeq_epi16(load(p + 8), zero));
+  };
+  BlockBits b;
+  b.no_depth = static_cast<uint32_t>(_mm_movemask_epi8(zero_words(in.raw + first)));
+  if (in.envelope_from_raw != nullptr) {
+    b.envelope = ~static_cast<uint32_t>(_mm_movemask_epi8(zero_words(in.envelope_from_raw + first))) & 0xFFFFU;
+  }
+  if (in.foreground_mask != nullptr) {
+    b.foreground = ~static_cast<uint32_t>(_mm_movemask_epi8(_mm_cmpeq_epi8(load(in.foreground_mask + first), zero))) &
+                   0xFFFFU;
+  }
+  const uint32_t gaps = b.no_depth & ~b.envelope;
+  if (in.valid_ratio == nullptr || gaps == 0) return b;
+  const __m128 min_ratio = _mm_set1_ps(in.min_valid_ratio), no_depth_zero = _mm_setzero_ps();
+  __m128i reliable[4];
+  for (int q = 0; q < 4; ++q) {
+    // Ordered compares: false for NaN, as the per-pixel test.
+    const __m128 known = _mm_cmpgt_ps(_mm_loadu_ps(in.background_m + first + 4 * q), no_depth_zero);
+    const __m128 steady = _mm_cmpge_ps(_mm_loadu_ps(in.valid_ratio + first + 4 * q), min_ratio);
+    reliable[q] = _mm_castps_si128(_mm_and_ps(known, steady));
+  }
+  const __m128i bytes = _mm_packs_epi16(_mm_packs_epi32(reliable[0], reliable[1]),
+                                        _mm_packs_epi32(reliable[2], reliable[3]));
+  b.reliable = static_cast<uint32_t>(_mm_movemask_epi8(bytes)) & gaps;
+  return b;
+}
+#endif
+
+/// A whole block's bits, with SSE2 where the compiler targets it.
+inline BlockBits block_bits(const BlockInputs& in, size_t first) {
+#if defined(__SSE2__)
+  return block_bits_sse2(in, first);
+#else
+  return block_bits_plain(in, first, kBlockPx);
+#endif
+}
+
+}  // namespace hrcsense::unknown_space_detail
