@@ -81,65 +81,81 @@ struct Ros2CameraSource::Dds {
     check_dds(dds_waitset_attach(waitset, condition, condition), "DDS waitset attach");
     return waitset;
   }
+
+  // The participant in params.domain_id, the readers of the configured topics (colour ones only
+  // with params.color) and a waitset on each reader waited on.
+  void open(const Ros2SourceParams& params, const std::string& domain) {
+    const CameraTopics& topics = params.topics;
+    // Cyclone reads its own configuration (CYCLONEDDS_URI) here; hrcsense never overrides it.
+    participant = DdsEntity(check_dds(dds_create_participant(params.domain_id, nullptr, nullptr),
+                                      "DDS participant on " + domain));
+    const EndpointQos images{false, false, static_cast<int32_t>(kMaxTake)};
+    const EndpointQos infos{false, false, 1};
+    depth_reader = reader(sensor_msgs_msg_dds__Image__desc, topics.depth_image, images);
+    depth_info_reader = reader(sensor_msgs_msg_dds__CameraInfo__desc, topics.depth_info, infos);
+    if (params.color) {
+      color_reader = reader(sensor_msgs_msg_dds__Image__desc, topics.color_image, images);
+      color_info_reader = reader(sensor_msgs_msg_dds__CameraInfo__desc, topics.color_info, infos);
+      extrinsics_reader =
+          reader(realsense2_camera_msgs_msg_dds__Extrinsics__desc, topics.extrinsics, EndpointQos{true, true, 1});
+      color_waitset = waitset_on(color_reader);
+    }
+    depth_waitset = waitset_on(depth_reader);
+    info_waitset = waitset_on(depth_info_reader);
+  }
+
+  // Waits for the first depth CameraInfo, which sets `depth_intrinsics`, and a second one when it
+  // comes within 500 ms (realsense-ros publishes one per image), whose stamp gives the rate.
+  // Returns their stamps (ns); throws Ros2StartupError when none came within
+  // params.startup_timeout_s, when a stop was requested first, or when the message is invalid.
+  std::vector<int64_t> first_depth_infos(const Ros2SourceParams& params, const std::string& domain,
+                                         Intrinsics& depth_intrinsics) {
+    const CameraTopics& topics = params.topics;
+    const auto timeout = static_cast<dds_duration_t>(params.startup_timeout_s * 1e9);
+    const dds_time_t deadline = dds_time() + timeout;
+    const dds_time_t second_info_deadline_ns = DDS_MSECS(500);
+    const auto stopping = [&params] { return params.stop_requested != nullptr && params.stop_requested->load(); };
+    std::vector<int64_t> stamps;
+    dds_time_t second_deadline = deadline;
+    while (stamps.size() < 2 && !stopping() && dds_time() < std::min(deadline, second_deadline)) {
+      // Slices of 100 ms, so that a stop request (a signal) ends the wait promptly.
+      const dds_time_t slice = std::min({deadline, second_deadline, dds_time() + DDS_MSECS(100)});
+      if (dds_waitset_wait_until(info_waitset, nullptr, 0, slice) <= 0) continue;
+      Taken<sensor_msgs_msg_dds__CameraInfo_> taken(depth_info_reader);
+      for (int32_t i = 0; i < taken.size(); ++i) {
+        if (!taken.valid(i)) continue;
+        try {
+          depth_intrinsics = intrinsics_from_camera_info(taken[i], topics.depth_info);
+        } catch (const Ros2Error& e) {
+          throw Ros2StartupError(e.what());  // the camera's message, not the configuration, is wrong
+        }
+        stamps.push_back(stamp_ns(taken[i].header.stamp));
+        if (stamps.size() == 1) second_deadline = dds_time() + second_info_deadline_ns;
+      }
+    }
+    if (stamps.empty() && stopping()) {
+      throw Ros2StartupError("stopped while waiting for the first CameraInfo on " + topics.depth_info + " (" + domain +
+                             ")");
+    }
+    if (stamps.empty()) {
+      throw Ros2StartupError("no CameraInfo on " + topics.depth_info + " (DDS " + dds_topic_name(topics.depth_info) +
+                             ", " + domain + ") within " + std::to_string(params.startup_timeout_s) +
+                             " s (source.ros2.startup_timeout_s): is the camera node running, in this domain "
+                             "(ROS_DOMAIN_ID), reachable under CYCLONEDDS_URI's network settings?");
+    }
+    return stamps;
+  }
 };
 
 Ros2CameraSource::Ros2CameraSource(Ros2SourceParams params) : params_(std::move(params)), dds_(std::make_unique<Dds>()) {
-  const CameraTopics& topics = params_.topics;
   const std::string domain = "domain " + std::to_string(params_.domain_id);
-  // Cyclone reads its own configuration (CYCLONEDDS_URI) here; hrcsense never overrides it.
-  dds_->participant = DdsEntity(check_dds(dds_create_participant(params_.domain_id, nullptr, nullptr),
-                                          "DDS participant on " + domain));
-  const EndpointQos images{false, false, static_cast<int32_t>(kMaxTake)};
-  const EndpointQos infos{false, false, 1};
-  dds_->depth_reader = dds_->reader(sensor_msgs_msg_dds__Image__desc, topics.depth_image, images);
-  dds_->depth_info_reader = dds_->reader(sensor_msgs_msg_dds__CameraInfo__desc, topics.depth_info, infos);
-  if (params_.color) {
-    dds_->color_reader = dds_->reader(sensor_msgs_msg_dds__Image__desc, topics.color_image, images);
-    dds_->color_info_reader = dds_->reader(sensor_msgs_msg_dds__CameraInfo__desc, topics.color_info, infos);
-    dds_->extrinsics_reader =
-        dds_->reader(realsense2_camera_msgs_msg_dds__Extrinsics__desc, topics.extrinsics, EndpointQos{true, true, 1});
-    dds_->color_waitset = dds_->waitset_on(dds_->color_reader);
-  }
-  dds_->depth_waitset = dds_->waitset_on(dds_->depth_reader);
-  dds_->info_waitset = dds_->waitset_on(dds_->depth_info_reader);
-
+  dds_->open(params_, domain);
   // The first depth CameraInfo gives the intrinsics the run starts with; a second one, when it
-  // comes soon, gives the rate (realsense-ros publishes one per image).
-  const auto timeout = static_cast<dds_duration_t>(params_.startup_timeout_s * 1e9);
-  const dds_time_t deadline = dds_time() + timeout;
-  const dds_time_t second_info_deadline_ns = DDS_MSECS(500);
-  const auto stopping = [this] { return params_.stop_requested != nullptr && params_.stop_requested->load(); };
-  std::vector<int64_t> stamps;
-  dds_time_t second_deadline = deadline;
-  while (stamps.size() < 2 && !stopping() && dds_time() < std::min(deadline, second_deadline)) {
-    // Slices of 100 ms, so that a stop request (a signal) ends the wait promptly.
-    const dds_time_t slice = std::min({deadline, second_deadline, dds_time() + DDS_MSECS(100)});
-    if (dds_waitset_wait_until(dds_->info_waitset, nullptr, 0, slice) <= 0) continue;
-    Taken<sensor_msgs_msg_dds__CameraInfo_> taken(dds_->depth_info_reader);
-    for (int32_t i = 0; i < taken.size(); ++i) {
-      if (!taken.valid(i)) continue;
-      try {
-        depth_intrinsics_ = intrinsics_from_camera_info(taken[i], topics.depth_info);
-      } catch (const Ros2Error& e) {
-        throw Ros2StartupError(e.what());  // the camera's message, not the configuration, is wrong
-      }
-      stamps.push_back(stamp_ns(taken[i].header.stamp));
-      if (stamps.size() == 1) second_deadline = dds_time() + second_info_deadline_ns;
-    }
-  }
-  if (stamps.empty() && stopping()) {
-    throw Ros2StartupError("stopped while waiting for the first CameraInfo on " + topics.depth_info + " (" + domain +
-                           ")");
-  }
-  if (stamps.empty()) {
-    throw Ros2StartupError("no CameraInfo on " + topics.depth_info + " (DDS " + dds_topic_name(topics.depth_info) + ", " +
-                    domain + ") within " + std::to_string(params_.startup_timeout_s) +
-                    " s (source.ros2.startup_timeout_s): is the camera node running, in this domain "
-                    "(ROS_DOMAIN_ID), reachable under CYCLONEDDS_URI's network settings?");
-  }
+  // comes soon, gives the rate.
+  const std::vector<int64_t> stamps = dds_->first_depth_infos(params_, domain, depth_intrinsics_);
   info_.type = "ros2";
   info_.live = true;
-  info_.description = "ROS 2 " + topics.depth_image + " (" + domain + ")";
+  info_.description = "ROS 2 " + params_.topics.depth_image + " (" + domain + ")";
   info_.intrinsics = depth_intrinsics_;
   info_.stereo_baseline_mm = params_.stereo_baseline_mm;
   info_.frame_count = -1;

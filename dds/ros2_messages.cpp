@@ -69,10 +69,9 @@ namespace {
 
 bool fits_float(double value) { return std::isfinite(value) && std::fabs(value) <= std::numeric_limits<float>::max(); }
 
-}  // namespace
-
-Intrinsics intrinsics_from_camera_info(const sensor_msgs_msg_dds__CameraInfo_& info, const std::string& topic) {
-  const std::string where = topic + ": CameraInfo ";
+// The pinhole part from CameraInfo's K and size (`where` starts every error message); the
+// distortion is left to distortion_from_camera_info.
+Intrinsics pinhole_from_camera_info(const sensor_msgs_msg_dds__CameraInfo_& info, const std::string& where) {
   const double* k = info.k;
   // Intrinsics are float32 (as the SDK's): a double beyond float's range would become inf.
   for (double value : info.k) {
@@ -96,7 +95,13 @@ Intrinsics intrinsics_from_camera_info(const sensor_msgs_msg_dds__CameraInfo_& i
     throw Ros2Error(where + "k: fx, fy are 0 as float32");
   }
   // k[1] (skew) is ignored: realsense-ros writes 0, and DESIGN's model has none.
+  return intrinsics;
+}
 
+// CameraInfo's distortion_model and D as the SDK's model and coefficients, into `intrinsics`;
+// throws Ros2Error (starting with `where`) for a model or coefficients the SDK cannot express.
+void distortion_from_camera_info(const sensor_msgs_msg_dds__CameraInfo_& info, const std::string& where,
+                                 Intrinsics& intrinsics) {
   const std::string model = text_of(info.distortion_model);
   const double* d = info.d._buffer;
   const size_t n = info.d._length;
@@ -118,21 +123,30 @@ Intrinsics intrinsics_from_camera_info(const sensor_msgs_msg_dds__CameraInfo_& i
     }
     intrinsics.model = Distortion::brown_conrady;
     for (size_t i = 0; i < std::min<size_t>(n, 5); ++i) intrinsics.coeffs[i] = static_cast<float>(d[i]);
-    return intrinsics;
+    return;
   }
   if (model == "equidistant") {
     if (n != 4 && n != 5) throw Ros2Error(where + "distortion_model 'equidistant' with " + count_text + ": expected 4");
     if (n == 5 && d[4] != 0.0) throw Ros2Error(where + "distortion_model 'equidistant': d[4] must be 0");
     intrinsics.model = Distortion::kannala_brandt4;
     for (size_t i = 0; i < 4; ++i) intrinsics.coeffs[i] = static_cast<float>(d[i]);
-    return intrinsics;
+    return;
   }
   if ((model.empty() || model == "none") && is_zero(d, n)) {
     intrinsics.model = Distortion::none;
-    return intrinsics;
+    return;
   }
   throw Ros2Error(where + "distortion_model '" + model + "' (" + count_text +
                   "): hrcsense maps plumb_bob, rational_polynomial (k4-k6 zero), equidistant and none");
+}
+
+}  // namespace
+
+Intrinsics intrinsics_from_camera_info(const sensor_msgs_msg_dds__CameraInfo_& info, const std::string& topic) {
+  const std::string where = topic + ": CameraInfo ";
+  Intrinsics intrinsics = pinhole_from_camera_info(info, where);
+  distortion_from_camera_info(info, where, intrinsics);
+  return intrinsics;
 }
 
 const char* distortion_model_name(Distortion model) {

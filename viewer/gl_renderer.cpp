@@ -68,6 +68,53 @@ std::string distance_text(const ViewFrame& frame) {
   return text;
 }
 
+// The distance beside the line between the two closest points, placed by projecting both into
+// the 2D pane's image (`image`, its pixels) and scaling to where that image is drawn
+// (`image_rect`, window pixels); nothing when either point does not project.
+void draw_contact_distance_label(ImDrawList* draw, ImFont* font, const ViewFrame& frame, const ColorImage& image,
+                                 const Rect& image_rect) {
+  const ViewCamera camera = view_camera(frame);
+  const std::optional<Eigen::Vector2f> a = project_to_view(camera, frame.contact.closest_camera);
+  const Eigen::Vector3f robot_camera = frame.T_camera_base.cast<float>() * frame.contact.closest_robot_base;
+  const std::optional<Eigen::Vector2f> b = project_to_view(camera, robot_camera);
+  if (!a || !b) return;
+  const float scale = static_cast<float>(image_rect.width) / static_cast<float>(image.width);
+  const Eigen::Vector2f mid = (*a + *b) * 0.5F;
+  const ImVec2 at(image_rect.x + (mid.x() + 0.5F) * scale + 12.0F, image_rect.y + (mid.y() + 0.5F) * scale - 14.0F);
+  const std::string text = distance_text(frame);
+  const ImVec2 size = font->CalcTextSizeA(28.0F, 1e9F, 0.0F, text.c_str());
+  draw->AddRectFilled(ImVec2(at.x - 4, at.y - 2), ImVec2(at.x + size.x + 4, at.y + size.y + 2), IM_COL32(0, 0, 0, 200));
+  draw->AddText(font, 28.0F, at, IM_COL32(255, 255, 255, 255), text.c_str());
+}
+
+// The status strip's small lines under the large verdict (x and the strip's top strip_y in
+// window pixels): the verdict's reason, the frame's figures, the rates and drops, then the
+// disclaimer with any notice beside it.
+void draw_status_lines(ImDrawList* draw, ImFont* font, const ViewFrame& frame, ShownState state, const ViewStats& stats,
+                       float x, float strip_y) {
+  const RateStats rates = rate_stats(stats.timeline);
+  const std::string reason = state == ShownState::no_data
+                                 ? std::string("no result newer than safety.max_frame_age_s")
+                                 : std::string(reason_code_name(frame.verdict.code)) + ": " + frame.verdict.reason;
+  char line2[160];
+  char line3[200];
+  std::snprintf(line2, sizeof(line2), "frame %lld  fg %zu pts  invalid %zu px  latency %.2f / %.2f ms%s",
+                static_cast<long long>(frame.frame), frame.foreground_points, frame.invalid_pixels,
+                rates.latency_p50_us / 1000.0, rates.latency_p99_us / 1000.0, stats.session_ended ? "  (ended)" : "");
+  std::snprintf(line3, sizeof(line3), "capture %.1f  processing %.1f  view %.1f frames/s  dropped %lld, view %lld",
+                rates.capture_fps, rates.processing_fps, stats.display_fps,
+                static_cast<long long>(stats.pipeline_dropped), static_cast<long long>(stats.viewer_dropped));
+  draw->AddText(font, 18.0F, ImVec2(x, strip_y + 68.0F), IM_COL32(230, 230, 230, 255), reason.c_str());
+  draw->AddText(font, 18.0F, ImVec2(x, strip_y + 88.0F), IM_COL32(170, 170, 170, 255), line2);
+  draw->AddText(font, 18.0F, ImVec2(x, strip_y + 108.0F), IM_COL32(170, 170, 170, 255), line3);
+  const char* disclaimer = "hrcsense is not a safety-rated device";
+  draw->AddText(font, 18.0F, ImVec2(x, strip_y + 128.0F), IM_COL32(140, 140, 140, 255), disclaimer);
+  if (!stats.notice.empty()) {
+    const float after = font->CalcTextSizeA(18.0F, 1e9F, 0.0F, disclaimer).x + 24.0F;
+    draw->AddText(font, 18.0F, ImVec2(x + after, strip_y + 128.0F), IM_COL32(255, 210, 80, 255), stats.notice.c_str());
+  }
+}
+
 }  // namespace
 
 bool Renderer::init(GLFWwindow* window, std::string& error) {
@@ -220,22 +267,9 @@ void Renderer::draw_overlay(const ViewFrame& frame, const ColorImage* image, Sho
   // Everything stays inside the border: clip to the inner rectangle.
   draw->PushClipRect(ImVec2(kBorderPx, kBorderPx), ImVec2(static_cast<float>(width - kBorderPx),
                                                            static_cast<float>(height - kBorderPx)));
-  // The distance beside the line between the two closest points.
   if (state != ShownState::no_data && frame.contact.valid && image != nullptr && image->width > 0 &&
       image_rect.width > 0) {
-    const ViewCamera camera = view_camera(frame);
-    const std::optional<Eigen::Vector2f> a = project_to_view(camera, frame.contact.closest_camera);
-    const Eigen::Vector3f robot_camera = frame.T_camera_base.cast<float>() * frame.contact.closest_robot_base;
-    const std::optional<Eigen::Vector2f> b = project_to_view(camera, robot_camera);
-    if (a && b) {
-      const float scale = static_cast<float>(image_rect.width) / static_cast<float>(image->width);
-      const Eigen::Vector2f mid = (*a + *b) * 0.5F;
-      const ImVec2 at(image_rect.x + (mid.x() + 0.5F) * scale + 12.0F, image_rect.y + (mid.y() + 0.5F) * scale - 14.0F);
-      const std::string text = distance_text(frame);
-      const ImVec2 size = font_small_->CalcTextSizeA(28.0F, 1e9F, 0.0F, text.c_str());
-      draw->AddRectFilled(ImVec2(at.x - 4, at.y - 2), ImVec2(at.x + size.x + 4, at.y + size.y + 2), IM_COL32(0, 0, 0, 200));
-      draw->AddText(font_small_, 28.0F, at, IM_COL32(255, 255, 255, 255), text.c_str());
-    }
+    draw_contact_distance_label(draw, font_small_, frame, *image, image_rect);
   }
   // The status strip: the word in the state's colour and the distance, large; the reason and
   // the figures under them; the timeline on the right.
@@ -248,28 +282,7 @@ void Renderer::draw_overlay(const ViewFrame& frame, const ColorImage* image, Sho
   const std::string distance = state == ShownState::no_data ? "-" : distance_text(frame);
   draw->AddText(font_large_, 56.0F, ImVec2(x + word_width + 40.0F, strip_y + 6.0F), IM_COL32(255, 255, 255, 255),
                 distance.c_str());
-  const RateStats rates = rate_stats(stats.timeline);
-  const std::string reason = state == ShownState::no_data
-                                 ? std::string("no result newer than safety.max_frame_age_s")
-                                 : std::string(reason_code_name(frame.verdict.code)) + ": " + frame.verdict.reason;
-  char line2[160];
-  char line3[200];
-  std::snprintf(line2, sizeof(line2), "frame %lld  fg %zu pts  invalid %zu px  latency %.2f / %.2f ms%s",
-                static_cast<long long>(frame.frame), frame.foreground_points, frame.invalid_pixels,
-                rates.latency_p50_us / 1000.0, rates.latency_p99_us / 1000.0, stats.session_ended ? "  (ended)" : "");
-  std::snprintf(line3, sizeof(line3), "capture %.1f  processing %.1f  view %.1f frames/s  dropped %lld, view %lld",
-                rates.capture_fps, rates.processing_fps, stats.display_fps,
-                static_cast<long long>(stats.pipeline_dropped), static_cast<long long>(stats.viewer_dropped));
-  draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 68.0F), IM_COL32(230, 230, 230, 255), reason.c_str());
-  draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 88.0F), IM_COL32(170, 170, 170, 255), line2);
-  draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 108.0F), IM_COL32(170, 170, 170, 255), line3);
-  const char* disclaimer = "hrcsense is not a safety-rated device";
-  draw->AddText(font_small_, 18.0F, ImVec2(x, strip_y + 128.0F), IM_COL32(140, 140, 140, 255), disclaimer);
-  if (!stats.notice.empty()) {
-    const float after = font_small_->CalcTextSizeA(18.0F, 1e9F, 0.0F, disclaimer).x + 24.0F;
-    draw->AddText(font_small_, 18.0F, ImVec2(x + after, strip_y + 128.0F), IM_COL32(255, 210, 80, 255),
-                  stats.notice.c_str());
-  }
+  draw_status_lines(draw, font_small_, frame, state, stats, x, strip_y);
   draw_timeline(draw, frame, stats, ImVec2(static_cast<float>(width - kBorderPx) - 16.0F - kTimelineWidthPx,
                                            strip_y + 8.0F),
                 ImVec2(kTimelineWidthPx, static_cast<float>(kStatusPx) - 16.0F));

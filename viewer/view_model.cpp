@@ -193,9 +193,13 @@ void robot_mask(const std::vector<Capsule>& capsules_base, const Pose& T_camera_
   }
 }
 
-void compose_2d(const ViewFrame& frame, float depth_alpha, int marker_radius_px, ComposeScratch& scratch,
-                ColorImage& out) {
-  const ViewCamera camera = view_camera(frame);
+namespace {
+
+// The depth image in the view camera's grid, coloured and blended over the colour image (or
+// alone without one). False, with `out` left black, when the frame has no depth of the view's
+// size.
+bool paint_depth_over_color(const ViewFrame& frame, const ViewCamera& camera, float depth_alpha,
+                            ComposeScratch& scratch, ColorImage& out) {
   const Intrinsics& in = camera.intrinsics;
   const bool with_color = in.width == frame.color_intrinsics.width && frame.color && frame.depth_to_color &&
                           in.width == frame.color->width;
@@ -208,7 +212,7 @@ void compose_2d(const ViewFrame& frame, float depth_alpha, int marker_radius_px,
   out.width = in.width;
   out.height = in.height;
   out.rgb.assign(static_cast<size_t>(in.width) * in.height * 3, 0);
-  if (depth->width != in.width || depth->height != in.height) return;  // a frame without depth of its size: black
+  if (depth->width != in.width || depth->height != in.height) return false;
   colorize_depth(*depth, scratch.histogram, scratch.lut, scratch.depth_rgb);
   // Blend in integers, weights out of 256, rounded to nearest: (1 - a)·colour + a·depth.
   const int weight = static_cast<int>(std::lround(std::clamp(depth_alpha, 0.0F, 1.0F) * 256.0F));
@@ -222,8 +226,15 @@ void compose_2d(const ViewFrame& frame, float depth_alpha, int marker_radius_px,
   } else {
     out.rgb = scratch.depth_rgb.rgb;
   }
-  // Foreground points, tinted towards the contact marker's colour over their footprint. The
-  // mask keeps a pixel covered by two points from being tinted twice.
+  return true;
+}
+
+// Foreground points (depth-camera frame), tinted towards the contact marker's colour over their
+// footprint scaled to the view camera's focal length. The mask keeps a pixel covered by two
+// points from being tinted twice.
+void tint_foreground_points(const ViewFrame& frame, const ViewCamera& camera, ComposeScratch& scratch,
+                            ColorImage& out) {
+  const Intrinsics& in = camera.intrinsics;
   const float focal_ratio = frame.depth_intrinsics.fx > 0.0F ? in.fx / frame.depth_intrinsics.fx : 1.0F;
   const int side = std::clamp(static_cast<int>(std::lround(frame.foreground_footprint * focal_ratio)), 1, 16);
   scratch.tinted.assign(static_cast<size_t>(in.width) * in.height, 0);
@@ -242,7 +253,13 @@ void compose_2d(const ViewFrame& frame, float depth_alpha, int marker_radius_px,
       }
     }
   }
-  // The robot: brightened, its outline exact.
+}
+
+// The robot's capsules as the view camera sees them: brightened, their outline exact (a pixel
+// on the image border counts as outline).
+void paint_robot_silhouette(const ViewFrame& frame, const ViewCamera& camera, ComposeScratch& scratch,
+                            ColorImage& out) {
+  const Intrinsics& in = camera.intrinsics;
   robot_mask(frame.capsules_base, frame.T_camera_base, camera, scratch.robot);
   const std::vector<uint8_t>& robot = scratch.robot;
   for (int v = 0; v < in.height; ++v) {
@@ -258,7 +275,11 @@ void compose_2d(const ViewFrame& frame, float depth_alpha, int marker_radius_px,
       }
     }
   }
-  // The closest pair and the line between them.
+}
+
+// The closest pair (foreground point in the depth-camera frame, robot point in the base frame)
+// and the line between them; an end that does not project into the view is left out.
+void draw_closest_pair(const ViewFrame& frame, const ViewCamera& camera, int marker_radius_px, ColorImage& out) {
   if (!frame.contact.valid) return;
   const std::optional<Eigen::Vector2f> contact_px = project_to_view(camera, frame.contact.closest_camera);
   const Eigen::Vector3f robot_camera = frame.T_camera_base.cast<float>() * frame.contact.closest_robot_base;
@@ -266,6 +287,18 @@ void compose_2d(const ViewFrame& frame, float depth_alpha, int marker_radius_px,
   if (contact_px && robot_px) draw_line(out, *contact_px, *robot_px, kContactLine);
   if (robot_px) draw_disc(out, *robot_px, marker_radius_px, kRobotMarker);
   if (contact_px) draw_disc(out, *contact_px, marker_radius_px, kContactMarker);
+}
+
+}  // namespace
+
+void compose_2d(const ViewFrame& frame, float depth_alpha, int marker_radius_px, ComposeScratch& scratch,
+                ColorImage& out) {
+  const ViewCamera camera = view_camera(frame);
+  // A frame without depth of the view's size stays black: nothing else would line up with it.
+  if (!paint_depth_over_color(frame, camera, depth_alpha, scratch, out)) return;
+  tint_foreground_points(frame, camera, scratch, out);
+  paint_robot_silhouette(frame, camera, scratch, out);
+  draw_closest_pair(frame, camera, marker_radius_px, out);
 }
 
 Timeline::Timeline(double window_s, size_t max_points) : window_s_(window_s), max_points_(max_points) {

@@ -124,6 +124,63 @@ void add_stage(std::vector<std::pair<const char*, std::vector<double>>>& stages,
   stages.push_back({name, {us}});
 }
 
+// What the timed passes measured: per frame the measurement plus the decision (µs), per stage
+// its timings (µs) in the order the stages ran, and how many verdicts were `run`.
+struct BenchTimings {
+  std::vector<double> latencies_us;
+  std::vector<std::pair<const char*, std::vector<double>>> stages;
+  double total_s = 0.0;
+  size_t decided_run = 0;
+};
+
+// One untimed pass over frames[first..] so that buffers reach their size, then kRepetitions
+// timed passes: Pipeline::process and SafetyMonitor::decide on each frame with its robot state.
+BenchTimings time_frames(Pipeline& pipeline, SafetyMonitor& monitor, const std::vector<Frame>& frames,
+                         const std::vector<RobotState>& robot_states, size_t first) {
+  BenchTimings timings;
+  timings.latencies_us.reserve((frames.size() - first) * kRepetitions);
+  FrameResult result;
+  for (size_t i = first; i < frames.size(); ++i) {  // warm-up
+    pipeline.process(frames[i], robot_states[i], result);
+    monitor.decide(result, 0);
+  }
+  for (int rep = 0; rep < kRepetitions; ++rep) {
+    for (size_t i = first; i < frames.size(); ++i) {
+      const Clock::time_point start = Clock::now();
+      pipeline.process(frames[i], robot_states[i], result);
+      const Clock::time_point measured = Clock::now();
+      monitor.decide(result, 0);
+      const Clock::time_point decided = Clock::now();
+      const double us = std::chrono::duration<double, std::micro>(decided - start).count();
+      timings.latencies_us.push_back(us);
+      timings.total_s += us * 1e-6;
+      for (const StageTiming& timing : result.timings) add_stage(timings.stages, timing.stage, timing.us);
+      add_stage(timings.stages, "decision", std::chrono::duration<double, std::micro>(decided - measured).count());
+      timings.decided_run += result.verdict.state == VerdictState::run ? 1 : 0;
+    }
+  }
+  return timings;
+}
+
+// The report on stdout: `first` learning frames, then the timed ones of `frame_count`;
+// render_s is the time the source took to produce all of them.
+void print_bench_report(const CommandArgs& args, const Config& config, const SourceInfo& info, size_t frame_count,
+                        size_t first, double render_s, const BenchTimings& timings) {
+  const std::vector<double>& latencies_us = timings.latencies_us;
+  const double mean_ms = timings.total_s * 1e3 / static_cast<double>(latencies_us.size());
+  std::printf("config        %s\n", args.config_path.c_str());
+  std::printf("frames        %zu timed x %d repetitions (%zu learning frames before them), %dx%d\n",
+              frame_count - first, kRepetitions, first, info.intrinsics.width, info.intrinsics.height);
+  std::printf("frames/s      %.1f\n", static_cast<double>(latencies_us.size()) / timings.total_s);
+  std::printf("latency ms    mean %.3f  p50 %.3f  p99 %.3f\n", mean_ms, percentile_ms(latencies_us, 0.50),
+              percentile_ms(latencies_us, 0.99));
+  print_stage_medians(timings.stages);
+  std::printf("verdicts      %zu of %zu timed frames run (%s mode)\n", timings.decided_run, latencies_us.size(),
+              config.pipeline.safety.mode == SafetyParams::Mode::ssm ? "ssm" : "zones");
+  std::printf("rendering     %.3f ms/frame (not included above)\n", render_s * 1e3 / static_cast<double>(frame_count));
+  std::printf("peak RSS      %.1f MiB (includes the pre-rendered frames)\n", peak_rss_mib());
+}
+
 }  // namespace
 
 int bench_command(const CommandArgs& args) {
@@ -140,48 +197,13 @@ int bench_command(const CommandArgs& args) {
     Pipeline pipeline(config.pipeline);
     pipeline.set_background(learn(config.pipeline, frames));
 
-    // The timed frames follow the learning frames, as in a run; buffers warm up on the first pass.
+    // The timed frames follow the learning frames, as in a run.
     const size_t first = std::min(frames.size(), static_cast<size_t>(config.pipeline.background.frames));
     if (first == frames.size()) throw std::runtime_error("no frames left after background learning");
-    std::vector<double> latencies_us;
-    latencies_us.reserve((frames.size() - first) * kRepetitions);
     const std::vector<RobotState> robot_states = robot_states_for(config, *source, frames);
-    FrameResult result;
     SafetyMonitor monitor(config.pipeline.safety);
-    std::vector<std::pair<const char*, std::vector<double>>> stages;
-    for (size_t i = first; i < frames.size(); ++i) {  // warm-up
-      pipeline.process(frames[i], robot_states[i], result);
-      monitor.decide(result, 0);
-    }
-    double total_s = 0.0;
-    size_t decided_run = 0;
-    for (int rep = 0; rep < kRepetitions; ++rep) {
-      for (size_t i = first; i < frames.size(); ++i) {
-        const Clock::time_point start = Clock::now();
-        pipeline.process(frames[i], robot_states[i], result);
-        const Clock::time_point measured = Clock::now();
-        monitor.decide(result, 0);
-        const Clock::time_point decided = Clock::now();
-        const double us = std::chrono::duration<double, std::micro>(decided - start).count();
-        latencies_us.push_back(us);
-        total_s += us * 1e-6;
-        for (const StageTiming& timing : result.timings) add_stage(stages, timing.stage, timing.us);
-        add_stage(stages, "decision", std::chrono::duration<double, std::micro>(decided - measured).count());
-        decided_run += result.verdict.state == VerdictState::run ? 1 : 0;
-      }
-    }
-    const double mean_ms = total_s * 1e3 / static_cast<double>(latencies_us.size());
-    std::printf("config        %s\n", args.config_path.c_str());
-    std::printf("frames        %zu timed x %d repetitions (%zu learning frames before them), %dx%d\n",
-                frames.size() - first, kRepetitions, first, info.intrinsics.width, info.intrinsics.height);
-    std::printf("frames/s      %.1f\n", static_cast<double>(latencies_us.size()) / total_s);
-    std::printf("latency ms    mean %.3f  p50 %.3f  p99 %.3f\n", mean_ms, percentile_ms(latencies_us, 0.50),
-                percentile_ms(latencies_us, 0.99));
-    print_stage_medians(stages);
-    std::printf("verdicts      %zu of %zu timed frames run (%s mode)\n", decided_run, latencies_us.size(),
-                config.pipeline.safety.mode == SafetyParams::Mode::ssm ? "ssm" : "zones");
-    std::printf("rendering     %.3f ms/frame (not included above)\n", render_s * 1e3 / static_cast<double>(frames.size()));
-    std::printf("peak RSS      %.1f MiB (includes the pre-rendered frames)\n", peak_rss_mib());
+    const BenchTimings timings = time_frames(pipeline, monitor, frames, robot_states, first);
+    print_bench_report(args, config, info, frames.size(), first, render_s, timings);
     return 0;
   } catch (const std::exception& e) {
     return report_error(e);

@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -244,6 +245,105 @@ void check_sweep_settings(const SweepRequest& request, const std::string& csv, b
   if (!out.flush()) throw std::runtime_error(path + ": cannot write");
 }
 
+// The sweep's rows in row order: each point on each scene with each seed (1..seeds, or only the
+// scene's own seed when seeds is 0).
+std::vector<Row> sweep_rows(const SweepRequest& request) {
+  std::vector<Row> rows;
+  for (const eval::SweepPoint& point : request.points) {
+    for (const std::string& scene : request.scenes) {
+      for (int64_t seed = request.seeds > 0 ? 1 : 0; seed <= std::max<int64_t>(0, request.seeds); ++seed) {
+        rows.push_back({static_cast<int64_t>(rows.size()), &point, scene, seed});
+      }
+    }
+  }
+  return rows;
+}
+
+// Every row's configuration (the scene with the sweep's --set, then the point's settings, then
+// the seed), loaded before any row runs: a bad key fails now, naming it, not after hours of rows.
+std::vector<Config> row_configs(const SweepRequest& request, const std::vector<Row>& rows) {
+  std::vector<Config> configs;
+  for (const Row& row : rows) {
+    std::vector<std::string> sets = request.sets;
+    sets.insert(sets.end(), row.point->settings.begin(), row.point->settings.end());
+    if (row.seed > 0) sets.push_back("source.seed=" + std::to_string(row.seed));
+    configs.push_back(load_config(row.scene, sets));
+  }
+  return configs;
+}
+
+// The indices of the rows results.csv does not hold yet (all of them in a fresh table).
+std::vector<size_t> rows_not_done(const std::vector<Row>& rows, const eval::ResumeState& resumed) {
+  std::vector<size_t> pending;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (resumed.done.count(eval::row_key(rows[i].key_fields())) == 0) pending.push_back(i);
+  }
+  return pending;
+}
+
+// What the workers share: `mutex` guards the table, the error, the next row and the label of
+// the row being run; `progress` is atomic.
+struct SweepWork {
+  const SweepRequest& request;
+  const std::vector<Row>& rows;
+  const std::vector<Config>& configs;
+  const std::vector<size_t>& pending;
+  std::ofstream& out;
+  bool serial;  ///< one job: the rate column says the row was measured alone
+  Progress progress{};
+  std::mutex mutex{};
+  size_t next = 0;
+  std::string first_error{};
+  std::string current{};
+};
+
+// One worker: takes the next pending row, runs it and appends its line, until none is left or
+// any row has failed (the first failure is kept; later rows are not started).
+void run_rows_worker(SweepWork& work) {
+  for (;;) {
+    size_t i = 0;
+    {
+      std::lock_guard<std::mutex> lock(work.mutex);
+      if (work.next >= work.pending.size() || !work.first_error.empty()) return;
+      i = work.pending[work.next++];
+      work.current = work.request.label + (work.request.label.empty() ? "" : ": ") + work.rows[i].key_fields()[1] +
+                     " " + std::filesystem::path(work.rows[i].scene).filename().string();
+    }
+    const EvalRun run = run_eval(work.configs[i], work.request.frames, &work.progress.frames);
+    std::lock_guard<std::mutex> lock(work.mutex);
+    if (!run.error.empty()) {
+      work.first_error = work.rows[i].scene + " (" + work.rows[i].key_fields()[1] + "): " + run.error;
+      return;
+    }
+    work.out << row_line(work.rows[i], run, work.serial) << '\n';
+    work.out.flush();
+    ++work.progress.rows_done;
+  }
+}
+
+// Runs the pending rows on `jobs` threads, drawing the progress bar every 200 ms when stderr is
+// a terminal; throws std::runtime_error naming the first row that failed.
+void run_pending_rows(SweepWork& work, int jobs) {
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::thread> threads;
+  for (int j = 0; j < jobs; ++j) threads.emplace_back(run_rows_worker, std::ref(work));
+  const bool tty = ::isatty(STDERR_FILENO) != 0;
+  while (work.progress.rows_done.load() < work.progress.rows_total) {
+    {
+      std::lock_guard<std::mutex> lock(work.mutex);
+      if (!work.first_error.empty()) break;
+      if (tty) {
+        draw(work.progress, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+             work.current);
+      }
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  for (std::thread& t : threads) t.join();
+  if (tty) std::fprintf(stderr, "\n");
+  if (!work.first_error.empty()) throw std::runtime_error("eval: " + work.first_error);
+}
+
 }  // namespace
 
 size_t ResultTable::column(const std::string& name) const {
@@ -285,81 +385,25 @@ ResultTable run_sweep(const SweepRequest& request) {
   if (request.points.empty() || request.scenes.empty()) {
     throw std::invalid_argument("eval: a sweep needs at least one point and one scene");
   }
-  std::vector<Row> rows;
-  for (const eval::SweepPoint& point : request.points) {
-    for (const std::string& scene : request.scenes) {
-      for (int64_t seed = request.seeds > 0 ? 1 : 0; seed <= std::max<int64_t>(0, request.seeds); ++seed) {
-        rows.push_back({static_cast<int64_t>(rows.size()), &point, scene, seed});
-      }
-    }
-  }
-  // Every row's configuration is loaded before any runs: a bad key fails now, naming it.
-  std::vector<Config> configs;
-  for (const Row& row : rows) {
-    std::vector<std::string> sets = request.sets;
-    sets.insert(sets.end(), row.point->settings.begin(), row.point->settings.end());
-    if (row.seed > 0) sets.push_back("source.seed=" + std::to_string(row.seed));
-    configs.push_back(load_config(row.scene, sets));
-  }
+  const std::vector<Row> rows = sweep_rows(request);
+  const std::vector<Config> configs = row_configs(request, rows);
 
   std::filesystem::create_directories(request.out_dir);
   const std::string csv = (std::filesystem::path(request.out_dir) / "results.csv").string();
   const eval::ResumeState resumed = eval::resume_results(csv, header_line(), kKeyColumns);
   check_sweep_settings(request, csv, resumed.existed);
-  std::vector<size_t> pending;
-  for (size_t i = 0; i < rows.size(); ++i) {
-    if (resumed.done.count(eval::row_key(rows[i].key_fields())) == 0) pending.push_back(i);
-  }
+  const std::vector<size_t> pending = rows_not_done(rows, resumed);
   if (resumed.existed) {
     spdlog::info("eval: resuming {}: {} of {} rows already there{}", csv, rows.size() - pending.size(), rows.size(),
                  resumed.dropped_partial ? " (a row cut off by the interruption was removed)" : "");
   }
 
   const int jobs = std::max(1, std::min<int>(request.jobs, static_cast<int>(pending.size())));
-  Progress progress;
-  progress.rows_total = static_cast<int64_t>(pending.size());
-  progress.frames_per_row = request.frames > 0 ? request.frames : (configs.empty() ? 0 : configs[0].sim.frames);
   std::ofstream out(csv, std::ios::app | std::ios::binary);
-  std::mutex mutex;  // the table, the error, the next row
-  size_t next = 0;
-  std::string first_error;
-  std::string current;
-  const auto start = std::chrono::steady_clock::now();
-  const auto worker = [&] {
-    for (;;) {
-      size_t i = 0;
-      {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (next >= pending.size() || !first_error.empty()) return;
-        i = pending[next++];
-        current = request.label + (request.label.empty() ? "" : ": ") + rows[i].key_fields()[1] + " " +
-                  std::filesystem::path(rows[i].scene).filename().string();
-      }
-      const EvalRun run = run_eval(configs[i], request.frames, &progress.frames);
-      std::lock_guard<std::mutex> lock(mutex);
-      if (!run.error.empty()) {
-        first_error = rows[i].scene + " (" + rows[i].key_fields()[1] + "): " + run.error;
-        return;
-      }
-      out << row_line(rows[i], run, jobs == 1) << '\n';
-      out.flush();
-      ++progress.rows_done;
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int j = 0; j < jobs; ++j) threads.emplace_back(worker);
-  const bool tty = ::isatty(STDERR_FILENO) != 0;
-  while (progress.rows_done.load() < progress.rows_total) {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (!first_error.empty()) break;
-      if (tty) draw(progress, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), current);
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
-  }
-  for (std::thread& t : threads) t.join();
-  if (tty) std::fprintf(stderr, "\n");
-  if (!first_error.empty()) throw std::runtime_error("eval: " + first_error);
+  SweepWork work{request, rows, configs, pending, out, jobs == 1};
+  work.progress.rows_total = static_cast<int64_t>(pending.size());
+  work.progress.frames_per_row = request.frames > 0 ? request.frames : (configs.empty() ? 0 : configs[0].sim.frames);
+  run_pending_rows(work, jobs);
   if (!out) throw std::runtime_error("eval: cannot write " + csv);
   out.close();
   const std::string md = (std::filesystem::path(request.out_dir) / "results.md").string();

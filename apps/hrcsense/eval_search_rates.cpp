@@ -60,16 +60,19 @@ std::string number(double value, const char* format) {
   return text;
 }
 
-}  // namespace
-
-StudySection study_table_44(const StudyContext& ctx) {
-  const std::filesystem::path dir = std::filesystem::path(ctx.out_dir) / "table-4.4";
-  std::filesystem::create_directories(dir);
-  const RobotModel robot = person_cloud_robot_point();
-  std::ofstream csv(dir / "results.csv");
-  csv << "backend,points,seconds_per_search,searches_per_s,distance_m\n";
-  double rate[std::size(kBackends)][std::size(kSizes)];
+// Searches per second of each backend at each cloud size; `exact` says whether every backend
+// found brute force's closest distance at every size.
+struct BackendRates {
+  double per_s[std::size(kBackends)][std::size(kSizes)];
   bool exact = true;
+};
+
+// Times every backend on the synthetic person at every size, serially, and writes each
+// measurement to `csv` (seconds per search, searches/s, the distance found, m).
+BackendRates measure_search_rates(std::ofstream& csv) {
+  const RobotModel robot = person_cloud_robot_point();
+  csv << "backend,points,seconds_per_search,searches_per_s,distance_m\n";
+  BackendRates rates{};
   for (size_t s = 0; s < std::size(kSizes); ++s) {
     const PointCloud cloud = person_cloud(kSizes[s]);
     float brute_distance_m = NAN;
@@ -80,12 +83,47 @@ StudySection study_table_44(const StudyContext& ctx) {
       float distance_m = NAN;
       const double seconds = seconds_per_search(search, cloud, robot, distance_m);
       if (b == 0) brute_distance_m = distance_m;
-      exact = exact && distance_m == brute_distance_m;
-      rate[b][s] = 1.0 / seconds;
+      rates.exact = rates.exact && distance_m == brute_distance_m;
+      rates.per_s[b][s] = 1.0 / seconds;
       csv << kBackends[b].name << ',' << kSizes[s] << ',' << number(seconds, "%.9g") << ','
-          << number(rate[b][s], "%.6g") << ',' << number(distance_m, "%.9g") << '\n';
+          << number(rates.per_s[b][s], "%.6g") << ',' << number(distance_m, "%.9g") << '\n';
     }
   }
+  return rates;
+}
+
+// Table 4.4's rows (the thesis's Hz above ours in searches/s, per backend) into `md`; returns
+// the plotted series, ours then the thesis's for each backend.
+std::vector<PlotSeries> write_rate_rows(const BackendRates& rates, std::ostringstream& md) {
+  std::vector<PlotSeries> series;
+  for (size_t b = 0; b < std::size(kBackends); ++b) {
+    md << "| thesis: " << kBackends[b].name << " (Hz) ";
+    for (double hz : kBackends[b].thesis_hz) md << "| " << number(hz, "%.2f") << " ";
+    md << "|\n| ours: " << kBackends[b].name << " (searches/s) ";
+    for (size_t s = 0; s < std::size(kSizes); ++s) md << "| " << number(rates.per_s[b][s], "%.0f") << " ";
+    md << "|\n";
+    PlotSeries ours{std::string("ours: ") + kBackends[b].name, {}, {}, {}};
+    PlotSeries thesis{std::string("thesis: ") + kBackends[b].name, {}, {}, {}};
+    for (size_t s = 0; s < std::size(kSizes); ++s) {
+      ours.x.push_back(static_cast<double>(kSizes[s]));
+      ours.y.push_back(rates.per_s[b][s]);
+      thesis.x.push_back(static_cast<double>(kSizes[s]));
+      thesis.y.push_back(kBackends[b].thesis_hz[s]);
+    }
+    series.push_back(ours);
+    series.push_back(thesis);
+  }
+  return series;
+}
+
+}  // namespace
+
+StudySection study_table_44(const StudyContext& ctx) {
+  const std::filesystem::path dir = std::filesystem::path(ctx.out_dir) / "table-4.4";
+  std::filesystem::create_directories(dir);
+  std::ofstream csv(dir / "results.csv");
+  const BackendRates rates = measure_search_rates(csv);
+  const auto& rate = rates.per_s;
 
   std::ostringstream md;
   md << "Each backend on a synthetic person of 10² … 10⁶ points (`person_cloud`, the same generator as the proximity "
@@ -93,29 +131,12 @@ StudySection study_table_44(const StudyContext& ctx) {
         "tree built anew for every search as for every frame; the median of five serial repetitions. The thesis's "
         "figures are whole-system refresh rates (Hz), capped near 12 Hz by the rest of its pipeline.\n\n"
      << "| search | 10² | 10³ | 10⁴ | 10⁵ | 10⁶ |\n| --- | --- | --- | --- | --- | --- |\n";
-  std::vector<PlotSeries> series;
-  for (size_t b = 0; b < std::size(kBackends); ++b) {
-    md << "| thesis: " << kBackends[b].name << " (Hz) ";
-    for (double hz : kBackends[b].thesis_hz) md << "| " << number(hz, "%.2f") << " ";
-    md << "|\n| ours: " << kBackends[b].name << " (searches/s) ";
-    for (size_t s = 0; s < std::size(kSizes); ++s) md << "| " << number(rate[b][s], "%.0f") << " ";
-    md << "|\n";
-    PlotSeries ours{std::string("ours: ") + kBackends[b].name, {}, {}, {}};
-    PlotSeries thesis{std::string("thesis: ") + kBackends[b].name, {}, {}, {}};
-    for (size_t s = 0; s < std::size(kSizes); ++s) {
-      ours.x.push_back(static_cast<double>(kSizes[s]));
-      ours.y.push_back(rate[b][s]);
-      thesis.x.push_back(static_cast<double>(kSizes[s]));
-      thesis.y.push_back(kBackends[b].thesis_hz[s]);
-    }
-    series.push_back(ours);
-    series.push_back(thesis);
-  }
+  const std::vector<PlotSeries> series = write_rate_rows(rates, md);
   md << "\nAt 10⁶ points: ours " << number(rate[0][4], "%.0f") << " searches/s by brute force against the thesis's "
      << "6.71 Hz (" << number(rate[0][4] / 6.71, "%.0f") << "×), " << number(rate[1][4], "%.0f")
      << " by the octree (h = 4) against 9.33 Hz (" << number(rate[1][4] / 9.33, "%.0f") << "×). Every backend found "
-     << (exact ? "the same closest distance as brute force at every size (they are exact)."
-               : "**not** always the same closest distance as brute force: a defect.")
+     << (rates.exact ? "the same closest distance as brute force at every size (they are exact)."
+                     : "**not** always the same closest distance as brute force: a defect.")
      << " The table is in `table-4.4/results.csv`.\n";
   StudySection section{"Table 4.4", md.str(), {},
                        "Brute force at every size (the vectorised scan prunes whole blocks by their boxes); "

@@ -121,6 +121,59 @@ std::string rate_note(const ResultTable& table) {
 
 // ---- The studies ---------------------------------------------------------------------------
 
+namespace {
+
+// Table 4.1's rows, ours beside the thesis's, per persistence; the plotted series on the way.
+struct PersistenceSeries {
+  PlotSeries ours_error{"ours: mean distance error", {}, {}, {}};
+  PlotSeries thesis_mse{"thesis: MSE", {}, {}, {}};
+  PlotSeries ours_mse{"ours: MSE (thesis windows)", {}, {}, {}};
+};
+PersistenceSeries write_persistence_rows(const ResultTable& table, std::ostringstream& md) {
+  PersistenceSeries series;
+  for (const ThesisFilterRow& t : kThesisPersistence) {
+    const size_t r = row_with(table, "filters.temporal.persistence=" + value_text(t.value));
+    const double error = table.number(r, "distance_error_mean_m");
+    md << "| " << t.value << " | " << fixed(t.rate_hz, 2) << " | " << fixed(table.number(r, "processing_fps"), 0)
+       << " | " << t.instability << " | " << fixed(table.number(r, "misrecognised_1m_per_thesis_minute"), 1) << " | "
+       << fixed(table.number(r, "misrecognised_0.1m_per_1000"), 1) << " | " << fixed(t.mse_m2, 4) << " | "
+       << fixed(table.number(r, "mse_thesis_m2"), 6) << " | " << fixed(table.number(r, "mse_run_m2"), 6) << " | "
+       << fixed(1000.0 * error, 2) << " |\n";
+    series.ours_error.x.push_back(t.value);
+    series.ours_error.y.push_back(error);
+    series.thesis_mse.x.push_back(t.value);
+    series.thesis_mse.y.push_back(t.mse_m2);
+    series.ours_mse.x.push_back(t.value);
+    series.ours_mse.y.push_back(table.number(r, "mse_thesis_m2"));
+  }
+  return series;
+}
+
+// What Table 4.1's numbers recommend: how far the persistence moves the mean distance error on
+// the still box, and why the moving cell still uses 0.
+std::string persistence_recommendation(const ResultTable& table) {
+  const ErrorSpread spread = error_spread(table);
+  const std::string spread_text =
+      spread.high_m - spread.low_m < 1e-4
+          ? "the mean distance error is " + mm(spread.low_m) + " at every persistence (the rows differ by less "
+            "than 0.1 mm)"
+          : "the mean distance error spans " + mm(spread.low_m) + " to " + mm(spread.high_m);
+  bool none_misrecognised = true;
+  for (size_t r = 0; r < table.rows.size(); ++r) {
+    none_misrecognised = none_misrecognised && table.text(r, "misrecognised_1m") == "0" &&
+                         table.text(r, "misrecognised_0.1m") == "0";
+  }
+  return "On the still box the persistence hardly moves the closest point: " + spread_text + " over persistence 0–8" +
+         (none_misrecognised ? ", and no frame is mis-recognised by either rule" : "") +
+         ": the box's corner nearest the robot point has no holes for the filter to fill (the thesis's counts came "
+         "from holes and noise at its closest point in a real room). For people who move, persistence 0: filling a "
+         "hole from history puts a walking person's old depth into the stereo shadow they leave, which the moving "
+         "cell below measures (persistence 0 against 3) and why `config/cell-ur5-moving.yaml` uses 0. The `thesis` "
+         "preset keeps the thesis's 3 and `sdk` the SDK's default 3.";
+}
+
+}  // namespace
+
 StudySection study_table_41(const StudyContext& ctx) {
   SweepRequest request = ctx.sweep("table-4.1", ctx.scene("thesis-box.yaml"), kStudyFrames);
   request.sets.push_back("filters.preset=thesis");
@@ -139,53 +192,18 @@ StudySection study_table_41(const StudyContext& ctx) {
      << "| persistence | thesis Hz | ours frames/s | thesis instability | ours (1 m) | ours per 1000 (0.1 m) | "
         "thesis MSE m² | ours MSE m² | ours MSE whole run m² | distance error mm |\n"
      << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
-  PlotSeries ours_error{"ours: mean distance error", {}, {}, {}};
-  PlotSeries thesis_mse{"thesis: MSE", {}, {}, {}};
-  PlotSeries ours_mse{"ours: MSE (thesis windows)", {}, {}, {}};
-  for (const ThesisFilterRow& t : kThesisPersistence) {
-    const size_t r = row_with(table, "filters.temporal.persistence=" + value_text(t.value));
-    const double error = table.number(r, "distance_error_mean_m");
-    md << "| " << t.value << " | " << fixed(t.rate_hz, 2) << " | " << fixed(table.number(r, "processing_fps"), 0)
-       << " | " << t.instability << " | " << fixed(table.number(r, "misrecognised_1m_per_thesis_minute"), 1) << " | "
-       << fixed(table.number(r, "misrecognised_0.1m_per_1000"), 1) << " | " << fixed(t.mse_m2, 4) << " | "
-       << fixed(table.number(r, "mse_thesis_m2"), 6) << " | " << fixed(table.number(r, "mse_run_m2"), 6) << " | "
-       << fixed(1000.0 * error, 2) << " |\n";
-    ours_error.x.push_back(t.value);
-    ours_error.y.push_back(error);
-    thesis_mse.x.push_back(t.value);
-    thesis_mse.y.push_back(t.mse_m2);
-    ours_mse.x.push_back(t.value);
-    ours_mse.y.push_back(table.number(r, "mse_thesis_m2"));
-  }
+  const PersistenceSeries series = write_persistence_rows(table, md);
   StudySection section{"Table 4.1", md.str(), {}, ""};
   section.figures.push_back(ctx.figure("table-4.1", "persistence_error.png",
                                        {"", "closest-distance error against the temporal filter's persistence",
                                         "filters.temporal.persistence", "mean |measured - true| (m)", false, false,
-                                        {ours_error}}));
+                                        {series.ours_error}}));
   section.figures.push_back(ctx.figure("table-4.1", "persistence_mse.png",
                                        {"", "MSE of the closest point against persistence (thesis windows)",
                                         "filters.temporal.persistence", "MSE (m^2)", false, true,
-                                        {thesis_mse, ours_mse}}));
-  const ErrorSpread spread = error_spread(table);
+                                        {series.thesis_mse, series.ours_mse}}));
   section.markdown += "\n" + rate_note(table) + "\n";
-  const std::string spread_text =
-      spread.high_m - spread.low_m < 1e-4
-          ? "the mean distance error is " + mm(spread.low_m) + " at every persistence (the rows differ by less "
-            "than 0.1 mm)"
-          : "the mean distance error spans " + mm(spread.low_m) + " to " + mm(spread.high_m);
-  bool none_misrecognised = true;
-  for (size_t r = 0; r < table.rows.size(); ++r) {
-    none_misrecognised = none_misrecognised && table.text(r, "misrecognised_1m") == "0" &&
-                         table.text(r, "misrecognised_0.1m") == "0";
-  }
-  section.recommendation =
-      "On the still box the persistence hardly moves the closest point: " + spread_text + " over persistence 0–8" +
-      (none_misrecognised ? ", and no frame is mis-recognised by either rule" : "") +
-      ": the box's corner nearest the robot point has no holes for the filter to fill (the thesis's counts came "
-      "from holes and noise at its closest point in a real room). For people who move, persistence 0: filling a "
-      "hole from history puts a walking person's old depth into the stereo shadow they leave, which the moving cell "
-      "below measures (persistence 0 against 3) and why `config/cell-ur5-moving.yaml` uses 0. The `thesis` preset "
-      "keeps the thesis's 3 and `sdk` the SDK's default 3.";
+  section.recommendation = persistence_recommendation(table);
   return section;
 }
 

@@ -27,23 +27,29 @@ void add_common_flags(CLI::App& command, CommandArgs& args) {
       ->check(CLI::Range(int64_t{1}, kMaxFrames));
 }
 
-}  // namespace
+// The subcommands in the order `--help` lists them; CLI11's `app` owns them.
+struct Subcommands {
+  CLI::App* run = nullptr;
+  CLI::App* record = nullptr;
+  CLI::App* publish = nullptr;
+  CLI::App* info = nullptr;
+  CLI::App* teach = nullptr;
+  CLI::App* devices = nullptr;
+  CLI::App* bench = nullptr;
+  CLI::App* eval = nullptr;
+  CLI::App* verify_filters = nullptr;
+};
 
-int main(int argc, char** argv) {
-  // Logs go to stderr so that stdout carries only results.
-  spdlog::set_default_logger(spdlog::stderr_color_mt("hrcsense"));
-  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
-
-  CLI::App app{"hrcsense: safety distances in a human-robot collaboration cell from a depth camera"};
-  app.require_subcommand(1);
-  CommandArgs args;
-
+CLI::App* add_run_command(CLI::App& app, CommandArgs& args) {
   CLI::App* run = app.add_subcommand("run", "process a source and write JSON Lines (docs/OUTPUT.md)");
   add_common_flags(*run, args);
   run->add_option("--out", args.out, "JSON Lines output file (default: stdout)");
   run->add_option("--record", args.record, "also record the source's frames to this RealSense .bag (docs/RECORDINGS.md)");
   run->add_flag("--overwrite", args.overwrite, "with --record: replace an existing recording (never the source itself)");
+  return run;
+}
 
+CLI::App* add_record_command(CLI::App& app, CommandArgs& args) {
   CLI::App* record = app.add_subcommand("record", "record the configured source to a RealSense .bag (docs/RECORDINGS.md)");
   add_common_flags(*record, args);
   record->add_option("--out", args.out, "the .bag file (with record.split_mb: FILE-000.bag, ...)")->required();
@@ -52,26 +58,11 @@ int main(int argc, char** argv) {
   record->add_option("--duration-s", args.duration_s, "stop after S seconds of source time, 0.001 to 86400")
       ->check(CLI::Range(0.001, 86400.0))
       ->excludes(record->get_option("--frames"));
+  return record;
+}
 
-  CLI::App* publish = app.add_subcommand(
-      "publish", "publish the configured source as a realsense-ros camera's ROS 2 topics (docs/CAMERAS.md)");
-  add_common_flags(*publish, args);
-
-  CLI::App* info = app.add_subcommand("info", "describe a configured source or a recording");
-  add_common_flags(*info, args);
-  info->add_option("path", args.input, "a recording: a RealSense .bag file or a folder of depth PNGs");
-
-  CLI::App* teach = app.add_subcommand(
-      "teach", "learn the background with the cell empty and write it for background.reference (docs/SAFETY.md)");
-  add_common_flags(*teach, args);
-  teach->add_option("--out", args.out, "the reference background file (the background.path format)")->required();
-
-  CLI::App* devices = app.add_subcommand("devices", "list the RealSense cameras connected and their depth profiles");
-
-  CLI::App* bench = app.add_subcommand("bench", "time the processing path on pre-rendered frames");
-  add_common_flags(*bench, args);
-
-  hrcsense::app::EvalArgs eval_args;
+// `eval` has flags of its own (EvalArgs): a sweep spans rows, each with its own configuration.
+CLI::App* add_eval_command(CLI::App& app, hrcsense::app::EvalArgs& eval_args) {
   CLI::App* eval = app.add_subcommand("eval", "the thesis's measures over sweeps, scenes and seeds (docs/EVALUATION.md)");
   eval->add_option("--config", eval_args.config_path, "the scene's configuration file when no --scene is given");
   eval->add_option("--set", eval_args.sets, "override a key in every row, KEY=VALUE (repeatable)")->allow_extra_args(false);
@@ -87,16 +78,71 @@ int main(int argc, char** argv) {
                    "a ready-made study: table-4.1, table-4.2, table-4.3, table-4.4, moving-cell or thesis (all)");
   eval->add_option("--config-dir", eval_args.config_dir, "where a study finds its scenes (default: config)");
   eval->add_option("--report", eval_args.report, "with --study thesis: write the report here too (its figures beside it)");
+  return eval;
+}
 
-  CLI::App* verify_filters =
+// Every subcommand, added in the order `--help` lists them; `args` and `eval_args` receive the
+// parsed flags.
+Subcommands add_subcommands(CLI::App& app, CommandArgs& args, hrcsense::app::EvalArgs& eval_args) {
+  Subcommands commands;
+  commands.run = add_run_command(app, args);
+  commands.record = add_record_command(app, args);
+  commands.publish = app.add_subcommand(
+      "publish", "publish the configured source as a realsense-ros camera's ROS 2 topics (docs/CAMERAS.md)");
+  add_common_flags(*commands.publish, args);
+  commands.info = app.add_subcommand("info", "describe a configured source or a recording");
+  add_common_flags(*commands.info, args);
+  commands.info->add_option("path", args.input, "a recording: a RealSense .bag file or a folder of depth PNGs");
+  commands.teach = app.add_subcommand(
+      "teach", "learn the background with the cell empty and write it for background.reference (docs/SAFETY.md)");
+  add_common_flags(*commands.teach, args);
+  commands.teach->add_option("--out", args.out, "the reference background file (the background.path format)")->required();
+  commands.devices = app.add_subcommand("devices", "list the RealSense cameras connected and their depth profiles");
+  commands.bench = app.add_subcommand("bench", "time the processing path on pre-rendered frames");
+  add_common_flags(*commands.bench, args);
+  commands.eval = add_eval_command(app, eval_args);
+  commands.verify_filters =
       app.add_subcommand("verify-filters", "compare hrcsense's depth filters with RealSense SDK goldens");
-  verify_filters->add_option("cases", args.input, "cases.json of an SDK golden set")->required();
-  verify_filters->add_option("--shared", args.shared, "folder the cases' input paths are relative to (default ../shared)");
+  commands.verify_filters->add_option("cases", args.input, "cases.json of an SDK golden set")->required();
+  commands.verify_filters->add_option("--shared", args.shared,
+                                      "folder the cases' input paths are relative to (default ../shared)");
+  return commands;
+}
 
-  // CLI11 would only say "a subcommand is required" for a misspelt one; name it instead.
-  const std::string first = argc > 1 ? argv[1] : "";
-  if (!first.empty() && first[0] != '-' && first != "run" && first != "record" && first != "publish" && first != "info" &&
-      first != "devices" && first != "bench" && first != "verify-filters" && first != "eval" && first != "teach") {
+// CLI11 would only say "a subcommand is required" for a misspelt one; main names it instead.
+bool is_unknown_command(const std::string& first) {
+  return !first.empty() && first[0] != '-' && first != "run" && first != "record" && first != "publish" &&
+         first != "info" && first != "devices" && first != "bench" && first != "verify-filters" && first != "eval" &&
+         first != "teach";
+}
+
+// Runs the one subcommand CLI11 parsed (require_subcommand(1)); `bench` is the one left.
+int run_parsed_command(const Subcommands& commands, const CommandArgs& args, const hrcsense::app::EvalArgs& eval_args) {
+  if (commands.run->parsed()) return hrcsense::app::run_command(args);
+  if (commands.record->parsed()) return hrcsense::app::record_command(args);
+  if (commands.publish->parsed()) return hrcsense::app::publish_command(args);
+  if (commands.info->parsed()) return hrcsense::app::info_command(args);
+  if (commands.teach->parsed()) return hrcsense::app::teach_command(args);
+  if (commands.devices->parsed()) return hrcsense::app::devices_command();
+  if (commands.verify_filters->parsed()) return hrcsense::app::verify_filters_command(args);
+  if (commands.eval->parsed()) return hrcsense::app::eval_command(eval_args);
+  return hrcsense::app::bench_command(args);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Logs go to stderr so that stdout carries only results.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("hrcsense"));
+  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
+
+  CLI::App app{"hrcsense: safety distances in a human-robot collaboration cell from a depth camera"};
+  app.require_subcommand(1);
+  CommandArgs args;
+  hrcsense::app::EvalArgs eval_args;
+  const Subcommands commands = add_subcommands(app, args, eval_args);
+
+  if (is_unknown_command(argc > 1 ? argv[1] : "")) {
     return hrcsense::app::report_error(std::string("unknown command '") + argv[1] +
                                            "'; expected run, record, publish, info, teach, devices, bench, eval or "
                                            "verify-filters",
@@ -110,15 +156,7 @@ int main(int argc, char** argv) {
   }
 
   try {
-    if (run->parsed()) return hrcsense::app::run_command(args);
-    if (record->parsed()) return hrcsense::app::record_command(args);
-    if (publish->parsed()) return hrcsense::app::publish_command(args);
-    if (info->parsed()) return hrcsense::app::info_command(args);
-    if (teach->parsed()) return hrcsense::app::teach_command(args);
-    if (devices->parsed()) return hrcsense::app::devices_command();
-    if (verify_filters->parsed()) return hrcsense::app::verify_filters_command(args);
-    if (eval->parsed()) return hrcsense::app::eval_command(eval_args);
-    return hrcsense::app::bench_command(args);
+    return run_parsed_command(commands, args, eval_args);
   } catch (const std::exception& e) {
     return hrcsense::app::report_error(e);
   }
