@@ -4,7 +4,8 @@
 #                   then configure, build and run the consumer project (CONSUMER_DIR) against it.
 #   MODE=core_only  configure SOURCE_DIR with -DHRCSENSE_WITH_APPS=OFF (no tests, benchmarks;
 #                   the apps' dependencies disabled so that a search for one fails), build it
-#                   with -j2, install it and build and run the consumer against that install.
+#                   with -j2 (in unity batches when the calling build uses them, UNITY), install
+#                   it and build and run the consumer against that install.
 cmake_minimum_required(VERSION 3.25)
 
 function(run)
@@ -69,7 +70,7 @@ elseif(MODE STREQUAL "core_only")
   run(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${BUILD_DIR} -G ${GENERATOR}
       -DCMAKE_MAKE_PROGRAM=${MAKE_PROGRAM} -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DCMAKE_BUILD_TYPE=Release
       -DHRCSENSE_WITH_APPS=OFF -DBUILD_TESTING=OFF -DHRCSENSE_BUILD_BENCHMARKS=OFF -DHRCSENSE_WERROR=ON
-      ${disabled})
+      -DCMAKE_UNITY_BUILD=${UNITY} -DCMAKE_UNITY_BUILD_BATCH_SIZE=16 ${disabled})
   run(${CMAKE_COMMAND} --build ${BUILD_DIR} -j 2)
   run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
   check_export(${prefix})
