@@ -3,7 +3,8 @@
 // a row wider than a block, laid out by hand, whose kinds and shadow cross block boundaries;
 // and the rays skipped by the bounding spheres against measuring every ray (the pre-A4 scan).
 
-#include "../../src/pipeline/unknown_space_blocks.hpp"
+#include "src/pipeline/unknown_space_blocks.hpp"
+#include "unknown_space_row.hpp"
 #include "hrcsense/unknown_space.hpp"
 
 #include <gtest/gtest.h>
@@ -19,13 +20,7 @@ namespace {
 using unknown_space_detail::BlockBits;
 using unknown_space_detail::BlockInputs;
 
-Capsule capsule(Eigen::Vector3f a, Eigen::Vector3f b, float radius_m) {
-  Capsule c;
-  c.a = a;
-  c.b = b;
-  c.radius_m = radius_m;
-  return c;
-}
+using test::capsule;
 
 #if defined(__SSE2__)
 TEST(UnknownSpaceBlocks, Sse2BitsEqualThePlainOnes) {
@@ -74,35 +69,10 @@ TEST(UnknownSpaceBlocks, KindsOfOneBlockByHand) {
   EXPECT_EQ(kinds.envelope, 0b010000U);
 }
 
-// One row of 40 pixels: blocks [24, 39] and [8, 23] and the 8 pixels [0, 7] left over. fx 100 px,
-// ppx 0, baseline 0.05 m, background at 2 m; camera at the base origin. The capsule runs along y
-// at x = 0.3, z = 1, radius 0.05: the ray of pixel u is x = 0.01·u·z.
-struct WideRow {
-  static constexpr int kWidth = 40;
-  DepthImage depth;
-  Intrinsics in;
-  BackgroundModel background;
-  std::vector<uint8_t> mask = std::vector<uint8_t>(kWidth, 0);
-  std::vector<uint16_t> from = std::vector<uint16_t>(kWidth, 0), to = std::vector<uint16_t>(kWidth, 0);
-  std::vector<uint8_t> no_depth_frames = std::vector<uint8_t>(kWidth, 5);
-  RobotModel robot;
-  WideRow() {
-    depth.resize(kWidth, 1);
-    std::fill(depth.pixels.begin(), depth.pixels.end(), 2000);
-    in.width = kWidth;
-    in.height = 1;
-    in.fx = in.fy = 100.0F;
-    background.width = kWidth;
-    background.height = 1;
-    background.mean_m.assign(kWidth, 2.0F);
-    background.spread_m.assign(kWidth, 0.005F);
-    background.valid_ratio.assign(kWidth, 1.0F);
-    robot.capsules.push_back(capsule({0.3F, -1.0F, 1.0F}, {0.3F, 1.0F, 1.0F}, 0.05F));
-  }
-  UnknownSpace run() {
-    const RobotPixels envelope{from.data(), to.data()};
-    return unknown_space(depth, in, background, mask, &envelope, Pose::Identity(), robot, 0.05F, no_depth_frames);
-  }
+// One row of 40 pixels (unknown_space_row.hpp): blocks [24, 39] and [8, 23] and the 8 pixels
+// [0, 7] left over; every gap an old one (5 frames without depth) unless a test says otherwise.
+struct WideRow : test::UnknownSpaceRow<40> {
+  WideRow() : UnknownSpaceRow(5) {}
 };
 
 TEST(UnknownSpaceBlocks, KindsAndShadowAcrossBlocks) {

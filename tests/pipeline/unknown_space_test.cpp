@@ -3,6 +3,7 @@
 // capsule distance, each kind of pixel (no depth, hidden behind foreground, never valid, the
 // robot's envelope and its stereo shadow, a fresh dropout), and the distance they give.
 
+#include "unknown_space_row.hpp"
 #include "hrcsense/unknown_space.hpp"
 
 #include <gtest/gtest.h>
@@ -16,11 +17,7 @@ namespace {
 
 RobotModel one_capsule(Eigen::Vector3f a, Eigen::Vector3f b, float radius_m) {
   RobotModel robot;
-  Capsule c;
-  c.a = a;
-  c.b = b;
-  c.radius_m = radius_m;
-  robot.capsules.push_back(c);
+  robot.capsules.push_back(test::capsule(a, b, radius_m));
   return robot;
 }
 
@@ -49,36 +46,9 @@ TEST(UnknownSpace, RaySegmentThroughAPixel) {
   EXPECT_NEAR(s.to_base.y(), 0.0, 1e-6);
 }
 
-// One row of 12 pixels, fx 100 px, ppx 0, a baseline of 0.05 m, background at 2 m, always
-// valid; camera at the base origin. The capsule runs along y at x = 0.3, z = 1, radius 0.05:
-// the ray of pixel u meets x = 0.01·u·z, so its closest approach is near u = 30 / z.
-struct Row {
-  static constexpr int kWidth = 12;
-  DepthImage depth;
-  Intrinsics in;
-  BackgroundModel background;
-  std::vector<uint8_t> mask = std::vector<uint8_t>(kWidth, 0);
-  std::vector<uint16_t> from = std::vector<uint16_t>(kWidth, 0), to = std::vector<uint16_t>(kWidth, 0);
-  std::vector<uint8_t> no_depth_frames = std::vector<uint8_t>(kWidth, 0);
-  RobotModel robot = one_capsule({0.3F, -1.0F, 1.0F}, {0.3F, 1.0F, 1.0F}, 0.05F);
-  Row() {
-    depth.resize(kWidth, 1);
-    depth.depth_scale_m = 0.001F;
-    std::fill(depth.pixels.begin(), depth.pixels.end(), 2000);
-    in.width = kWidth;
-    in.height = 1;
-    in.fx = in.fy = 100.0F;
-    background.width = kWidth;
-    background.height = 1;
-    background.mean_m.assign(kWidth, 2.0F);
-    background.spread_m.assign(kWidth, 0.005F);
-    background.valid_ratio.assign(kWidth, 1.0F);
-  }
-  UnknownSpace run(bool with_envelope) {
-    const RobotPixels envelope{from.data(), to.data()};
-    return unknown_space(depth, in, background, mask, with_envelope ? &envelope : nullptr, Pose::Identity(), robot,
-                         0.05F, no_depth_frames);
-  }
+// One row of 12 pixels, no pixel without depth yet (unknown_space_row.hpp).
+struct Row : test::UnknownSpaceRow<12> {
+  Row() : UnknownSpaceRow(0) {}
 };
 
 TEST(UnknownSpace, NothingUnknownInAClearFrame) {
