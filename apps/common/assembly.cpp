@@ -71,6 +71,9 @@ Simulator make_simulator(const Config& config, std::shared_ptr<TrajectoryClock> 
 
 namespace {
 
+// What an error in the configuration names first: its file, or "configuration" for defaults.
+std::string config_where(const Config& config) { return config.file.empty() ? "configuration" : config.file; }
+
 // source.type ros2: realsense-ros topics over Cyclone DDS (docs/CAMERAS.md).
 std::unique_ptr<Source> make_ros2_source([[maybe_unused]] const Config& config,
                                          [[maybe_unused]] const SourceOptions& options,
@@ -107,7 +110,7 @@ std::unique_ptr<Source> make_ros2_source([[maybe_unused]] const Config& config,
 }  // namespace
 
 std::unique_ptr<Source> make_source(const Config& config, const SourceOptions& options) {
-  const std::string where = config.file.empty() ? std::string("configuration") : config.file;
+  const std::string where = config_where(config);
   if (config.source.type == "sim") return std::make_unique<SimSource>(make_simulator(config, options.trajectory_clock));
   if (config.source.type == "folder" || config.source.type == "bag") {
     if (config.source.path.empty()) {
@@ -161,7 +164,7 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
   const RobotStateConfig& state = config.robot_state;
   const std::string& source = state.source;
   if (source == "fixed") return std::make_unique<FixedRobotState>(state.joints_rad);
-  const std::string where = config.file.empty() ? std::string("configuration") : config.file;
+  const std::string where = config_where(config);
   if (source == "sim") {
     // Config requires the trajectory with the sim source; checked again for a hand-made Config.
     if (!config.robot_state.trajectory) throw ConfigError(where + ": robot.trajectory: required for robot.state.source sim");
@@ -209,7 +212,7 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, Source& source, RunClock* clock,
                                                           std::shared_ptr<TrajectoryClock> trajectory_clock) {
   if (config.robot_state.source != "recorded") return make_robot_state_source(config, clock, std::move(trajectory_clock));
-  const std::string where = config.file.empty() ? std::string("configuration") : config.file;
+  const std::string where = config_where(config);
   const auto* bag = dynamic_cast<const BagSource*>(&source);
   if (bag == nullptr) {
     throw ConfigError(where + ": robot.state.source recorded: needs source.type bag (a recording made by hrcsense), not " +
@@ -262,14 +265,14 @@ std::unique_ptr<UdpLinkSink> make_udp_link_sink(const Config& config, const RunC
     return std::make_unique<UdpLinkSink>(params, clock != nullptr ? *clock : steady_clock);
   } catch (const std::invalid_argument& e) {
     // The message names link.udp.address (or link.heartbeat_hz); add the file.
-    throw ConfigError((config.file.empty() ? std::string("configuration") : config.file) + ": " + e.what());
+    throw ConfigError(config_where(config) + ": " + e.what());
   }
 }
 
 std::unique_ptr<RtdeLinkSink> make_rtde_link_sink(const Config& config, const RunClock* clock) {
   const LinkConfig& link = config.link;
   if (link.rtde_write == "off") return nullptr;
-  const std::string where = config.file.empty() ? std::string("configuration") : config.file;
+  const std::string where = config_where(config);
   if (config.robot_state.host.empty()) {
     throw ConfigError(where + ": link.rtde.write: needs the controller's address robot.state.host");
   }
