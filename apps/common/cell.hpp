@@ -73,7 +73,7 @@ struct Cell {
   std::unique_ptr<UdpLinkSink> udp_link;    ///< link.udp.address
   std::unique_ptr<RtdeLinkSink> rtde_link;  ///< link.rtde.write
   std::unique_ptr<FollowLinkSink> follow;   ///< follow_link: the arm takes the scale just sent
-  /// Simulated runs: the simulator that labels each result's truth (TruthLabelSink).
+  /// Simulated runs: the simulator that labels each result's truth (TruthLabeller).
   std::optional<Simulator> truth;
   RunHeader header;
   RunOptions run_options;

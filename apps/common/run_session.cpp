@@ -11,7 +11,7 @@
 #include "common/follow_link_sink.hpp"
 #include "common/record_setup.hpp"
 #include "common/tee_sink.hpp"
-#include "common/truth_label_sink.hpp"
+#include "common/truth_labeller.hpp"
 
 #include "hrcsense/recorder.hpp"
 #include "hrcsense/sinks.hpp"
@@ -52,46 +52,6 @@ void install_signal_handlers() {
   for (int signal : kStopSignals) std::signal(signal, on_stop_signal);
   std::signal(SIGPIPE, SIG_IGN);
 }
-
-// Adds the recorder's counters to the summary. The summary comes after the run's final stop, so
-// closing the recording here (writing what is still queued) never delays a verdict.
-class RecordCountersSink final : public Sink {
- public:
-  RecordCountersSink(Sink& inner, Recorder& recorder) : inner_(inner), recorder_(recorder) {}
-  void header(const RunHeader& header) override { inner_.header(header); }
-  void frame(const FrameResult& result) override { inner_.frame(result); }
-  void summary(const RunSummary& summary) override {
-    RunSummary with_record = summary;
-    const RecorderStats stats = recorder_.close();
-    with_record.record = RecordCounters{stats.frames_recorded, stats.frames_dropped, stats.files, stats.error};
-    inner_.summary(with_record);
-  }
-  bool failed() const override { return inner_.failed(); }
-  std::string failure() const override { return inner_.failure(); }
-
- private:
-  Sink& inner_;
-  Recorder& recorder_;
-};
-
-// Adds the viewer's drops to the summary (the viewer's mailbox, read after the run).
-class ViewerCountersSink final : public Sink {
- public:
-  ViewerCountersSink(Sink& inner, std::function<int64_t()> dropped) : inner_(inner), dropped_(std::move(dropped)) {}
-  void header(const RunHeader& header) override { inner_.header(header); }
-  void frame(const FrameResult& result) override { inner_.frame(result); }
-  void summary(const RunSummary& summary) override {
-    RunSummary with_viewer = summary;
-    with_viewer.viewer_frames_dropped = dropped_();
-    inner_.summary(with_viewer);
-  }
-  bool failed() const override { return inner_.failed(); }
-  std::string failure() const override { return inner_.failure(); }
-
- private:
-  Sink& inner_;
-  std::function<int64_t()> dropped_;
-};
 
 // What each part of the run can say is wrong while it runs (fault_log.hpp).
 std::vector<FaultProbe> fault_probes(const RobotStateSource& robot_states, const Recorder* recorder,
@@ -186,36 +146,51 @@ CellOptions cell_options(const SessionOptions& args) {
   return options;
 }
 
-// What the run writes and tells, in order: the controller's links, the JSON Lines (through the
-// truth labeller in a simulated run), the console, a viewer; then the summary's counters
-// (recording, viewer) and the fault log around them all.
+// What the run writes and tells, in order: the controller's links, the JSON Lines (with the
+// truth labels of a simulated run and the recorder's and viewer's counters in the summary),
+// the console, a viewer; the fault log around them all.
 class SessionSinks {
  public:
   SessionSinks(Cell& cell, std::ostream& out, const Config& config, const SessionOptions& args)
-      : jsonl_(out, config.pipeline.backend) {
-    if (cell.truth) labelled_.emplace(std::move(*cell.truth), jsonl_);
-    std::vector<Sink*> sinks = cell.link_sinks();
-    sinks.push_back(labelled_ ? static_cast<Sink*>(&*labelled_) : &jsonl_);
-    sinks.push_back(&console_);
-    sinks.push_back(args.viewer_sink);
-    tee_.emplace(std::move(sinks));
-    Sink* counted = &*tee_;
-    if (cell.recorder) counted = &with_record_.emplace(*counted, *cell.recorder);
-    if (args.viewer_frames_dropped) counted = &with_viewer_.emplace(*counted, args.viewer_frames_dropped);
-    faults_.emplace(*counted,
-                    fault_probes(*cell.robot_states, cell.recorder.get(), cell.udp_link.get(), cell.rtde_link.get()),
-                    [] { return SteadyClock().now_ns(); });
-  }
-  Sink& sink() { return *faults_; }
+      : jsonl_(out, config.pipeline.backend, extras(cell, args)),
+        tee_(sinks(cell, args)),
+        faults_(tee_, fault_probes(*cell.robot_states, cell.recorder.get(), cell.udp_link.get(), cell.rtde_link.get()),
+                [] { return SteadyClock().now_ns(); }) {}
+  Sink& sink() { return faults_; }
 
  private:
+  JsonLinesExtras extras(Cell& cell, const SessionOptions& args) {
+    JsonLinesExtras extras;
+    if (cell.truth) {
+      labeller_.emplace(std::move(*cell.truth), cell.header);
+      extras.contact_label = [this](const FrameResult& result) { return labeller_->contact_label(result); };
+    }
+    // Asked when the summary is written, after the run's final stop: closing the recording here
+    // (writing what is still queued) never delays a verdict.
+    extras.app_counters = [recorder = cell.recorder.get(), dropped = args.viewer_frames_dropped] {
+      AppCounters counters;
+      if (recorder != nullptr) {
+        const RecorderStats stats = recorder->close();
+        counters.record = RecordCounters{stats.frames_recorded, stats.frames_dropped, stats.files, stats.error};
+      }
+      if (dropped) counters.viewer_frames_dropped = dropped();
+      return counters;
+    };
+    return extras;
+  }
+  std::vector<Sink*> sinks(const Cell& cell, const SessionOptions& args) {
+    std::vector<Sink*> all = cell.link_sinks();
+    all.push_back(&jsonl_);
+    all.push_back(&console_);
+    all.push_back(args.viewer_sink);
+    return all;
+  }
+
+  std::optional<TruthLabeller> labeller_;  // before jsonl_, which asks it
   JsonLinesSink jsonl_;
   ConsoleSink console_;
-  std::optional<TruthLabelSink> labelled_;
-  std::optional<TeeSink> tee_;
-  std::optional<RecordCountersSink> with_record_;
-  std::optional<ViewerCountersSink> with_viewer_;
-  std::optional<FaultLogSink> faults_;
+  TeeSink tee_;
+  FaultLogSink faults_;
 };
 
 // The links' counters, as a warning when something went wrong.
