@@ -301,6 +301,135 @@ app::SessionOptions session_options(const ViewArgs& args, bool snapshots, ViewTa
   return options;
 }
 
+// What both draw loops share: the window and its renderer, the run's tap and controls.
+struct ViewerParts {
+  const ViewArgs& args;
+  GLFWwindow* window;
+  Renderer& renderer;
+  ViewTap& tap;
+  Panels& panels;
+  PlaybackControl* playback;  ///< a recording's pause, step and seek; null for other sources
+  double max_frame_age_s;
+  int64_t start_ns;
+};
+
+// One picture's inputs: the panes composed again where needed, the strip's figures and the
+// state shown (a result older than max_frame_age_s is NO DATA: a frozen pipeline).
+struct Picture {
+  PaneImages panes;
+  ShownState state;
+};
+
+Picture compose_picture(LoopState& s, const ViewerParts& v, int width, int height, bool fresh, bool orbit_moved,
+                        bool ended) {
+  const PaneRects rects = window_panes(s.mode, width, height);
+  if (fresh && v.args.slow_render_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(v.args.slow_render_ms));
+  compose_panes(s, rects, orbit_moved);
+  update_stats(s, v.tap, v.playback, v.start_ns, ended);
+  const PaneImages panes{s.mode, rects.image_2d.width > 0 ? &s.image : nullptr,
+                         rects.cloud_3d.width > 0 ? &s.cloud : nullptr};
+  return {panes, shown_state(s.frame, steady_ns(), v.max_frame_age_s)};
+}
+
+void count_drawn(LoopState& s, std::chrono::steady_clock::time_point t0) {
+  ++s.drawn;
+  s.frame_times_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+}
+
+// Headless: draws only the --snapshot-at frames, offscreen, until the last one is written or
+// the run ends. Returns 1 when a picture could not be written.
+int snapshot_loop(LoopState& s, const ViewerParts& v, const std::set<int64_t>& snapshot_frames,
+                  const std::atomic<bool>& session_done) {
+  int exit_code = 0;
+  while (v.tap.snapshots_pending() > 0) {
+    glfwPollEvents();
+    const bool fresh = v.tap.take(s.frame, 1.0 / 60.0);
+    if (!fresh && session_done.load()) break;
+    if (!fresh) continue;
+    ++s.serial;
+    if (snapshot_frames.count(s.frame.frame) == 0) continue;
+    const auto t0 = std::chrono::steady_clock::now();
+    const Picture picture = compose_picture(s, v, kSnapshotWidth, kSnapshotHeight, true, false, session_done.load());
+    if (!write_snapshot(v.renderer, s.frame, picture.panes, picture.state, s.stats, v.args.snapshot_dir, s.snapshot)) {
+      exit_code = 1;
+    }
+    v.tap.rendered(s.frame.frame);
+    count_drawn(s, t0);
+  }
+  return exit_code;
+}
+
+// The window: every turn polls the input, takes the newest frame and draws it with the
+// panels, until the user quits or kLingerAfterEndS after the run ended. Key s writes a PNG
+// into the working folder. Returns 1 when such a picture could not be written.
+int interactive_loop(LoopState& s, const ViewerParts& v, const std::atomic<bool>& session_done) {
+  int64_t ended_ns = 0;
+  int exit_code = 0;
+  bool quit_requested = false;
+  while (true) {
+    glfwPollEvents();
+    if (g_quit.load() || glfwWindowShouldClose(v.window)) quit_requested = true;
+    // Asked again every turn: a request made before the run installed its handlers is reset.
+    if (quit_requested && !session_done.load()) app::request_session_stop();
+    const bool orbit_moved = handle_input(v.playback, v.panels, s.mode, s.orbit_ready ? &s.orbit : nullptr);
+    const bool fresh = v.tap.take(s.frame, 1.0 / 60.0);
+    if (fresh) ++s.serial;
+    if (session_done.load() && ended_ns == 0) ended_ns = steady_ns();
+    if (ended_ns != 0 && (quit_requested || steady_ns() - ended_ns > kLingerAfterEndS * 1e9)) break;
+    const auto t0 = std::chrono::steady_clock::now();
+    int width = kSnapshotWidth, height = kSnapshotHeight;
+    glfwGetFramebufferSize(v.window, &width, &height);
+    const Picture picture = compose_picture(s, v, width, height, fresh, orbit_moved, ended_ns != 0);
+    if (g_screenshot.exchange(false) &&
+        !write_snapshot(v.renderer, s.frame, picture.panes, picture.state, s.stats, ".", s.snapshot)) {
+      exit_code = 1;
+    }
+    v.panels.take_events();
+    v.renderer.draw(s.frame, picture.panes, picture.state, s.stats, width, height,
+                    [&] { v.panels.draw(s.mode, s.reset_orbit); });
+    glfwSwapBuffers(v.window);
+    if (fresh) count_drawn(s, t0);
+  }
+  return exit_code;
+}
+
+// One picture (NO DATA) before the run starts: llvmpipe compiles its shaders at the first draw
+// on every core, which would otherwise starve the run's first frames (a paced run then drops
+// one that no slowness of the pipeline caused).
+void draw_first_picture(LoopState& s, const ViewerParts& v) {
+  int width = kSnapshotWidth, height = kSnapshotHeight;
+  glfwGetFramebufferSize(v.window, &width, &height);
+  const PaneRects rects = window_panes(s.mode, width, height);
+  compose_panes(s, rects, false);
+  const PaneImages panes{s.mode, rects.image_2d.width > 0 ? &s.image : nullptr,
+                         rects.cloud_3d.width > 0 ? &s.cloud : nullptr};
+  v.panels.take_events();
+  v.renderer.draw(s.frame, panes, shown_state(s.frame, steady_ns(), v.max_frame_age_s), s.stats, width, height,
+                  [&] { v.panels.draw(s.mode, s.reset_orbit); });
+  glfwSwapBuffers(v.window);
+}
+
+// The window with an OpenGL 3.3 context and the renderer on it; null (after saying why) when
+// there is no display or no such context.
+GLFWwindow* open_renderer(bool hidden, Renderer& renderer) {
+  GLFWwindow* window = open_window(hidden);
+  if (window == nullptr) return nullptr;
+  std::string gl_error;
+  if (renderer.init(window, gl_error)) return window;
+  renderer.shutdown();
+  glfwDestroyWindow(window);
+  glfwTerminate();
+  std::fprintf(stderr, "hrcsense-view: %s\n", gl_error.c_str());
+  return nullptr;
+}
+
+void log_frame_times(const LoopState& s, const ViewTap& tap) {
+  if (s.frame_times_ms.empty()) return;
+  spdlog::info("viewer: {} frames drawn, {} dropped; frame time p50 {:.2f} ms, p99 {:.2f} ms (compose p50 {:.2f} ms)",
+               s.drawn, tap.dropped(), nearest_rank(s.frame_times_ms, 0.5), nearest_rank(s.frame_times_ms, 0.99),
+               nearest_rank(s.compose_times_ms, 0.5));
+}
+
 int run_viewer(const ViewArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
   const bool snapshots = !args.snapshot_dir.empty();
@@ -311,21 +440,11 @@ int run_viewer(const ViewArgs& args) {
   } else if (!args.snapshot_at.empty()) {
     throw ConfigError("--snapshot-at needs --snapshot DIR");
   }
-  const double max_frame_age_s = config.pipeline.safety.max_frame_age_s;
   const std::optional<PaneMode> pane_mode = parse_pane_mode(args.pane);
   if (!pane_mode) throw ConfigError("--pane: '" + args.pane + "' is not 2d, 3d or split");
-
-  GLFWwindow* window = open_window(snapshots);
-  if (window == nullptr) return kExitNoDisplay;
   Renderer renderer;
-  std::string gl_error;
-  if (!renderer.init(window, gl_error)) {
-    renderer.shutdown();
-    glfwDestroyWindow(window);
-    glfwTerminate();
-    std::fprintf(stderr, "hrcsense-view: %s\n", gl_error.c_str());
-    return kExitNoDisplay;
-  }
+  GLFWwindow* window = open_renderer(snapshots, renderer);
+  if (window == nullptr) return kExitNoDisplay;
 
   ViewTap tap(snapshot_frames);
   ViewSink view_sink(tap);
@@ -335,23 +454,11 @@ int run_viewer(const ViewArgs& args) {
   const bool replay = !snapshots && (config.source.type == "bag" || config.source.type == "folder");
   const app::SessionOptions options = session_options(args, snapshots, tap, view_sink, inbox, replay ? &playback : nullptr);
   Panels panels(PanelContext{args.config_path, args.sets, &inbox, replay ? &playback : nullptr}, config);
+  const ViewerParts parts{args,   window, renderer, tap, panels, replay ? &playback : nullptr,
+                          config.pipeline.safety.max_frame_age_s, steady_ns()};
   LoopState s;
   s.mode = *pane_mode;
-  if (!snapshots) {
-    // One picture (NO DATA) before the run starts: llvmpipe compiles its shaders at the first
-    // draw on every core, which would otherwise starve the run's first frames (a paced run then
-    // drops one that no slowness of the pipeline caused).
-    int width = kSnapshotWidth, height = kSnapshotHeight;
-    glfwGetFramebufferSize(window, &width, &height);
-    const PaneRects rects = window_panes(s.mode, width, height);
-    compose_panes(s, rects, false);
-    const PaneImages panes{s.mode, rects.image_2d.width > 0 ? &s.image : nullptr,
-                           rects.cloud_3d.width > 0 ? &s.cloud : nullptr};
-    panels.take_events();
-    renderer.draw(s.frame, panes, shown_state(s.frame, steady_ns(), max_frame_age_s), s.stats, width, height,
-                  [&] { panels.draw(s.mode, s.reset_orbit); });
-    glfwSwapBuffers(window);
-  }
+  if (!snapshots) draw_first_picture(s, parts);
   std::atomic<bool> session_done{false};
   int session_code = 0;
   std::thread session([&] {
@@ -362,64 +469,16 @@ int run_viewer(const ViewArgs& args) {
     }
     session_done.store(true);
   });
-
-  const int64_t start_ns = steady_ns();
-  int64_t ended_ns = 0;
-  int exit_code = 0;
-  bool quit_requested = false;
-  while (true) {
-    glfwPollEvents();
-    if (g_quit.load() || glfwWindowShouldClose(window)) quit_requested = true;
-    // Asked again every turn: a request made before the run installed its handlers is reset.
-    if (quit_requested && !session_done.load()) app::request_session_stop();
-    const bool orbit_moved = handle_input(replay ? &playback : nullptr, panels, s.mode, s.orbit_ready ? &s.orbit : nullptr);
-    const bool fresh = tap.take(s.frame, 1.0 / 60.0);
-    if (fresh) ++s.serial;
-    if (session_done.load() && ended_ns == 0) ended_ns = steady_ns();
-    if (snapshots && session_done.load() && !fresh) break;
-    if (!snapshots && ended_ns != 0 && (quit_requested || steady_ns() - ended_ns > kLingerAfterEndS * 1e9)) break;
-    const bool take_snapshot = snapshots && fresh && snapshot_frames.count(s.frame.frame) > 0;
-    if (snapshots && !take_snapshot) continue;  // headless: only the listed frames are drawn
-    const auto t0 = std::chrono::steady_clock::now();
-    int width = kSnapshotWidth, height = kSnapshotHeight;
-    if (!snapshots) glfwGetFramebufferSize(window, &width, &height);
-    const PaneRects rects = window_panes(s.mode, width, height);
-    if (fresh && args.slow_render_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(args.slow_render_ms));
-    compose_panes(s, rects, orbit_moved);
-    update_stats(s, tap, replay ? &playback : nullptr, start_ns, ended_ns != 0);
-    // The state when drawn: a result older than max_frame_age_s is NO DATA (a frozen pipeline).
-    const ShownState state = shown_state(s.frame, steady_ns(), max_frame_age_s);
-    const PaneImages panes{s.mode, rects.image_2d.width > 0 ? &s.image : nullptr,
-                           rects.cloud_3d.width > 0 ? &s.cloud : nullptr};
-    if (take_snapshot || (!snapshots && g_screenshot.exchange(false))) {
-      const std::string dir = snapshots ? args.snapshot_dir : std::string(".");
-      if (!write_snapshot(renderer, s.frame, panes, state, s.stats, dir, s.snapshot)) exit_code = 1;
-      if (take_snapshot) tap.rendered(s.frame.frame);
-    }
-    if (!snapshots) {
-      panels.take_events();
-      renderer.draw(s.frame, panes, state, s.stats, width, height, [&] { panels.draw(s.mode, s.reset_orbit); });
-      glfwSwapBuffers(window);
-    }
-    if (fresh) {
-      ++s.drawn;
-      s.frame_times_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    }
-    if (snapshots && tap.snapshots_pending() == 0) break;
-  }
+  int exit_code = snapshots ? snapshot_loop(s, parts, snapshot_frames, session_done) : interactive_loop(s, parts, session_done);
   if (!session_done.load()) app::request_session_stop();
   tap.close();  // a session waiting at a snapshot frame goes on
   session.join();
-  const size_t missing = tap.snapshots_pending();
-  if (snapshots && missing > 0) {
-    spdlog::error("snapshot: {} of the --snapshot-at frames never came (the run ended before them)", missing);
+  if (snapshots && tap.snapshots_pending() > 0) {
+    spdlog::error("snapshot: {} of the --snapshot-at frames never came (the run ended before them)",
+                  tap.snapshots_pending());
     exit_code = 1;
   }
-  if (!s.frame_times_ms.empty()) {
-    spdlog::info("viewer: {} frames drawn, {} dropped; frame time p50 {:.2f} ms, p99 {:.2f} ms (compose p50 {:.2f} ms)",
-                 s.drawn, tap.dropped(), nearest_rank(s.frame_times_ms, 0.5), nearest_rank(s.frame_times_ms, 0.99),
-                 nearest_rank(s.compose_times_ms, 0.5));
-  }
+  log_frame_times(s, tap);
   renderer.shutdown();
   glfwDestroyWindow(window);
   glfwTerminate();

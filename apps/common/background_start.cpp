@@ -2,6 +2,7 @@
 // hrcsense assembly — a run's background at start, and teaching a reference
 // (background_start.hpp).
 #include "common/background_start.hpp"
+#include "common/cell.hpp"
 
 #include "common/assembly.hpp"
 
@@ -80,21 +81,17 @@ BackgroundStart start_background(const Config& config, const SourceInfo& info, P
   return BackgroundStart::loaded;
 }
 
-// run_pipeline itself, unpaced as the source allows, so that the frames, the filters, the
-// robot state at each frame and the learner are a run's; it is stopped as soon as the
-// background is ready.
-TeachResult teach_background(const Config& config, Pipeline& pipeline, int64_t max_frames) {
-  std::unique_ptr<Source> source = make_source(config);
-  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config, *source);
-  const SourceInfo info = source->info();
+// run_pipeline itself, paced as the source says, on the cell a run would assemble (without
+// links or background files), so that the frames, the filters, the robot state at each frame
+// and the learner are a run's; it is stopped as soon as the background is ready.
+TeachResult teach_background(const Config& config, int64_t max_frames) {
   std::atomic<bool> stop{false};
   TeachResult result;
-  result.source = info.description.empty() ? info.type : info.type + ", " + info.description;
-  RunOptions options;
-  options.pace = config.source.pace;
-  options.camera_latency_s = config.robot_state.camera_latency_s;
-  options.max_frames = max_frames;
-  options.stop_requested = &stop;
+  app::CellOptions options;
+  options.frames = max_frames;
+  options.links = false;
+  options.background_files = false;
+  options.follow_link = false;
   // On the processing thread, after each frame: the frame that completed the background ends it.
   options.on_processed = [&](const Frame& frame, const Pipeline& p, const FrameResult&) {
     ++result.frames;
@@ -103,11 +100,17 @@ TeachResult teach_background(const Config& config, Pipeline& pipeline, int64_t m
       stop.store(true);
     }
   };
+  const std::unique_ptr<app::Cell> cell = app::assemble_cell(config, options);
+  cell->run_options.stop_requested = &stop;
+  const SourceInfo info = cell->source->info();
+  result.source = info.description.empty() ? info.type : info.type + ", " + info.description;
   DiscardSink sink;
-  const RunSummary summary = run_pipeline(*source, *robot_states, pipeline, sink, options, make_run_header(config, info));
+  const RunSummary summary =
+      run_pipeline(cell->frames(), *cell->robot_states, *cell->pipeline, sink, cell->run_options, cell->header);
   if (!summary.error.empty()) throw std::runtime_error(summary.error);
-  result.learnt = pipeline.background_ready();
-  result.message = pipeline.background_message();
+  result.learnt = cell->pipeline->background_ready();
+  result.message = cell->pipeline->background_message();
+  if (result.learnt) result.background = cell->pipeline->background();
   return result;
 }
 

@@ -37,13 +37,14 @@ struct TeachResult {
   int64_t last_frame = -1;  ///< index of the frame that completed it
   std::string message;      ///< why learning last restarted, if it did
   std::string source;       ///< the source's description (SourceInfo::description)
+  BackgroundModel background;  ///< the learnt background (empty unless `learnt`)
 };
 
 /// Learns the background from the configured source exactly as a run's pipeline learns it (the
 /// same filters, learner, self-filter and robot states looked up at the source time as an
-/// unpaced run does), reading at most `max_frames` frames (-1: until the source ends), into
-/// `pipeline`, which must have been built from config.pipeline with no background set.
-/// background.path and background.reference are not read.
-TeachResult teach_background(const Config& config, Pipeline& pipeline, int64_t max_frames);
+/// unpaced run does), reading at most `max_frames` frames (-1: until the source ends).
+/// background.path and background.reference are not read; a follow_link arm plays its
+/// trajectory as programmed.
+TeachResult teach_background(const Config& config, int64_t max_frames);
 
 }  // namespace hrcsense

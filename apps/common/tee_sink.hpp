@@ -4,7 +4,6 @@
 
 #include "hrcsense/sink.hpp"
 
-#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -14,7 +13,7 @@ namespace hrcsense::app {
 /// the configuration leaves off) are skipped. The sinks must outlive the tee.
 class TeeSink : public Sink {
  public:
-  TeeSink(std::initializer_list<Sink*> sinks) {
+  explicit TeeSink(const std::vector<Sink*>& sinks) {
     for (Sink* sink : sinks) {
       if (sink != nullptr) sinks_.push_back(sink);
     }

@@ -3,7 +3,7 @@
 // filter), to a RealSense .bag (docs/RECORDINGS.md, "Recording").
 #include "commands.hpp"
 #include "common/app_errors.hpp"
-#include "common/assembly.hpp"
+#include "common/cell.hpp"
 #include "common/record_setup.hpp"
 
 #include "hrcsense/config.hpp"
@@ -37,17 +37,17 @@ int record_command(const CommandArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
   // Before anything is opened: never replace a file unasked, never the source being played.
   check_record_output(config, args.out, args.overwrite);
-  SourceOptions source_options;
-  source_options.stop_requested = &g_record_stop;
-  // A recording keeps what the source has: a folder's or bag's colour frames too.
-  source_options.with_color = true;
-  std::unique_ptr<Source> source = make_source(config, source_options);
-  const SourceInfo info = source->info();
+  CellOptions options;
+  options.measure = false;
+  options.stop_requested = &g_record_stop;
+  options.with_color = true;  // a recording keeps what the source has: a folder's or bag's colour frames too
+  const std::unique_ptr<Cell> cell = assemble_cell(config, options);
+  Source& source = *cell->source;
+  const SourceInfo info = source.info();
   // The robot's joints at each frame go to /hrcsense/joint_states beside it, looked up as an
   // unpaced `hrcsense run` of the configuration would.
-  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config, *source);
   std::unique_ptr<RobotStateSource> recorder_states;
-  const RecordStateLookup lookup = record_state_lookup(config, *source, *robot_states, false, recorder_states);
+  const RecordStateLookup lookup = record_state_lookup(config, source, *cell->robot_states, false, recorder_states);
   Recorder recorder(recorder_params(config, args.out, info));
 
   g_record_stop.store(false);
@@ -58,10 +58,10 @@ int record_command(const CommandArgs& args) {
   std::string source_error;
   const auto duration_ns = static_cast<int64_t>(args.duration_s * 1e9);
   while (!g_record_stop.load() && (args.frames < 0 || frames < args.frames) && !recorder.failed()) {
-    const Source::Status status = source->next(frame);
+    const Source::Status status = source.next(frame);
     if (status == Source::Status::end) break;
     if (status == Source::Status::error) {
-      source_error = source->error();
+      source_error = source.error();
       break;
     }
     if (frames == 0) {

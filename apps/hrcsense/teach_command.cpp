@@ -27,8 +27,7 @@ int teach_command(const CommandArgs& args) {
     spdlog::info("teach: background.path and background.reference are not read; the background is learnt from "
                  "the source");
   }
-  Pipeline pipeline(config.pipeline);
-  const TeachResult taught = teach_background(config, pipeline, args.frames);
+  const TeachResult taught = teach_background(config, args.frames);
   if (!taught.learnt) {
     const std::string why = taught.message.empty() ? "" : "; last restart: " + taught.message;
     const std::string ended = args.frames >= 0 && taught.frames >= args.frames
@@ -42,8 +41,8 @@ int teach_command(const CommandArgs& args) {
   }
   const std::filesystem::path parent = std::filesystem::path(args.out).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);
-  save_background(args.out, pipeline.background());
-  const BackgroundModel& model = pipeline.background();
+  save_background(args.out, taught.background);
+  const BackgroundModel& model = taught.background;
   std::printf("reference background written to %s (%dx%d, learnt by frame %lld); use it with background.reference: %s\n",
               args.out.c_str(), model.width, model.height, static_cast<long long>(taught.last_frame), args.out.c_str());
   std::fflush(stdout);

@@ -53,15 +53,6 @@ struct TimestampCounts {
 };
 
 /// Totals written once at the end.
-/// The recorder's counters over a run (`hrcsense run --record`), apart from the pipeline's own
-/// frames_dropped.
-struct RecordCounters {
-  int64_t frames_recorded = 0;     ///< source frames written to the recording
-  int64_t frames_dropped = 0;      ///< source frames not recorded: the writer's queue was full, or after a write error
-  std::vector<std::string> files;  ///< the files written, in order (several with record.split_mb)
-  std::string error;               ///< the write error, naming the file; empty when none
-};
-
 struct RunSummary {
   int64_t frames_in = 0;          ///< frames read from the source
   int64_t frames_processed = 0;   ///< frames that went through processing
@@ -84,10 +75,6 @@ struct RunSummary {
   RobotStateStats robot_state;    ///< the robot state source's counters
   RobotStatusCounts robot_status; ///< the controller's status over the frames written
   double unknown_background_share = -1.0;  ///< Pipeline::unknown_background_share at the end; < 0: no background
-  std::optional<RecordCounters> record;   ///< the recording's counters; none when the run records nothing
-  /// Frames the viewer (hrcsense-view) never drew, apart from frames_dropped: its mailbox kept
-  /// only the newest; none when no viewer watched the run.
-  std::optional<int64_t> viewer_frames_dropped;
 };
 
 /// A consumer of results. One of the four virtual interfaces of hrcsense (listed at the top of source.hpp).

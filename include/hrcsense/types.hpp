@@ -333,11 +333,6 @@ struct Measurement {
   int64_t seen_ns = 0;
   std::optional<Contact> truth;  ///< simulated sources: ground-truth contact
   std::vector<LinkTruth> truth_links;  ///< simulated sources: GroundTruth::links
-  /// Simulated sources: the truth label's name under the measured contact's source pixel
-  /// (`truth.contact_label`: "static", "robot" or the object's name); null when there is no
-  /// measured contact or nobody set it. The pipeline leaves it alone: the app's truth-label
-  /// sink (apps/common) sets it from the simulator; static text or owned by that sink.
-  const char* truth_contact_label = nullptr;
   double latency_us = 0.0;       ///< from the frame entering processing to the measurement
   /// The robot's distance to the nearest unknown ray (docs/SAFETY.md), m; NaN: none known.
   float unknown_distance_m = std::numeric_limits<float>::quiet_NaN();

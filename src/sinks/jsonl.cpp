@@ -176,13 +176,13 @@ void put_robot_status(Members& m, const RobotStatus& status, bool announced) {
 }
 
 // `truth`: the simulator's exact contact and per-link distances; absent for other sources.
-void put_truth(Members& m, const FrameResult& result) {
+void put_truth(Members& m, const FrameResult& result, const char* contact_label) {
   if (!result.truth) return;
   m.open("truth");
   m.number_or_null("distance_m", result.truth->valid, result.truth->distance_m);
   m.point_or_null("closest_base", result.truth->valid, result.truth->closest_base);
-  if (result.truth_contact_label != nullptr) {
-    m.text("contact_label", result.truth_contact_label);
+  if (contact_label != nullptr) {
+    m.text("contact_label", contact_label);
   } else {
     m.null("contact_label");
   }
@@ -310,7 +310,8 @@ void JsonLinesSink::frame(const FrameResult& result) {
   m.open("timings_us");
   for (const StageTiming& timing : result.timings) m.number(timing.stage, timing.us);
   m.close();
-  put_truth(m, result);
+  const bool labelled = result.truth && result.contact.valid && extras_.contact_label;
+  put_truth(m, result, labelled ? extras_.contact_label(result) : nullptr);
   line_ += "}\n";
   write_line();
 }
@@ -319,12 +320,13 @@ void JsonLinesSink::summary(const RunSummary& summary) {
   line_.assign("{");
   Members m{line_};
   m.text("type", "summary");
+  const AppCounters app = extras_.app_counters ? extras_.app_counters() : AppCounters{};
   m.integer("frames_in", summary.frames_in);
   m.integer("frames_processed", summary.frames_processed);
   m.integer("frames_dropped", summary.frames_dropped);
   m.integer("frames_dropped_camera", summary.frames_dropped_camera);
-  if (summary.viewer_frames_dropped) {
-    m.integer("viewer_frames_dropped", *summary.viewer_frames_dropped);
+  if (app.viewer_frames_dropped) {
+    m.integer("viewer_frames_dropped", *app.viewer_frames_dropped);
   } else {
     m.null("viewer_frames_dropped");
   }
@@ -349,7 +351,7 @@ void JsonLinesSink::summary(const RunSummary& summary) {
   m.number_or_null("unknown_background_share", summary.unknown_background_share >= 0.0,
                    summary.unknown_background_share);
   put_robot_state_counters(m, summary.robot_state, summary.robot_status);
-  put_record_counters(m, summary.record);
+  put_record_counters(m, app.record);
   line_ += "}\n";
   write_line();
 }

@@ -99,11 +99,10 @@ class BackgroundReference : public ::testing::Test {
   // The reference, taught once from the empty cell through hrcsense teach's own path.
   static void SetUpTestSuite() {
     const Config empty = standing_person_cell(false);
-    Pipeline pipeline(empty.pipeline);
-    const TeachResult taught = teach_background(empty, pipeline, -1);
+    const TeachResult taught = teach_background(empty, -1);
     ASSERT_TRUE(taught.learnt);
     EXPECT_EQ(taught.last_frame, kLearningFrames - 1);
-    reference_ = new BackgroundModel(pipeline.background());
+    reference_ = new BackgroundModel(taught.background);
   }
   static void TearDownTestSuite() {
     delete reference_;

@@ -2,9 +2,9 @@
 // Tests of the simulator's moving arm (robot.trajectory) on config/cell-ur5-moving.yaml: the
 // scene's timeline from the simulator's own truth, the arm's label and motion, the tool speed,
 // the truth contact against the arm's searched capsules at each frame's time, and
-// truth.contact_label (label_at, source_pixel_of, TruthLabelSink).
+// truth.contact_label (label_at, source_pixel_of, TruthLabeller).
 #include "common/assembly.hpp"
-#include "common/truth_label_sink.hpp"
+#include "common/truth_labeller.hpp"
 #include "hrcsense/camera.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/sim.hpp"
@@ -196,30 +196,18 @@ TEST(SourceBlockOf, MapsADecimatedPixelToItsBlock) {
   EXPECT_TRUE(source_block_of(424 * 240, filtered, source).empty());
 }
 
-/// Keeps the last frame result it was given.
-struct LastResultSink : Sink {
-  FrameResult last;
-  std::string label;
-  void header(const RunHeader&) override {}
-  void frame(const FrameResult& result) override {
-    last = result;
-    label = result.truth_contact_label ? result.truth_contact_label : "(null)";
-  }
-  void summary(const RunSummary&) override {}
-};
+std::string label_text(const char* label) { return label != nullptr ? label : "(null)"; }
 
-TEST(TruthLabelSink, NamesTheObjectUnderTheMeasuredContact) {
+TEST(TruthLabeller, NamesTheObjectUnderTheMeasuredContact) {
   const Config config = moving_cell();
   const Simulator sim = make_simulator(config);
   Frame frame;
   sim.render(250, frame);
   const Intrinsics in = sim.intrinsics();
-  LastResultSink out;
-  TruthLabelSink sink(make_simulator(config), out);
   RunHeader header;
   header.source.intrinsics = in;
   header.filters.intrinsics = in;
-  sink.header(header);
+  const TruthLabeller labeller(make_simulator(config), header);
   FrameResult result;
   result.frame = 250;
   result.truth = frame.truth->contact;
@@ -229,27 +217,23 @@ TEST(TruthLabelSink, NamesTheObjectUnderTheMeasuredContact) {
     ASSERT_NE(it, frame.truth->labels.end());
     result.contact.valid = true;
     result.contact.pixel = static_cast<int>(it - frame.truth->labels.begin());
-    sink.frame(result);
-    EXPECT_EQ(out.label, label == kStaticLabel ? "static" : label == kRobotLabel ? "robot" : "person");
+    EXPECT_EQ(label_text(labeller.contact_label(result)), label == kStaticLabel ? "static" : label == kRobotLabel ? "robot" : "person");
   }
   result.contact.valid = false;  // no measured contact: no label
-  sink.frame(result);
-  EXPECT_EQ(out.label, "(null)");
+  EXPECT_EQ(label_text(labeller.contact_label(result)), "(null)");
 }
 
 // A decimated pixel on the edge between the arm and a person: its label is that of the block's
 // source pixel whose true depth is nearest the measured one, whichever pixel comes first.
-TEST(TruthLabelSink, OnAnEdgeNamesTheSurfaceAtTheMeasuredDepth) {
+TEST(TruthLabeller, OnAnEdgeNamesTheSurfaceAtTheMeasuredDepth) {
   const Config config = moving_cell();
   const Simulator sim = make_simulator(config);
   const Intrinsics in = sim.intrinsics();
   const Intrinsics filtered = decimated_by_two(in);
-  LastResultSink out;
-  TruthLabelSink sink(make_simulator(config), out);
   RunHeader header;
   header.source.intrinsics = in;
   header.filters.intrinsics = filtered;
-  sink.header(header);
+  const TruthLabeller labeller(make_simulator(config), header);
   int edges = 0;
   for (const int64_t index : {250, 283, 300}) {
     Frame frame;
@@ -271,11 +255,9 @@ TEST(TruthLabelSink, OnAnEdgeNamesTheSurfaceAtTheMeasuredDepth) {
         result.contact.valid = true;
         result.contact.pixel = (v / 2) * filtered.width + u / 2;
         result.contact.closest_camera.z() = person_z + 0.003F;  // measured with a little noise
-        sink.frame(result);
-        EXPECT_EQ(out.label, "person") << index << " " << u << "," << v;
+        EXPECT_EQ(label_text(labeller.contact_label(result)), "person") << index << " " << u << "," << v;
         result.contact.closest_camera.z() = robot_z - 0.003F;
-        sink.frame(result);
-        EXPECT_EQ(out.label, "robot") << index << " " << u << "," << v;
+        EXPECT_EQ(label_text(labeller.contact_label(result)), "robot") << index << " " << u << "," << v;
       }
     }
   }

@@ -187,6 +187,31 @@ TEST(JsonLinesSink, FrameWithContactHasEveryField) {
   EXPECT_EQ(f["robot_state_age_ms"].get<double>(), 3.5);
 }
 
+// truth.contact_label is the extras' answer, asked only for a frame with a truth and a measured
+// contact; without a labeller (any source but the simulator) it is null.
+TEST(JsonLinesSink, ContactLabelComesFromTheExtrasOnlyForAMeasuredContact) {
+  std::ostringstream out;
+  int asked = 0;
+  JsonLinesExtras extras;
+  extras.contact_label = [&asked](const FrameResult&) {
+    ++asked;
+    return "person";
+  };
+  JsonLinesSink labelled(out, "brute", extras);
+  FrameResult r = contact_result();
+  labelled.frame(r);
+  r.contact.valid = false;
+  labelled.frame(r);
+  JsonLinesSink plain(out);
+  plain.frame(contact_result());
+  const std::vector<json> lines = parse_lines(out.str());
+  ASSERT_EQ(lines.size(), 3U);
+  EXPECT_EQ(lines[0]["truth"]["contact_label"], "person");
+  EXPECT_TRUE(lines[1]["truth"]["contact_label"].is_null());
+  EXPECT_TRUE(lines[2]["truth"]["contact_label"].is_null());
+  EXPECT_EQ(asked, 1);
+}
+
 TEST(JsonLinesSink, FrameWithoutContactWritesNulls) {
   std::ostringstream out;
   JsonLinesSink sink(out);
@@ -435,13 +460,16 @@ TEST(JsonLinesSink, NoRobotStatusKeyForSourcesWithoutOne) {
 // frames_dropped; null when the run recorded nothing.
 TEST(JsonLinesSink, SummaryHasTheRecordersCountersOrNull) {
   std::ostringstream out;
-  JsonLinesSink sink(out);
+  AppCounters app;  // what the extras report at each summary
+  JsonLinesExtras extras;
+  extras.app_counters = [&app] { return app; };
+  JsonLinesSink sink(out, "brute", extras);
   RunSummary summary;
   summary.frames_dropped = 2;
   sink.summary(summary);
-  summary.record = RecordCounters{297, 3, {"rec/a-000.bag", "rec/\"b\"-001.bag"}, ""};
+  app.record = RecordCounters{297, 3, {"rec/a-000.bag", "rec/\"b\"-001.bag"}, ""};
   sink.summary(summary);
-  summary.record->error = "rec/a-001.bag: write failed at byte 5: No space left on device";
+  app.record->error = "rec/a-001.bag: write failed at byte 5: No space left on device";
   sink.summary(summary);
   const std::vector<json> lines = parse_lines(out.str());
   ASSERT_EQ(lines.size(), 3U);

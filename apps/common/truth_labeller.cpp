@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense assembly — `truth.contact_label`: the simulated object under the measured contact.
-#include "common/truth_label_sink.hpp"
+#include "common/truth_labeller.hpp"
 
 #include "hrcsense/camera.hpp"
 
@@ -37,18 +37,14 @@ SourceBlock source_block_of(int filtered_pixel, const Intrinsics& filtered, cons
   return block;
 }
 
-void TruthLabelSink::header(const RunHeader& header) {
-  source_ = header.source.intrinsics;
-  filtered_ = header.filters.intrinsics.width > 0 ? header.filters.intrinsics : header.source.intrinsics;
-  sink_.header(header);
-}
+TruthLabeller::TruthLabeller(Simulator simulator, const RunHeader& header)
+    : sim_(std::move(simulator)),
+      source_(header.source.intrinsics),
+      filtered_(header.filters.intrinsics.width > 0 ? header.filters.intrinsics : header.source.intrinsics) {}
 
-void TruthLabelSink::frame(const FrameResult& result) {
-  if (!result.truth || !result.contact.valid) {
-    sink_.frame(result);
-    return;
-  }
-  labelled_ = result;
+const char* TruthLabeller::contact_label(const FrameResult& result) const {
+  if (!result.truth || !result.contact.valid) return nullptr;
+  const char* label = nullptr;
   const SourceBlock block = source_block_of(result.contact.pixel, filtered_, source_);
   const float measured_z_m = result.contact.closest_camera.z();
   float best_gap_m = std::numeric_limits<float>::infinity();
@@ -60,11 +56,11 @@ void TruthLabelSink::frame(const FrameResult& result) {
       if (gap_m < best_gap_m) {
         best_gap_m = gap_m;
         const std::string& name = sim_.label_name(hit.label);
-        labelled_.truth_contact_label = name.empty() ? nullptr : name.c_str();
+        label = name.empty() ? nullptr : name.c_str();
       }
     }
   }
-  sink_.frame(labelled_);
+  return label;
 }
 
 }  // namespace hrcsense

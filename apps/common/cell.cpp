@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense apps — the assembled cell (cell.hpp).
+#include "common/cell.hpp"
+
+#include "common/record_setup.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <utility>
+
+namespace hrcsense::app {
+namespace {
+
+// A live source that could not start: the run's one event is its error.
+class UnstartedSource final : public Source {
+ public:
+  UnstartedSource(std::string type, std::string error) : error_(std::move(error)) {
+    info_.type = std::move(type);
+    info_.live = true;
+    info_.frame_count = -1;
+  }
+  SourceInfo info() const override { return info_; }
+  Status next(Frame&) override { return Status::error; }
+  std::string error() const override { return error_; }
+
+ private:
+  SourceInfo info_;
+  std::string error_;
+};
+
+bool is_recording(const Config& config) { return config.source.type == "bag" || config.source.type == "folder"; }
+
+// The source and the robot states it brings or needs (a bag's joint states), wrapped for a
+// viewer's playback when asked.
+void open_source(Cell& cell, const Config& config, const CellOptions& options, bool paced) {
+  SourceOptions source_options;
+  source_options.stop_requested = options.stop_requested;
+  // A recording keeps the source's colour, so --record decodes it even where processing does not.
+  source_options.with_color = options.with_color || !options.record.empty();
+  if (options.measure && options.follow_link) cell.trajectory_clock = make_trajectory_clock(config);
+  if (cell.trajectory_clock) cell.trajectory_clock->set_lockstep(!paced);
+  source_options.trajectory_clock = cell.trajectory_clock;
+  try {
+    cell.source = make_source(config, source_options);
+  } catch (const SourceStartError& e) {
+    cell.source = std::make_unique<UnstartedSource>(config.source.type, e.what());
+    cell.source_started = false;
+  }
+  cell.robot_states = make_robot_state_source(config, *cell.source, nullptr, cell.trajectory_clock);
+  if (options.wrap_recording && is_recording(config)) {
+    // The robot states may come from the first source: the wrapper keeps it alive.
+    cell.source = options.wrap_recording(std::move(cell.source),
+                                         [config, source_options] { return make_source(config, source_options); });
+  }
+}
+
+// --record: the source's frames, as delivered, to a bag on a writer thread (never blocking),
+// each with the robot state processing measures it against.
+void add_recording(Cell& cell, const Config& config, const CellOptions& options, bool paced) {
+  RecorderParams params = recorder_params(config, options.record, cell.source->info());
+  const RecordOnError on_error = params.on_error;
+  cell.recorder = std::make_unique<Recorder>(std::move(params));
+  RecordStateLookup lookup = record_state_lookup(config, *cell.source, *cell.robot_states, paced,
+                                                 cell.recorder_states, cell.trajectory_clock);
+  lookup.from_processing = true;  // the state each frame was measured against (run_options below)
+  cell.recording = std::make_unique<RecordingSource>(*cell.source, *cell.recorder, on_error, lookup);
+}
+
+// The controller's links, first among the sinks, so that no file or console write delays them.
+void add_links(Cell& cell, const Config& config) {
+  cell.udp_link = make_udp_link_sink(config);
+  if (cell.udp_link) {
+    spdlog::info("link: verdicts to {} ({}, heartbeat {} Hz)", cell.udp_link->address(), config.link.udp_format,
+                 config.link.heartbeat_hz);
+  }
+  cell.rtde_link = make_rtde_link_sink(config);
+  if (cell.rtde_link) {
+    spdlog::info("link: speed scale to RTDE {}:{} ({})", config.robot_state.host, config.robot_state.port,
+                 cell.rtde_link->input_names());
+  }
+}
+
+RunOptions run_options(const Config& config, const CellOptions& options, Cell& cell, bool paced) {
+  RunOptions run;
+  run.pace = paced;
+  run.camera_latency_s = config.robot_state.camera_latency_s;
+  run.max_frames = options.frames;
+  // A source that never started has nothing to stop: its error, not the signal that ended the
+  // wait, is how the run ends.
+  run.stop_requested = cell.source_started ? options.stop_requested : nullptr;
+  run.before_process = options.before_process;
+  run.on_processed = options.on_processed;
+  if (cell.recorder) {
+    // The recording holds the state processing used, so its replay decides as this run did.
+    Recorder* recorder = cell.recorder.get();
+    run.on_processed = [recorder, tap = options.on_processed](const Frame& frame, const Pipeline& pipeline,
+                                                              const FrameResult& result) {
+      recorder->state_used(frame.index, result.robot_state);
+      if (tap) tap(frame, pipeline, result);
+    };
+  }
+  return run;
+}
+
+}  // namespace
+
+std::unique_ptr<Cell> assemble_cell(const Config& config, const CellOptions& options) {
+  const bool paced = config.source.pace && !options.unpaced;
+  auto cell = std::make_unique<Cell>();
+  open_source(*cell, config, options, paced);
+  if (!options.measure) return cell;
+  const SourceInfo info = cell->source->info();
+  if (!options.record.empty()) add_recording(*cell, config, options, paced);
+  cell->pipeline = std::make_unique<Pipeline>(config.pipeline);
+  if (options.background_files) cell->background = start_background(config, info, *cell->pipeline);
+  if (options.links) add_links(*cell, config);
+  // follow_link: the simulated arm takes the scale the links have just sent.
+  if (cell->trajectory_clock) cell->follow = std::make_unique<FollowLinkSink>(cell->trajectory_clock);
+  // Simulated runs: truth.contact_label from the simulator's own labels.
+  if (config.source.type == "sim") cell->truth.emplace(make_simulator(config, cell->trajectory_clock));
+  cell->header = make_run_header(config, info);
+  cell->header.unknown_background_share = cell->pipeline->unknown_background_share();  // a loaded background's
+  if (!cell->header.filters.note.empty()) spdlog::warn("filters: {}", cell->header.filters.note);
+  cell->run_options = run_options(config, options, *cell, paced);
+  return cell;
+}
+
+}  // namespace hrcsense::app
