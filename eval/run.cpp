@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — one evaluation run (eval_run.hpp).
-#include "common/eval_run.hpp"
+// hrcsense — one evaluation run (eval/run.hpp).
+#include "hrcsense/eval/run.hpp"
 
 #include "common/assembly.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/sink.hpp"
 
-namespace hrcsense::app {
+namespace hrcsense::eval {
 namespace {
 
 std::array<double, 3> point_of(const Eigen::Vector3f& p) { return {p.x(), p.y(), p.z()}; }
@@ -67,4 +67,4 @@ EvalRun run_eval(const Config& config, int64_t max_frames, std::atomic<int64_t>*
   return run;
 }
 
-}  // namespace hrcsense::app
+}  // namespace hrcsense::eval
