@@ -1,232 +1,34 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense CLI — `hrcsense verify-filters CASES_JSON [--shared DIR]`: runs every case of a
 // golden file made by the real RealSense SDK (data/sdk_filter_goldens format) through
-// hrcsense's filters and compares every output value for value.
+// hrcsense's filters and compares every output value for value (verify_filter_goldens,
+// hrcsense/eval/goldens.hpp), then prints one line per case and the count of bit-exact ones.
 #include "common/app_errors.hpp"
 #include "commands.hpp"
 
-#include "hrcsense/filters.hpp"
-#include "hrcsense/io.hpp"
+#include "hrcsense/eval/goldens.hpp"
 
-#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
-#include <algorithm>
-#include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <stdexcept>
 #include <string>
-#include <vector>
 
 namespace hrcsense::app {
 namespace {
 
-using nlohmann::json;
-namespace fs = std::filesystem;
-
-// A case as it runs: the chain, where a disparity tap is taken, and the frames.
-struct GoldenCase {
-  std::string name;
-  FilterChainParams chain;
-  int tap_after = -1;  ///< index in chain.order after which the "save" tap is taken; -1 none
-  Intrinsics intrinsics;
-  float depth_scale_m = 0.001F;
-  float baseline_mm = 0.0F;
-  std::vector<std::string> inputs;  ///< absolute paths
-  json crop;                        ///< null or {x, y, width, height}
-};
-
-// Per-case comparison totals.
-struct Difference {
-  size_t pixels = 0;        ///< values that differ
-  double largest = 0.0;     ///< largest absolute difference
-  std::string problem;      ///< a size or intrinsics mismatch, or a missing output
-};
-
-[[noreturn]] void bad_case(const std::string& name, const std::string& what) {
-  throw std::runtime_error("case '" + name + "': " + what);
-}
-
-void read_block_options(const std::string& name, const json& step, FilterChainParams& chain) {
-  const std::string filter = step.at("filter").get<std::string>();
-  const json options = step.value("options_friendly", json::object());
-  const auto block = filter_block_from_name(filter);
-  if (!block) bad_case(name, "unknown filter '" + filter + "'");
-  chain.order.push_back(*block);
-  // Integer options truncate, as the SDK's uint8 options do.
-  switch (*block) {
-    case FilterBlock::threshold:
-      chain.threshold.min_m = options.value("min", chain.threshold.min_m);
-      chain.threshold.max_m = options.value("max", chain.threshold.max_m);
-      break;
-    case FilterBlock::decimation:
-      chain.decimation.magnitude = static_cast<int>(options.value("magnitude", 2.0));
-      break;
-    case FilterBlock::spatial:
-      chain.spatial.alpha = options.value("alpha", chain.spatial.alpha);
-      chain.spatial.delta = static_cast<int>(options.value("delta", 20.0));
-      chain.spatial.magnitude = static_cast<int>(options.value("magnitude", 2.0));
-      chain.spatial.holes_fill = static_cast<int>(options.value("holes_fill", 0.0));
-      break;
-    case FilterBlock::temporal:
-      chain.temporal.alpha = options.value("alpha", chain.temporal.alpha);
-      chain.temporal.delta = static_cast<int>(options.value("delta", 20.0));
-      chain.temporal.persistence = static_cast<int>(options.value("persistence", 3.0));
-      break;
-    case FilterBlock::hole_filling:
-      chain.hole_filling.mode = static_cast<int>(options.value("mode", 1.0));
-      break;
-    case FilterBlock::to_disparity:
-    case FilterBlock::to_depth:
-      break;
-  }
-}
-
-GoldenCase parse_case(const json& item, const fs::path& shared_dir) {
-  GoldenCase c;
-  c.name = item.at("name").get<std::string>();
-  for (const json& step : item.at("chain")) {
-    if (step.at("filter").get<std::string>() == "save") {
-      c.tap_after = static_cast<int>(c.chain.order.size()) - 1;
-      continue;
-    }
-    read_block_options(c.name, step, c.chain);
-  }
-  const std::string order_problem = check_filter_order(c.chain.order);
-  if (!order_problem.empty()) bad_case(c.name, order_problem);
-  const json& si = item.at("stream_intrinsics");
-  c.intrinsics.width = si.at("width").get<int>();
-  c.intrinsics.height = si.at("height").get<int>();
-  c.intrinsics.fx = si.at("fx").get<float>();
-  c.intrinsics.fy = si.at("fy").get<float>();
-  c.intrinsics.ppx = si.at("ppx").get<float>();
-  c.intrinsics.ppy = si.at("ppy").get<float>();
-  c.intrinsics.model = Distortion::brown_conrady;
-  c.depth_scale_m = item.at("depth_units").get<float>();
-  c.baseline_mm = item.value("stereo_baseline_mm", 0.0F);
-  for (const json& input : item.at("inputs")) c.inputs.push_back((shared_dir / input.get<std::string>()).string());
-  c.crop = item.value("crop", json());
-  return c;
-}
-
-// Reads input `path` into frame.depth, cropped as the case says.
-void load_input(const GoldenCase& c, const std::string& path, DepthImage& scratch, Frame& frame) {
-  read_depth_png(path, scratch);
-  int x = 0, y = 0, w = scratch.width, h = scratch.height;
-  if (!c.crop.is_null()) {
-    x = c.crop.at("x").get<int>();
-    y = c.crop.at("y").get<int>();
-    w = c.crop.at("width").get<int>();
-    h = c.crop.at("height").get<int>();
-    if (x < 0 || y < 0 || x + w > scratch.width || y + h > scratch.height) bad_case(c.name, "crop outside " + path);
-  }
-  if (w != c.intrinsics.width || h != c.intrinsics.height) {
-    bad_case(c.name, path + " is " + std::to_string(w) + "x" + std::to_string(h) + " after cropping; intrinsics say " +
-                         std::to_string(c.intrinsics.width) + "x" + std::to_string(c.intrinsics.height));
-  }
-  frame.depth.depth_scale_m = c.depth_scale_m;
-  frame.depth.resize(w, h);
-  for (int v = 0; v < h; ++v) {
-    const uint16_t* src = scratch.pixels.data() + static_cast<size_t>(v + y) * scratch.width + x;
-    std::copy(src, src + w, frame.depth.pixels.data() + static_cast<size_t>(v) * w);
-  }
-  frame.intrinsics = c.intrinsics;
-  frame.stereo_baseline_mm = c.baseline_mm;
-}
-
-std::vector<float> read_f32(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot open");
-  in.seekg(0, std::ios::end);
-  const auto bytes = static_cast<size_t>(in.tellg());
-  in.seekg(0);
-  std::vector<float> values(bytes / sizeof(float));
-  in.read(reinterpret_cast<char*>(values.data()), static_cast<std::streamsize>(values.size() * sizeof(float)));
-  return values;
-}
-
-template <typename T>
-void compare(const std::vector<T>& ours, const std::vector<T>& sdk, Difference& diff) {
-  for (size_t i = 0; i < ours.size(); ++i) {
-    // Bit-level equality for floats too (a NaN or -0 in the golden must be reproduced).
-    if (std::memcmp(&ours[i], &sdk[i], sizeof(T)) == 0) continue;
-    ++diff.pixels;
-    diff.largest = std::max(diff.largest, std::fabs(static_cast<double>(ours[i]) - static_cast<double>(sdk[i])));
-  }
-}
-
-bool close_to(float ours, double sdk) { return std::fabs(static_cast<double>(ours) - sdk) <= 1e-5 * std::fabs(sdk) + 1e-6; }
-
-// Compares one golden output with what the chain produced for its frame.
-void check_output(const json& output, const fs::path& golden_dir, const Frame& frame, const DisparityImage* tap,
-                  Difference& diff) {
-  const std::string file = (golden_dir / output.at("file").get<std::string>()).string();
-  const int w = output.at("width").get<int>();
-  const int h = output.at("height").get<int>();
-  if (output.at("format").get<std::string>() == "DISPARITY32") {
-    if (tap == nullptr || tap->width != w || tap->height != h) {
-      diff.problem = "no disparity tap of " + std::to_string(w) + "x" + std::to_string(h);
-      return;
-    }
-    const std::vector<float> sdk = read_f32(file);
-    if (sdk.size() != tap->pixels.size()) throw std::runtime_error(file + ": expected " + std::to_string(w * h) + " floats");
-    return compare(tap->pixels, sdk, diff);
-  }
-  if (frame.depth.width != w || frame.depth.height != h) {
-    diff.problem = "size " + std::to_string(frame.depth.width) + "x" + std::to_string(frame.depth.height) +
-                   ", SDK " + std::to_string(w) + "x" + std::to_string(h);
-    return;
-  }
-  const json& in = output.at("intrinsics");
-  if (!close_to(frame.intrinsics.fx, in.at("fx").get<double>()) || !close_to(frame.intrinsics.fy, in.at("fy").get<double>()) ||
-      !close_to(frame.intrinsics.ppx, in.at("ppx").get<double>()) ||
-      !close_to(frame.intrinsics.ppy, in.at("ppy").get<double>())) {
-    diff.problem = "intrinsics differ";
-  }
-  DepthImage sdk;
-  read_depth_png(file, sdk);
-  if (sdk.width != w || sdk.height != h) throw std::runtime_error(file + ": size differs from cases.json");
-  compare(frame.depth.pixels, sdk.pixels, diff);
-}
-
-// Runs one case; returns its stdout line.
-std::string run_case(const json& item, const fs::path& shared_dir, const fs::path& golden_dir) {
-  const GoldenCase c = parse_case(item, shared_dir);
-  FilterChain chain;
-  chain.params = c.chain;
-  Frame input, output;
-  DepthImage scratch;
-  DisparityImage tap;
-  Difference diff;
-  size_t outputs_checked = 0;
-  for (size_t f = 0; f < c.inputs.size(); ++f) {
-    load_input(c, c.inputs[f], scratch, input);
-    input.index = static_cast<int64_t>(f);
-    chain.start(input, output);
-    for (size_t b = 0; b < chain.block_count(); ++b) {
-      chain.run_block(b, output);
-      if (static_cast<int>(b) == c.tap_after) tap = chain.disparity();
-    }
-    for (const json& out : item.at("outputs")) {
-      if (out.at("frame_index").get<size_t>() != f) continue;
-      const bool is_tap = out.at("format").get<std::string>() == "DISPARITY32";
-      check_output(out, golden_dir, output, is_tap && c.tap_after >= 0 ? &tap : nullptr, diff);
-      ++outputs_checked;
-    }
-  }
-  if (outputs_checked != item.at("outputs").size()) diff.problem = "outputs for frames that have no input";
+// A case's stdout line: "NAME: match (K outputs)", "NAME: DIFFERENT (…)" or "NAME: ERROR (…)".
+// Other tools read these lines: their text stays as it is.
+std::string case_line(const eval::GoldenCaseResult& c) {
+  if (!c.error.empty()) return c.name + ": ERROR (" + c.error + ")";
   char text[160];
-  if (!diff.problem.empty()) {
+  if (!c.problem.empty()) {
     std::snprintf(text, sizeof text, "%s: DIFFERENT (%s; %zu values differ, largest difference %g)", c.name.c_str(),
-                  diff.problem.c_str(), diff.pixels, diff.largest);
-  } else if (diff.pixels > 0) {
+                  c.problem.c_str(), c.values_differing, c.largest_difference);
+  } else if (c.values_differing > 0) {
     std::snprintf(text, sizeof text, "%s: DIFFERENT (%zu values differ, largest difference %g)", c.name.c_str(),
-                  diff.pixels, diff.largest);
+                  c.values_differing, c.largest_difference);
   } else {
-    std::snprintf(text, sizeof text, "%s: match (%zu outputs)", c.name.c_str(), outputs_checked);
+    std::snprintf(text, sizeof text, "%s: match (%zu outputs)", c.name.c_str(), c.outputs_checked);
   }
   return text;
 }
@@ -234,37 +36,22 @@ std::string run_case(const json& item, const fs::path& shared_dir, const fs::pat
 }  // namespace
 
 int verify_filters_command(const CommandArgs& args) {
-  std::ifstream file(args.input);
-  if (!file) return report_error(args.input + ": cannot open cases file", kExitUsage);
-  json root;
+  const std::string shared_dir = args.shared.empty() ? "../shared" : args.shared;
+  eval::GoldenReport report;
   try {
-    root = json::parse(file);
-  } catch (const json::exception& e) {
-    return report_error(args.input + ": not valid JSON: " + e.what(), kExitUsage);
+    report = eval::verify_filter_goldens(args.input, shared_dir);
+  } catch (const eval::GoldenFileError& e) {
+    return report_error(e.what(), kExitUsage);
   }
-  if (!root.contains("cases") || !root.at("cases").is_array()) {
-    return report_error(args.input + ": expected a \"cases\" array", kExitUsage);
+  for (const eval::GoldenCaseResult& c : report.cases) {
+    if (!c.error.empty()) spdlog::error("{}: {}", args.input, c.error);
+    std::printf("%s\n", case_line(c).c_str());
   }
-  const fs::path golden_dir = fs::path(args.input).parent_path();
-  const fs::path shared_dir = args.shared.empty() ? fs::path("../shared") : fs::path(args.shared);
-  const json& cases = root.at("cases");
-  size_t exact = 0;
-  for (const json& item : cases) {
-    std::string line;
-    try {
-      line = run_case(item, shared_dir, golden_dir);
-    } catch (const std::exception& e) {
-      // One broken case (a missing input, a bad option) is reported and the others still run.
-      spdlog::error("{}: {}", args.input, e.what());
-      line = item.value("name", std::string("<unnamed>")) + ": ERROR (" + e.what() + ")";
-    }
-    if (line.find(": match") != std::string::npos) ++exact;
-    std::printf("%s\n", line.c_str());
-  }
-  std::printf("%zu/%zu cases bit-exact\n", exact, cases.size());
+  const size_t exact = report.bit_exact();
+  std::printf("%zu/%zu cases bit-exact\n", exact, report.cases.size());
   std::fflush(stdout);
-  spdlog::info("{}: {} of {} cases bit-exact", args.input, exact, cases.size());
-  return exact == cases.size() ? 0 : kExitRuntime;
+  spdlog::info("{}: {} of {} cases bit-exact", args.input, exact, report.cases.size());
+  return exact == report.cases.size() ? 0 : kExitRuntime;
 }
 
 }  // namespace hrcsense::app

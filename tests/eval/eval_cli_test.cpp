@@ -6,7 +6,7 @@
 // named.
 
 #include "../support/run_cli.hpp"
-#include "hrcsense/eval_sweep.hpp"
+#include "hrcsense/eval/sweep.hpp"
 
 #include <gtest/gtest.h>
 

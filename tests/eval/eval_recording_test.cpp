@@ -6,7 +6,7 @@
 // points (base frame), and how many lie more than 1 m and 0.1 m from it.
 
 #include "../support/run_cli.hpp"
-#include "hrcsense/eval_sweep.hpp"
+#include "hrcsense/eval/sweep.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

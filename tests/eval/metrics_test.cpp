@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
-// The evaluation harness's metrics (eval_metrics.hpp) on short hand-made runs whose expected
+// The evaluation harness's metrics (eval/metrics.hpp) on short hand-made runs whose expected
 // values are worked by hand beside each check: instability against truth and against the
 // median, the MSE over the whole run and the thesis's windows, the distance error, latency
 // percentiles and Z_d coverage, with their edge cases (empty runs, the strict threshold,
 // misses, failed measurements, even counts, nearest ranks). Coordinates are small binary
 // fractions, so most results are exact.
 
-#include "hrcsense/eval_metrics.hpp"
+#include "hrcsense/eval/metrics.hpp"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // `hrcsense eval`'s sweeps (parse_sweep, sweep_grid) and its resumable results.csv
 // (csv_field, split_csv_line, resume_results), against values written out by hand.
 
-#include "hrcsense/eval_sweep.hpp"
+#include "hrcsense/eval/sweep.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense CLI — eval's figures through gnuplot (eval_plots.hpp).
-#include "eval_plots.hpp"
+// hrcsense — eval's figures through gnuplot (eval/plots.hpp).
+#include "hrcsense/eval/plots.hpp"
 
 #include <fcntl.h>
 #include <sys/wait.h>
@@ -15,7 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace hrcsense::app {
+namespace hrcsense::eval {
 namespace {
 
 // Text inside a gnuplot double-quoted string: no double quotes, no backslashes.
@@ -176,4 +176,4 @@ std::vector<std::string> sweep_plots(const ResultTable& table, const std::vector
   return written;
 }
 
-}  // namespace hrcsense::app
+}  // namespace hrcsense::eval

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense CLI — Table 4.4 of `hrcsense eval --study`: each search backend's rate against the
+// hrcsense — Table 4.4 of `hrcsense eval --study`: each search backend's rate against the
 // size of the foreground cloud, 10^2 … 10^6 points. The simulator tops out at 921,600 pixels,
 // so the clouds are the synthetic person of person_cloud.hpp and the robot is the thesis's
 // single point beside it. The timing is of the search stage alone (tree build included, as the
 // cloud is new every frame): the median of five serial repetitions.
-#include "eval_studies.hpp"
+#include "hrcsense/eval/studies.hpp"
 #include "hrcsense/person_cloud.hpp"
 #include "hrcsense/proximity.hpp"
 
@@ -16,7 +16,7 @@
 #include <fstream>
 #include <sstream>
 
-namespace hrcsense::app {
+namespace hrcsense::eval {
 namespace {
 
 struct Backend {
@@ -147,4 +147,4 @@ StudySection study_table_44(const StudyContext& ctx) {
   return section;
 }
 
-}  // namespace hrcsense::app
+}  // namespace hrcsense::eval

@@ -1,15 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense CLI — the figures of `hrcsense eval`: PNG plots drawn by gnuplot (Debian's
+// hrcsense — the figures of `hrcsense eval`: PNG plots drawn by gnuplot (Debian's
 // gnuplot-nox, pngcairo terminal). Each figure keeps its data (.dat) and script (.gp) beside the
 // PNG, so that it can be redrawn or restyled without running the sweep again.
 #pragma once
 
-#include "eval_runner.hpp"
+#include "hrcsense/eval/runner.hpp"
 
 #include <string>
 #include <vector>
 
-namespace hrcsense::app {
+namespace hrcsense::eval {
 
 /// One line of a plot: y against x, or against named categories (x_labels, one per point).
 struct PlotSeries {
@@ -40,4 +40,4 @@ void draw_plot(const Plot& plot);
 std::vector<std::string> sweep_plots(const ResultTable& table, const std::vector<eval::SweepAxis>& axes,
                                      const std::string& out_dir);
 
-}  // namespace hrcsense::app
+}  // namespace hrcsense::eval

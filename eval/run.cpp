@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — one evaluation run (eval_run.hpp).
-#include "common/eval_run.hpp"
+// hrcsense — one evaluation run (eval/run.hpp).
+#include "hrcsense/eval/run.hpp"
 
-#include "common/assembly.hpp"
+#include "common/cell.hpp"
+#include "common/tee_sink.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/sink.hpp"
 
-namespace hrcsense::app {
+namespace hrcsense::eval {
 namespace {
 
 std::array<double, 3> point_of(const Eigen::Vector3f& p) { return {p.x(), p.y(), p.z()}; }
@@ -53,18 +54,20 @@ class SampleSink : public Sink {
 
 EvalRun run_eval(const Config& config, int64_t max_frames, std::atomic<int64_t>* frames_done) {
   EvalRun run;
-  std::unique_ptr<Source> source = make_source(config);
-  std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config, *source);
-  Pipeline pipeline(config.pipeline);
-  const SourceInfo info = source->info();
+  app::CellOptions options;
+  options.frames = max_frames;
+  options.links = false;             // an evaluation sends nothing to a controller
+  options.background_files = false;  // and learns its background in the run
+  const std::unique_ptr<app::Cell> cell = app::assemble_cell(config, options);
+  const SourceInfo info = cell->source->info();
   if (info.frame_count > 0) run.samples.reserve(static_cast<size_t>(info.frame_count));
-  SampleSink sink(run, frames_done);
-  RunOptions options;
-  options.max_frames = max_frames;
-  options.pace = config.source.pace;
-  options.camera_latency_s = config.robot_state.camera_latency_s;
-  run_pipeline(*source, *robot_states, pipeline, sink, options, make_run_header(config, info));
+  SampleSink samples(run, frames_done);
+  // A follow_link arm takes the scale each result asks for, as in `hrcsense run`.
+  std::vector<Sink*> sinks = cell->link_sinks();
+  sinks.push_back(&samples);
+  app::TeeSink sink(sinks);
+  run_pipeline(cell->frames(), *cell->robot_states, *cell->pipeline, sink, cell->run_options, cell->header);
   return run;
 }
 
-}  // namespace hrcsense::app
+}  // namespace hrcsense::eval

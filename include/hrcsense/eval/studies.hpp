@@ -1,17 +1,17 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense CLI — the ready-made studies of `hrcsense eval --study` (docs/EVALUATION.md): each
+// hrcsense — the ready-made studies of `hrcsense eval --study` (docs/EVALUATION.md): each
 // runs its sweep into DIR/<study>/, draws its figures there and returns its section of the
-// report, our numbers beside the thesis's.
+// report, our numbers beside the thesis's; the report, THESIS-REPLICATION.md, from them.
 #pragma once
 
-#include "eval_plots.hpp"
-#include "eval_runner.hpp"
+#include "hrcsense/eval/plots.hpp"
+#include "hrcsense/eval/runner.hpp"
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-namespace hrcsense::app {
+namespace hrcsense::eval {
 
 /// One section of THESIS-REPLICATION.md.
 struct StudySection {
@@ -48,4 +48,22 @@ StudySection study_table_43(const StudyContext& ctx);  ///< search backends on b
 StudySection study_table_44(const StudyContext& ctx);  ///< search rate against cloud size
 StudySection study_moving_cell(const StudyContext& ctx);  ///< the moving UR5 cell with SSM
 
-}  // namespace hrcsense::app
+/// Whether `name` is a study: table-4.1, table-4.2, table-4.3, table-4.4, moving-cell, or thesis (all of them).
+bool is_study(const std::string& name);
+
+/// Runs study `name`, or for `thesis` every study in the report's order (logging each); returns
+/// their sections. Throws std::invalid_argument when `name` is no study, and what a study throws.
+std::vector<StudySection> run_studies(const std::string& name, const StudyContext& ctx);
+
+/// Writes the report of `sections` as out_dir/THESIS-REPLICATION.md, its figures linked relative
+/// to out_dir, and returns its path. `command_line` is the command that made it, quoted in it so
+/// that a reader can make it again. Throws std::runtime_error when it cannot be written.
+std::string write_thesis_report(const std::string& out_dir, const std::string& command_line,
+                                const std::vector<StudySection>& sections);
+
+/// The same report at `path` (e.g. docs/THESIS-REPLICATION.md), its figures copied from out_dir
+/// into images/thesis/<study>-<file> beside it and linked there.
+void write_thesis_report_copy(const std::string& path, const std::string& out_dir, const std::string& command_line,
+                              const std::vector<StudySection>& sections);
+
+}  // namespace hrcsense::eval

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense CLI — the sweep runner (eval_runner.hpp): rows on --jobs threads, one complete CSV
+// hrcsense — the sweep runner (eval/runner.hpp): rows on --jobs threads, one complete CSV
 // line per finished row, the deterministic columns independent of the thread count and the
 // rate column saying whether it was measured alone (`serial`).
-#include "eval_runner.hpp"
+#include "hrcsense/eval/runner.hpp"
 
-#include "common/eval_run.hpp"
+#include "hrcsense/eval/run.hpp"
 #include "hrcsense/config.hpp"
-#include "hrcsense/eval_metrics.hpp"
+#include "hrcsense/eval/metrics.hpp"
 
 #include <unistd.h>
 
@@ -24,7 +24,7 @@
 #include <stdexcept>
 #include <thread>
 
-namespace hrcsense::app {
+namespace hrcsense::eval {
 namespace {
 
 using eval::EvalSample;
@@ -413,4 +413,4 @@ ResultTable run_sweep(const SweepRequest& request) {
   return table;
 }
 
-}  // namespace hrcsense::app
+}  // namespace hrcsense::eval

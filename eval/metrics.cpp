@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — the evaluation harness's metrics (eval_metrics.hpp): instability, MSE, distance
+// hrcsense — the evaluation harness's metrics (eval/metrics.hpp): instability, MSE, distance
 // error, latency percentiles and Z_d coverage over one run's samples.
 
-#include "hrcsense/eval_metrics.hpp"
+#include "hrcsense/eval/metrics.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense — sweeps and the resumable result table of `hrcsense eval` (eval_sweep.hpp).
+// hrcsense — sweeps and the resumable result table of `hrcsense eval` (eval/sweep.hpp).
 
-#include "hrcsense/eval_sweep.hpp"
+#include "hrcsense/eval/sweep.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,17 +1,17 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense CLI — the sweep runner behind `hrcsense eval` and its studies: every sweep point ×
+// hrcsense — the sweep runner behind `hrcsense eval` and its studies: every sweep point ×
 // scene × seed as one unpaced run, the thesis's measures (docs/EVALUATION.md) appended to
 // DIR/results.csv one complete line per row, so that an interrupted sweep continues where it
 // stopped; DIR/results.md beside it.
 #pragma once
 
-#include "hrcsense/eval_sweep.hpp"
+#include "hrcsense/eval/sweep.hpp"
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-namespace hrcsense::app {
+namespace hrcsense::eval {
 
 /// One sweep to run.
 struct SweepRequest {
@@ -48,4 +48,4 @@ ResultTable run_sweep(const SweepRequest& request);
 /// Reads a results.csv (header and rows, sorted by the `row` column); throws naming the file.
 ResultTable read_results(const std::string& csv_path);
 
-}  // namespace hrcsense::app
+}  // namespace hrcsense::eval

@@ -1,15 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
-// hrcsense CLI — `hrcsense eval --study NAME`: the ready-made studies that replicate the 2020
+// hrcsense — `hrcsense eval --study NAME`: the ready-made studies that replicate the 2020
 // thesis's Tables 4.1–4.4 (and add the moving cell it could not have), each one command, each a
 // sweep in DIR/<study>/ with its figures; `--study thesis` runs them all and writes
 // THESIS-REPLICATION.md (docs/EVALUATION.md). The thesis's figures below are quoted from it
 // (../shared/reference, Tables 4.1–4.4).
-#include "commands.hpp"
-#include "common/eval_run.hpp"
-#include "common/app_errors.hpp"
-#include "eval_plots.hpp"
-#include "eval_runner.hpp"
-#include "eval_studies.hpp"
+#include "hrcsense/eval/run.hpp"
+#include "hrcsense/eval/plots.hpp"
+#include "hrcsense/eval/runner.hpp"
+#include "hrcsense/eval/studies.hpp"
 #include "hrcsense/config.hpp"
 
 #include <spdlog/spdlog.h>
@@ -26,12 +24,12 @@
 #include <stdexcept>
 #include <thread>
 
-namespace hrcsense::app {
+namespace hrcsense::eval {
 namespace {
 
 namespace fs = std::filesystem;
 
-// ---- The thesis's figures (Tables 4.1-4.3; 4.4 is in eval_search_rates.cpp) ----------------
+// ---- The thesis's figures (Tables 4.1-4.3; 4.4 is in search_rates.cpp) ----------------
 struct ThesisFilterRow {
   double value;       // persistence, α or δ
   double rate_hz;     // refresh rate
@@ -437,4 +435,4 @@ StudySection study_moving_cell(const StudyContext& ctx) {
   return {"The moving cell and SSM", md.str() + "\n" + rate_note(table) + "\n", {}, recommend.str()};
 }
 
-}  // namespace hrcsense::app
+}  // namespace hrcsense::eval

@@ -1,19 +1,19 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — one evaluation run (`hrcsense eval`): a configured source processed unpaced by
 // run_pipeline, as `hrcsense run` would, with every processed frame kept as an EvalSample
-// (eval_metrics.hpp) instead of a JSON line. Nothing is pre-rendered: memory stays bounded
+// (eval/metrics.hpp) instead of a JSON line. Nothing is pre-rendered: memory stays bounded
 // by the samples (a few dozen bytes a frame).
 #pragma once
 
 #include "hrcsense/config.hpp"
-#include "hrcsense/eval_metrics.hpp"
+#include "hrcsense/eval/metrics.hpp"
 
 #include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
 
-namespace hrcsense::app {
+namespace hrcsense::eval {
 
 struct EvalRun {
   /// One per processed source frame after background learning (valid frames), in order.
@@ -30,4 +30,4 @@ struct EvalRun {
 /// when given, counts processed frames as they come (for a progress bar on another thread).
 EvalRun run_eval(const Config& config, int64_t max_frames, std::atomic<int64_t>* frames_done = nullptr);
 
-}  // namespace hrcsense::app
+}  // namespace hrcsense::eval
