@@ -214,12 +214,11 @@ int run_session(const Config& config, const SessionOptions& args) {
     source = make_source(config, source_options);
   } catch (const SourceStartError& e) {
     // The run still says so as every run does: header, stop, summary (source_error, exit 1).
-    source = std::make_unique<UnstartedSource>(config.source.type, e.what());
+    source = std::make_unique<UnstartedSource>(source_type_name(config.source.type), e.what());
     source_started = false;
   }
   std::unique_ptr<RobotStateSource> robot_states = make_robot_state_source(config, *source, nullptr, trajectory_clock);
-  const bool recording_source = config.source.type == "bag" || config.source.type == "folder";
-  if (args.wrap_recording && recording_source) {
+  if (args.wrap_recording && is_recording(config.source.type)) {
     // The robot states may come from the first source: the wrapper keeps it alive.
     source = args.wrap_recording(std::move(source), [config, source_options] { return make_source(config, source_options); });
   }
@@ -252,15 +251,15 @@ int run_session(const Config& config, const SessionOptions& args) {
   }
   std::ostream& out = args.out.empty() ? std::cout : file;
 
-  JsonLinesSink jsonl(out, config.pipeline.backend);
+  JsonLinesSink jsonl(out, proximity_backend_name(config.pipeline.backend));
   ConsoleSink console;
   // Simulated runs: truth.contact_label from the simulator's own labels (TruthLabelSink).
   std::optional<TruthLabelSink> labelled;
-  if (config.source.type == "sim") labelled.emplace(make_simulator(config, trajectory_clock), jsonl);
+  if (config.source.type == SourceType::sim) labelled.emplace(make_simulator(config, trajectory_clock), jsonl);
   // link.udp.address: the verdicts to the controller, first, so that no file or console write
   // delays a datagram.
   const std::unique_ptr<UdpLinkSink> link = make_udp_link_sink(config);
-  if (link) spdlog::info("link: verdicts to {} ({}, heartbeat {} Hz)", link->address(), config.link.udp_format,
+  if (link) spdlog::info("link: verdicts to {} ({}, heartbeat {} Hz)", link->address(), udp_format_name(config.link.udp_format),
                          config.link.heartbeat_hz);
   // link.rtde.write: the speed scale to the controller's RTDE inputs (its own connection).
   const std::unique_ptr<RtdeLinkSink> rtde_link = make_rtde_link_sink(config);

@@ -41,7 +41,7 @@ TEST(CameraConfig, ReadsAFile) {
                                      "  options: {visual_preset: high_accuracy, laser_power: 150, emitter_enabled: true}\n"
                                      "  settle_frames: 10\n");
   const SourceConfig source = load_config(file, {}).source;
-  EXPECT_EQ(source.type, "realsense");
+  EXPECT_EQ(source.type, SourceType::realsense);
   EXPECT_EQ(source.serial, "825312072719");  // quoted: a serial is text, leading zeros and all
   EXPECT_EQ(source.fps, 90);
   EXPECT_TRUE(source.color.enabled);
