@@ -226,12 +226,15 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
   if (source == RobotStateOrigin::recorded) {
     throw ConfigError(where + ": robot.state.source recorded: the joint states come from the recording (source.type bag)");
   }
-  throw ConfigError(where + ": robot.state.source '" + robot_state_origin_name(source) + "': not built into this hrcsense");
+  throw ConfigError(where + ": robot.state.source '" + robot_state_origin_name(source) +
+                    "': not built into this hrcsense");
 }
 
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, Source& source, RunClock* clock,
                                                           std::shared_ptr<TrajectoryClock> trajectory_clock) {
-  if (config.robot_state.source != RobotStateOrigin::recorded) return make_robot_state_source(config, clock, std::move(trajectory_clock));
+  if (config.robot_state.source != RobotStateOrigin::recorded) {
+    return make_robot_state_source(config, clock, std::move(trajectory_clock));
+  }
   const std::string where = config_where(config);
   const auto* bag = dynamic_cast<const BagSource*>(&source);
   if (bag == nullptr) {
@@ -254,7 +257,8 @@ bool load_background_file(const Config& config, const SourceInfo& info, Pipeline
   if (model.width != filtered.width || model.height != filtered.height) {
     throw IoError(config.background_path + ": background is " + std::to_string(model.width) + "x" +
                   std::to_string(model.height) + " but the filtered source is " + std::to_string(filtered.width) +
-                  "x" + std::to_string(filtered.height) + " (filters.preset " + filter_preset_name(config.filters_preset) + ")");
+                  "x" + std::to_string(filtered.height) + " (filters.preset " +
+                  filter_preset_name(config.filters_preset) + ")");
   }
   pipeline.set_background(std::move(model), "background.path '" + config.background_path + "'");
   return true;

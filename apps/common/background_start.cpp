@@ -33,8 +33,8 @@ BackgroundModel load_reference(const Config& config, const SourceInfo& info) {
   if (model.width != filtered.width || model.height != filtered.height) {
     throw IoError(path + ": reference background is " + std::to_string(model.width) + "x" +
                   std::to_string(model.height) + " but the filtered source is " + std::to_string(filtered.width) +
-                  "x" + std::to_string(filtered.height) + " (filters.preset " + filter_preset_name(config.filters_preset) +
-                  "); teach it again with this configuration");
+                  "x" + std::to_string(filtered.height) + " (filters.preset " +
+                  filter_preset_name(config.filters_preset) + "); teach it again with this configuration");
   }
   return model;
 }

@@ -259,8 +259,10 @@ int run_session(const Config& config, const SessionOptions& args) {
   // link.udp.address: the verdicts to the controller, first, so that no file or console write
   // delays a datagram.
   const std::unique_ptr<UdpLinkSink> link = make_udp_link_sink(config);
-  if (link) spdlog::info("link: verdicts to {} ({}, heartbeat {} Hz)", link->address(), udp_format_name(config.link.udp_format),
-                         config.link.heartbeat_hz);
+  if (link) {
+    spdlog::info("link: verdicts to {} ({}, heartbeat {} Hz)", link->address(), udp_format_name(config.link.udp_format),
+                 config.link.heartbeat_hz);
+  }
   // link.rtde.write: the speed scale to the controller's RTDE inputs (its own connection).
   const std::unique_ptr<RtdeLinkSink> rtde_link = make_rtde_link_sink(config);
   if (rtde_link) spdlog::info("link: speed scale to RTDE {}:{} ({})", config.robot_state.host, config.robot_state.port,

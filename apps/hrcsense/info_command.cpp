@@ -86,7 +86,8 @@ int print_sim(const Config& config) {
   std::printf("frames: %lld (%.3f s)\n", static_cast<long long>(sim.frames), static_cast<double>(sim.frames) / sim.fps);
   print_sensor_effects(simulator);
   print_scene(config.scene);
-  std::printf("robot: %s, %zu capsule(s)\n", robot_model_name(config.robot_model), fixed_robot_model(config).capsules.size());
+  std::printf("robot: %s, %zu capsule(s)\n", robot_model_name(config.robot_model),
+              fixed_robot_model(config).capsules.size());
   std::printf("config hash: %s\n", config_hash(config).c_str());
   return 0;
 }

@@ -74,8 +74,10 @@ struct SceneReader : YamlTree {
 
   std::vector<Waypoint> path(const YAML::Node& node, const std::string& key) const {
     if (!node.IsSequence()) fail(key, "expected a list of {t_s, offset_m}");
-    return waypoints<Waypoint>(node, key, "offset_m", [this](const YAML::Node& value, const std::string& value_key,
-                                                             Waypoint& point) { point.offset_m = vec3f(value, value_key); });
+    const auto read_offset = [this](const YAML::Node& value, const std::string& value_key, Waypoint& point) {
+      point.offset_m = vec3f(value, value_key);
+    };
+    return waypoints<Waypoint>(node, key, "offset_m", read_offset);
   }
 
   /// `material: [dark, shiny, low_texture]` (any of them; a single flag may stand alone).

@@ -43,7 +43,8 @@ struct StereoNoise {
 };
 
 std::vector<FrameLine> run_moving_cell(const std::string& extra, const std::string& name,
-                                       const std::string& config = scene_path("cell-ur5-moving.yaml"), StereoNoise* noise = nullptr) {
+                                       const std::string& config = scene_path("cell-ur5-moving.yaml"),
+                                       StereoNoise* noise = nullptr) {
   const std::string out = std::string(::testing::TempDir()) + "moving_cell_" + name + ".jsonl";
   const std::string command = std::string(HRCSENSE_CLI) + " run --config " + config + " " + extra + " --out " + out +
                               " 2>/dev/null";
