@@ -41,34 +41,41 @@ struct GoldenCase {
   throw std::runtime_error("case '" + name + "': " + what);
 }
 
+// An integer option: the SDK's options are floats in cases.json and truncate, as its uint8 options
+// do; a missing one keeps `value` (the params struct's default).
+void integer_option(const json& options, const char* key, int& value) {
+  value = static_cast<int>(options.value(key, static_cast<double>(value)));
+}
+
+// Every option missing from a case keeps the default of FilterChainParams (filters.hpp), which
+// are the SDK's defaults.
 void read_block_options(const std::string& name, const json& step, FilterChainParams& chain) {
   const std::string filter = step.at("filter").get<std::string>();
   const json options = step.value("options_friendly", json::object());
   const auto block = filter_block_from_name(filter);
   if (!block) bad_case(name, "unknown filter '" + filter + "'");
   chain.order.push_back(*block);
-  // Integer options truncate, as the SDK's uint8 options do.
   switch (*block) {
     case FilterBlock::threshold:
       chain.threshold.min_m = options.value("min", chain.threshold.min_m);
       chain.threshold.max_m = options.value("max", chain.threshold.max_m);
       break;
     case FilterBlock::decimation:
-      chain.decimation.magnitude = static_cast<int>(options.value("magnitude", 2.0));
+      integer_option(options, "magnitude", chain.decimation.magnitude);
       break;
     case FilterBlock::spatial:
       chain.spatial.alpha = options.value("alpha", chain.spatial.alpha);
-      chain.spatial.delta = static_cast<int>(options.value("delta", 20.0));
-      chain.spatial.magnitude = static_cast<int>(options.value("magnitude", 2.0));
-      chain.spatial.holes_fill = static_cast<int>(options.value("holes_fill", 0.0));
+      integer_option(options, "delta", chain.spatial.delta);
+      integer_option(options, "magnitude", chain.spatial.magnitude);
+      integer_option(options, "holes_fill", chain.spatial.holes_fill);
       break;
     case FilterBlock::temporal:
       chain.temporal.alpha = options.value("alpha", chain.temporal.alpha);
-      chain.temporal.delta = static_cast<int>(options.value("delta", 20.0));
-      chain.temporal.persistence = static_cast<int>(options.value("persistence", 3.0));
+      integer_option(options, "delta", chain.temporal.delta);
+      integer_option(options, "persistence", chain.temporal.persistence);
       break;
     case FilterBlock::hole_filling:
-      chain.hole_filling.mode = static_cast<int>(options.value("mode", 1.0));
+      integer_option(options, "mode", chain.hole_filling.mode);
       break;
     case FilterBlock::to_disparity:
     case FilterBlock::to_depth:

@@ -7,6 +7,7 @@
 #include "hrcsense/eval/run.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/eval/metrics.hpp"
+#include "hrcsense/number_text.hpp"
 
 #include <unistd.h>
 
@@ -75,9 +76,7 @@ std::string header_line() {
 // A number as the table writes it: enough digits to compare runs exactly; empty for NaN.
 std::string number(double value) {
   if (!std::isfinite(value)) return "";
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9g", value);
-  return text;
+  return float_digits_text(value);
 }
 
 // The processing path's rate: frames per second of processing time (latency_us summed), the

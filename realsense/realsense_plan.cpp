@@ -87,12 +87,12 @@ std::string offered_text(const std::vector<ProfileDescriptor>& offered, StreamKi
   return text;
 }
 
-ProfileChoice choose_profiles(const std::vector<ProfileDescriptor>& offered, const SourceConfig& source, bool usb2) {
+ProfileChoice choose_profiles(const std::vector<ProfileDescriptor>& offered, const RealSenseParams& params, bool usb2) {
   ProfileChoice choice;
-  choice.depth = pick(offered, StreamKind::depth, "Z16", source.width, source.height, source.fps, usb2,
+  choice.depth = pick(offered, StreamKind::depth, "Z16", params.width, params.height, params.fps, usb2,
                       "source.width, source.height, source.fps");
-  if (source.color.enabled) {
-    choice.color = pick(offered, StreamKind::color, "RGB8", source.color.width, source.color.height, source.color.fps,
+  if (params.color) {
+    choice.color = pick(offered, StreamKind::color, "RGB8", params.color_width, params.color_height, params.color_fps,
                         usb2, "source.color");
   }
   return choice;
@@ -105,16 +105,16 @@ std::string usb2_limit_note() {
          "@ 6; no 848x480, no 90 frames/s); plug it into a USB 3 port with a USB 3 cable";
 }
 
-bool auto_exposure_on(const std::vector<CameraOption>& options) {
+bool auto_exposure_on(const std::vector<RealSenseOption>& options) {
   bool on = true;  // the D435's depth sensor starts with auto exposure on
-  for (const CameraOption& option : options) {
+  for (const RealSenseOption& option : options) {
     if (option.name == "enable_auto_exposure") on = option.value != 0.0F;
   }
   return on;
 }
 
-int frames_to_settle(const SourceConfig& source) {
-  return auto_exposure_on(source.options) ? source.settle_frames : 0;
+int frames_to_settle(const RealSenseParams& params) {
+  return auto_exposure_on(params.options) ? params.settle_frames : 0;
 }
 
 int64_t timestamp_ms_to_ns(double timestamp_ms) {
@@ -141,9 +141,9 @@ int64_t HostClockMapper::host_time_ns(double timestamp_ms, TimestampDomain frame
   return arrival_ns;
 }
 
-std::vector<StreamKind> file_streams(const SourceConfig& source) {
+std::vector<StreamKind> file_streams(const RealSenseParams& params) {
   std::vector<StreamKind> streams = {StreamKind::depth};
-  if (source.color.enabled) streams.push_back(StreamKind::color);
+  if (params.color) streams.push_back(StreamKind::color);
   return streams;
 }
 

@@ -5,10 +5,10 @@
 // types, asks these functions, and copies the answers back; it decides nothing itself.
 #pragma once
 
-#include "hrcsense/config.hpp"
 #include "hrcsense/types.hpp"
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
@@ -22,6 +22,34 @@ namespace hrcsense {
 class RealSenseError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+/// One SDK option for the depth sensor: the SDK's name in snake_case (visual_preset,
+/// laser_power, emitter_enabled, exposure, enable_auto_exposure) and the value the SDK takes
+/// (a visual preset is its rs2_rs400_visual_preset number).
+struct RealSenseOption {
+  std::string name;
+  float value = 0.0F;
+};
+
+/// What the RealSense source is built from; the assembly fills it from `source.*`
+/// (docs/CAMERAS.md), which has checked every value against the D435's modes and ranges.
+struct RealSenseParams {
+  std::string serial;     ///< the camera's serial number; empty: the first camera found
+  int width = 848;        ///< depth width, pixels
+  int height = 480;       ///< depth height, pixels
+  int fps = 30;           ///< depth rate, frames/s
+  bool color = false;     ///< stream colour too
+  int color_width = 848;  ///< colour width, pixels
+  int color_height = 480; ///< colour height, pixels
+  int color_fps = 30;     ///< colour rate, frames/s
+  /// Applied in this order (a visual preset first: it resets the other options).
+  std::vector<RealSenseOption> options;
+  int settle_frames = 30;  ///< frames skipped after a start or reconnect while auto exposure settles
+  std::string path;        ///< a .bag to play through the SDK instead of a camera; empty: a camera
+  bool loop = false;       ///< the .bag starts over at its end
+  /// Ends a wait for an unplugged camera (SIGINT, SIGTERM): next() then says `end`. Null: never.
+  const std::atomic<bool>* stop_requested = nullptr;
 };
 
 /// The one message for a RealSense feature in a build without the SDK: `what` names it
@@ -60,7 +88,7 @@ struct ProfileDescriptor {
   int fps = 0;     ///< frames/s
 };
 
-/// The profiles to start: depth Z16 always, colour RGB8 when `source.color.enabled`.
+/// The profiles to start: depth Z16 always, colour RGB8 when RealSenseParams::color.
 struct ProfileChoice {
   ProfileDescriptor depth;
   std::optional<ProfileDescriptor> color;
@@ -70,7 +98,7 @@ struct ProfileChoice {
 /// `source.color.*`) among those the camera offers. Throws RealSenseError when one is not
 /// offered, listing what the camera does offer for that stream; on a USB 2 connection
 /// (`usb2`) the message adds usb2_limit_note().
-ProfileChoice choose_profiles(const std::vector<ProfileDescriptor>& offered, const SourceConfig& source, bool usb2);
+ProfileChoice choose_profiles(const std::vector<ProfileDescriptor>& offered, const RealSenseParams& params, bool usb2);
 
 /// "640x480 @ 30, 15, 6; 480x270 @ 60, 30" — the sizes and rates offered for `stream` in
 /// `format`, largest first; "none" when there are none.
@@ -89,11 +117,11 @@ std::string usb2_limit_note();
 
 /// Whether auto exposure is on after `options` are applied: the D435 starts with it on;
 /// enable_auto_exposure 0 (or a manual exposure, which config turns into it) switches it off.
-bool auto_exposure_on(const std::vector<CameraOption>& options);
+bool auto_exposure_on(const std::vector<RealSenseOption>& options);
 
 /// Frames to skip after a start or reconnect while auto exposure settles: `source.settle_frames`
 /// with auto exposure on, 0 with it off (a fixed exposure needs no settling).
-int frames_to_settle(const SourceConfig& source);
+int frames_to_settle(const RealSenseParams& params);
 
 // ---- Time
 
@@ -128,9 +156,9 @@ int64_t timestamp_ms_to_ns(double timestamp_ms);
 // ---- Playing a file (source.path names a .bag)
 
 /// The streams to enable when the SDK plays a file: depth (Z16), and colour (RGB8) when
-/// `source.color.enabled`; never the file's other streams. With every stream enabled the SDK's
+/// RealSenseParams::color; never the file's other streams. With every stream enabled the SDK's
 /// pipeline drops the file's first depth frame (it holds it back to match streams nobody reads).
-std::vector<StreamKind> file_streams(const SourceConfig& source);
+std::vector<StreamKind> file_streams(const RealSenseParams& params);
 
 /// A frame's times as the adapter hands them on.
 struct FrameTimes {

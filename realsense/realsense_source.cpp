@@ -80,8 +80,8 @@ rs2_option sdk_option(const std::string& name) {
 
 /// Applies the options in their order; one the sensor lacks, or a value beyond the camera's
 /// own range (another model or firmware than the D435 the configuration checked for), names the key.
-void apply_options(const rs2::sensor& depth_sensor, const std::vector<CameraOption>& options) {
-  for (const CameraOption& option : options) {
+void apply_options(const rs2::sensor& depth_sensor, const std::vector<RealSenseOption>& options) {
+  for (const RealSenseOption& option : options) {
     const rs2_option id = sdk_option(option.name);
     const std::string key = "source.options." + option.name;
     if (!depth_sensor.supports(id)) throw RealSenseError(key + ": the camera's depth sensor has no such option");
@@ -123,11 +123,11 @@ struct RealSenseSource::Impl {
   int64_t index = 0;
 
   explicit Impl(const RealSenseParams& p) : params(p) {
-    from_file = !params.source.path.empty();
+    from_file = !params.path.empty();
     if (from_file) {
-      config.enable_device_from_file(params.source.path, params.source.loop);
+      config.enable_device_from_file(params.path, params.loop);
       // Only the streams asked for: with all of the file's, the SDK drops its first depth frame.
-      for (const StreamKind stream : file_streams(params.source)) {
+      for (const StreamKind stream : file_streams(params)) {
         if (stream == StreamKind::depth) config.enable_stream(RS2_STREAM_DEPTH, RS2_FORMAT_Z16);
         if (stream == StreamKind::color) config.enable_stream(RS2_STREAM_COLOR, RS2_FORMAT_RGB8);
       }
@@ -146,18 +146,18 @@ struct RealSenseSource::Impl {
     const rs2::device_list devices = context.query_devices();
     for (const rs2::device& candidate : devices) {
       const std::string serial = info_or_empty(candidate, RS2_CAMERA_INFO_SERIAL_NUMBER);
-      if (params.source.serial.empty() || serial == params.source.serial) {
+      if (params.serial.empty() || serial == params.serial) {
         device = candidate;
         break;
       }
     }
     if (!device) {
-      throw RealSenseError(params.source.serial.empty() ? "no RealSense camera found ('hrcsense devices' lists them)"
-                                                        : "no RealSense camera with serial " + params.source.serial +
-                                                              " ('hrcsense devices' lists them)");
+      throw RealSenseError(params.serial.empty() ? "no RealSense camera found ('hrcsense devices' lists them)"
+                                                 : "no RealSense camera with serial " + params.serial +
+                                                       " ('hrcsense devices' lists them)");
     }
     const bool usb2 = is_usb2(info_or_empty(device, RS2_CAMERA_INFO_USB_TYPE_DESCRIPTOR));
-    const ProfileChoice choice = choose_profiles(device_profiles(device), params.source, usb2);
+    const ProfileChoice choice = choose_profiles(device_profiles(device), params, usb2);
     config.enable_device(info_or_empty(device, RS2_CAMERA_INFO_SERIAL_NUMBER));
     config.enable_stream(RS2_STREAM_DEPTH, choice.depth.width, choice.depth.height, RS2_FORMAT_Z16, choice.depth.fps);
     if (choice.color) {
@@ -177,7 +177,7 @@ struct RealSenseSource::Impl {
     if (auto playback = device.as<rs2::playback>()) {
       playback.set_real_time(false);  // every frame of the file, as fast as processing takes them
     } else {
-      apply_options(depth_sensor, params.source.options);
+      apply_options(depth_sensor, params.options);
     }
     depth_scale_m = depth_sensor.get_depth_scale();
     const auto depth = profile.get_stream(RS2_STREAM_DEPTH).as<rs2::video_stream_profile>();
@@ -189,7 +189,7 @@ struct RealSenseSource::Impl {
     info.camera_serial = info_or_empty(device, RS2_CAMERA_INFO_SERIAL_NUMBER);
     info.camera_firmware = info_or_empty(device, RS2_CAMERA_INFO_FIRMWARE_VERSION);
     const std::string usb = info_or_empty(device, RS2_CAMERA_INFO_USB_TYPE_DESCRIPTOR);
-    info.description = from_file ? params.source.path : info.camera_name + (usb.empty() ? "" : ", USB " + usb);
+    info.description = from_file ? params.path : info.camera_name + (usb.empty() ? "" : ", USB " + usb);
     if (is_usb2(usb)) info.description += "; " + usb2_limit_note();
     // The stereo baseline: the sensor's own option (mm), else the depth → infrared 2 extrinsics.
     if (depth_sensor.supports(RS2_OPTION_STEREO_BASELINE)) {
@@ -213,7 +213,7 @@ struct RealSenseSource::Impl {
     clock.from_file = from_file;
     clock.nominal_fps = info.nominal_fps;
     gaps.reset();
-    settle.frames = from_file ? 0 : frames_to_settle(params.source);  // a file's exposure settled when it was made
+    settle.frames = from_file ? 0 : frames_to_settle(params);  // a file's exposure settled when it was made
     settle.restart();
   }
 

@@ -7,7 +7,6 @@
 
 #include "realsense/realsense_plan.hpp"
 
-#include "hrcsense/config.hpp"
 #include "hrcsense/source.hpp"
 
 #include <atomic>
@@ -16,13 +15,6 @@
 #include <vector>
 
 namespace hrcsense {
-
-/// What the RealSense source is built from.
-struct RealSenseParams {
-  SourceConfig source;  ///< source.serial, width, height, fps, color, options, settle_frames, path (.bag)
-  /// Ends a wait for an unplugged camera (SIGINT, SIGTERM): next() then says `end`. Null: never.
-  const std::atomic<bool>* stop_requested = nullptr;
-};
 
 /// A D400 camera through rs2::pipeline: the configured profiles (848x480 @ 30 by default), the
 /// SDK options applied to the depth sensor, frames after auto exposure settled, timestamps

@@ -451,7 +451,7 @@ int run_viewer(const ViewArgs& args) {
   ControlInbox inbox;
   PlaybackControl playback;
   // run_session wraps only recordings (.bag, folder); a headless run plays straight through.
-  const bool replay = !snapshots && (config.source.type == "bag" || config.source.type == "folder");
+  const bool replay = !snapshots && is_recording(config.source.type);
   const app::SessionOptions options = session_options(args, snapshots, tap, view_sink, inbox, replay ? &playback : nullptr);
   Panels panels(PanelContext{args.config_path, args.sets, &inbox, replay ? &playback : nullptr}, config);
   const ViewerParts parts{args,   window, renderer, tap, panels, replay ? &playback : nullptr,

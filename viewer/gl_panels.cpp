@@ -7,13 +7,13 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <iterator>
 #include <utility>
 
 namespace hrcsense::view {
 namespace {
 
 constexpr size_t kLogLines = 6;
-constexpr const char* kBackends[] = {"brute", "kdtree", "octree", "auto"};
 constexpr const char* kRelearnPopup = "Relearn the background?";
 
 // A slider that reports a change once it is let go (dragging would parse the configuration
@@ -161,12 +161,15 @@ void Panels::draw_foreground() {
   edited_ |= slider("k_sigma", fg.k_sigma, 0.5F, 12.0F, "%.2f");
   edited_ |= slider("min_margin_m", fg.min_margin_m, 0.0F, 0.2F);
   edited_ |= slider("min_object_mm", fg.min_object_mm, 0.0F, 300.0F, "%.0f");
+  constexpr int kBackendCount = static_cast<int>(std::size(kProximityBackends));
+  const char* names[kBackendCount];
   int backend = 0;
-  for (int i = 0; i < 4; ++i) {
-    if (edit_.backend == kBackends[i]) backend = i;
+  for (int i = 0; i < kBackendCount; ++i) {
+    names[i] = proximity_backend_name(kProximityBackends[i]);
+    if (edit_.backend == kProximityBackends[i]) backend = i;
   }
-  if (ImGui::Combo("backend", &backend, kBackends, 4) && edit_.backend != kBackends[backend]) {
-    edit_.backend = kBackends[backend];
+  if (ImGui::Combo("backend", &backend, names, kBackendCount) && edit_.backend != kProximityBackends[backend]) {
+    edit_.backend = kProximityBackends[backend];
     edited_ = true;
   }
 }

@@ -2,6 +2,8 @@
 // hrcsense viewer — requests from the panels to the running pipeline (view_control.hpp).
 #include "viewer/view_control.hpp"
 
+#include "common/assembly.hpp"
+
 #include "hrcsense/io.hpp"
 #include "hrcsense/safety.hpp"
 
@@ -100,9 +102,8 @@ Config tuned_config(const std::string& config_path, const std::vector<std::strin
 void save_tuned_config(const Config& config, const std::string& path) {
   std::ofstream out(path, std::ios::out | std::ios::trunc);
   if (!out) throw IoError(path + ": cannot open for writing");
-  out << "# hrcsense: parameters tuned in hrcsense-view, from "
-      << (config.file.empty() ? std::string("the defaults") : config.file)
-      << ".\n# Every key is spelled out; run it with: hrcsense run --config " << path << "\n"
+  out << "# hrcsense: " << config_where(config)
+      << " with parameters tuned in hrcsense-view.\n# Every key is spelled out; run it with: hrcsense run --config " << path << "\n"
       << config.canonical_yaml;
   out.flush();
   if (!out) throw IoError(path + ": write failed");

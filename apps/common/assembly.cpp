@@ -55,7 +55,6 @@ std::shared_ptr<TrajectoryClock> make_trajectory_clock(const Config& config) {
 Simulator make_simulator(const Config& config, std::shared_ptr<TrajectoryClock> trajectory_clock) {
   Simulator simulator;
   simulator.params = config.sim;
-  simulator.params.seed = config.source.seed;
   simulator.scene = config.scene;
   simulator.T_base_camera = config.pipeline.T_base_camera;
   simulator.robot = fixed_robot_model(config);
@@ -69,10 +68,9 @@ Simulator make_simulator(const Config& config, std::shared_ptr<TrajectoryClock> 
   return simulator;
 }
 
-namespace {
-
-// What an error in the configuration names first: its file, or "configuration" for defaults.
 std::string config_where(const Config& config) { return config.file.empty() ? "configuration" : config.file; }
+
+namespace {
 
 // source.type ros2: realsense-ros topics over Cyclone DDS (docs/CAMERAS.md).
 std::unique_ptr<Source> make_ros2_source([[maybe_unused]] const Config& config,
@@ -109,29 +107,51 @@ std::unique_ptr<Source> make_ros2_source([[maybe_unused]] const Config& config,
 
 }  // namespace
 
+RealSenseParams realsense_params(const SourceConfig& source, const std::atomic<bool>* stop_requested) {
+  RealSenseParams params;
+  params.serial = source.serial;
+  params.width = source.width;
+  params.height = source.height;
+  params.fps = source.fps;
+  params.color = source.color.enabled;
+  params.color_width = source.color.width;
+  params.color_height = source.color.height;
+  params.color_fps = source.color.fps;
+  for (const CameraOption& option : source.options) params.options.push_back({option.name, option.value});
+  params.settle_frames = source.settle_frames;
+  params.path = source.path;
+  params.loop = source.loop;
+  params.stop_requested = stop_requested;
+  return params;
+}
+
 std::unique_ptr<Source> make_source(const Config& config, const SourceOptions& options) {
   const std::string where = config_where(config);
-  if (config.source.type == "sim") return std::make_unique<SimSource>(make_simulator(config, options.trajectory_clock));
-  if (config.source.type == "folder" || config.source.type == "bag") {
-    if (config.source.path.empty()) {
-      throw ConfigError(where + ": source.path: required for source.type " + config.source.type);
+  const SourceType type = config.source.type;
+  switch (type) {
+    case SourceType::sim: return std::make_unique<SimSource>(make_simulator(config, options.trajectory_clock));
+    case SourceType::folder:  // is_recording
+    case SourceType::bag: {
+      if (config.source.path.empty()) {
+        throw ConfigError(where + ": source.path: required for source.type " + source_type_name(type));
+      }
+      RecordingParams params{config.source.path, config.source.loop, config.source.stereo_baseline_mm};
+      params.with_color = options.with_color;
+      if (type == SourceType::folder) return std::make_unique<FolderSource>(params);
+      // make_robot_state_source takes them
+      params.with_joint_states = config.robot_state.source == RobotStateOrigin::recorded;
+      return std::make_unique<BagSource>(params);
     }
-    RecordingParams params{config.source.path, config.source.loop, config.source.stereo_baseline_mm};
-    params.with_color = options.with_color;
-    if (config.source.type == "folder") return std::make_unique<FolderSource>(params);
-    params.with_joint_states = config.robot_state.source == "recorded";  // make_robot_state_source takes them
-    return std::make_unique<BagSource>(params);
-  }
-  if (config.source.type == "ros2") return make_ros2_source(config, options, where);
-  if (config.source.type == "realsense") {
+    case SourceType::ros2: return make_ros2_source(config, options, where);
+    case SourceType::realsense:
 #ifdef HRCSENSE_HAVE_REALSENSE
-    return std::make_unique<RealSenseSource>(RealSenseParams{config.source, options.stop_requested});
+      return std::make_unique<RealSenseSource>(realsense_params(config.source, options.stop_requested));
 #else
-    throw ConfigError(realsense_missing_message(where + ": source.type 'realsense'"));
+      throw ConfigError(realsense_missing_message(where + ": source.type 'realsense'"));
 #endif
   }
   // The configuration knows every type; the live adapters are optional targets.
-  throw ConfigError(where + ": source.type '" + config.source.type + "': not built into this hrcsense");
+  throw ConfigError(where + ": source.type '" + source_type_name(type) + "': not built into this hrcsense");
 }
 
 std::vector<DeviceDescriptor> list_cameras() {
@@ -162,16 +182,16 @@ RobotStateHistoryParams robot_state_history_params(const Config& config) {
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock,
                                                           std::shared_ptr<TrajectoryClock> trajectory_clock) {
   const RobotStateConfig& state = config.robot_state;
-  const std::string& source = state.source;
-  if (source == "fixed") return std::make_unique<FixedRobotState>(state.joints_rad);
+  const RobotStateOrigin source = state.source;
+  if (source == RobotStateOrigin::fixed) return std::make_unique<FixedRobotState>(state.joints_rad);
   const std::string where = config_where(config);
-  if (source == "sim") {
+  if (source == RobotStateOrigin::sim) {
     // Config requires the trajectory with the sim source; checked again for a hand-made Config.
     if (!config.robot_state.trajectory) throw ConfigError(where + ": robot.trajectory: required for robot.state.source sim");
     SimRobotState::Params params;
     params.latency_s = config.robot_state.sim_latency_s;
     params.jitter_s = config.robot_state.sim_jitter_s;
-    params.seed = config.source.seed;
+    params.seed = config.sim.seed;  // source.seed
     params.history = robot_state_history_params(config);
     params.clock = std::move(trajectory_clock);
     return std::make_unique<SimRobotState>(*config.robot_state.trajectory, params);
@@ -181,7 +201,7 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
   // reads the same time as the run's.
   static SteadyClock steady_clock;
   RunClock& run_clock = clock != nullptr ? *clock : steady_clock;
-  if (source == "udp_json") {
+  if (source == RobotStateOrigin::udp_json) {
     UdpJsonParams params;
     params.listen = state.listen;
     params.history = robot_state_history_params(config);
@@ -193,7 +213,7 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
       throw ConfigError(where + ": " + e.what());
     }
   }
-  if (source == "rtde") {
+  if (source == RobotStateOrigin::rtde) {
     if (state.host.empty()) throw ConfigError(where + ": robot.state.host: required for robot.state.source rtde");
     RtdeParams params;
     params.host = state.host;
@@ -203,20 +223,23 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
     params.arm = config.pipeline.robot.arm;  // the forward kinematics actual_TCP_pose is checked against
     return std::make_unique<RtdeRobotState>(params, run_clock);
   }
-  if (source == "recorded") {
+  if (source == RobotStateOrigin::recorded) {
     throw ConfigError(where + ": robot.state.source recorded: the joint states come from the recording (source.type bag)");
   }
-  throw ConfigError(where + ": robot.state.source '" + source + "': not built into this hrcsense");
+  throw ConfigError(where + ": robot.state.source '" + robot_state_origin_name(source) +
+                    "': not built into this hrcsense");
 }
 
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, Source& source, RunClock* clock,
                                                           std::shared_ptr<TrajectoryClock> trajectory_clock) {
-  if (config.robot_state.source != "recorded") return make_robot_state_source(config, clock, std::move(trajectory_clock));
+  if (config.robot_state.source != RobotStateOrigin::recorded) {
+    return make_robot_state_source(config, clock, std::move(trajectory_clock));
+  }
   const std::string where = config_where(config);
   const auto* bag = dynamic_cast<const BagSource*>(&source);
   if (bag == nullptr) {
     throw ConfigError(where + ": robot.state.source recorded: needs source.type bag (a recording made by hrcsense), not " +
-                      config.source.type);
+                      source_type_name(config.source.type));
   }
   std::unique_ptr<RobotStateSource> states = bag->recorded_robot_state();
   if (!states) {
@@ -234,7 +257,8 @@ bool load_background_file(const Config& config, const SourceInfo& info, Pipeline
   if (model.width != filtered.width || model.height != filtered.height) {
     throw IoError(config.background_path + ": background is " + std::to_string(model.width) + "x" +
                   std::to_string(model.height) + " but the filtered source is " + std::to_string(filtered.width) +
-                  "x" + std::to_string(filtered.height) + " (filters.preset " + config.filters_preset + ")");
+                  "x" + std::to_string(filtered.height) + " (filters.preset " +
+                  filter_preset_name(config.filters_preset) + ")");
   }
   pipeline.set_background(std::move(model), "background.path '" + config.background_path + "'");
   return true;
@@ -258,9 +282,9 @@ std::unique_ptr<UdpLinkSink> make_udp_link_sink(const Config& config, const RunC
   static SteadyClock steady_clock;  // stateless: reads the same time as the run's
   UdpLinkParams params;
   params.address = link.udp_address;
-  params.format = link.udp_format == "json" ? UdpLinkParams::Format::json : UdpLinkParams::Format::binary;
+  params.format = link.udp_format == UdpFormat::json ? UdpLinkParams::Format::json : UdpLinkParams::Format::binary;
   params.heartbeat_hz = link.heartbeat_hz;
-  params.backend = config.pipeline.backend;
+  params.backend = proximity_backend_name(config.pipeline.backend);
   try {
     return std::make_unique<UdpLinkSink>(params, clock != nullptr ? *clock : steady_clock);
   } catch (const std::invalid_argument& e) {
@@ -271,7 +295,7 @@ std::unique_ptr<UdpLinkSink> make_udp_link_sink(const Config& config, const RunC
 
 std::unique_ptr<RtdeLinkSink> make_rtde_link_sink(const Config& config, const RunClock* clock) {
   const LinkConfig& link = config.link;
-  if (link.rtde_write == "off") return nullptr;
+  if (link.rtde_write == RtdeWrite::off) return nullptr;
   const std::string where = config_where(config);
   if (config.robot_state.host.empty()) {
     throw ConfigError(where + ": link.rtde.write: needs the controller's address robot.state.host");
@@ -280,8 +304,8 @@ std::unique_ptr<RtdeLinkSink> make_rtde_link_sink(const Config& config, const Ru
   RtdeLinkParams params;
   params.host = config.robot_state.host;
   params.port = config.robot_state.port;
-  params.mode = link.rtde_write == "speed_slider" ? RtdeLinkParams::Mode::speed_slider
-                                                  : RtdeLinkParams::Mode::input_register;
+  params.mode = link.rtde_write == RtdeWrite::speed_slider ? RtdeLinkParams::Mode::speed_slider
+                                                           : RtdeLinkParams::Mode::input_register;
   params.register_index = link.rtde_register;
   params.min_speed_slider = link.rtde_min_speed_slider;
   params.heartbeat_hz = link.heartbeat_hz;
@@ -317,14 +341,14 @@ RunHeader make_run_header(const Config& config, const SourceInfo& info) {
   header.config_hash = config_hash(config);
   header.session = process_session();  // the link's datagrams carry the same (UdpLinkParams::session 0)
   header.source = info;
-  header.robot_state = config.robot_state.source;
-  if (config.robot_state.source == "rtde") {
+  header.robot_state = robot_state_origin_name(config.robot_state.source);
+  if (config.robot_state.source == RobotStateOrigin::rtde) {
     header.robot_state_reports.push_back("robot_status");
     if (config.pipeline.robot.arm) header.robot_state_reports.push_back("tcp_pose_check");
   }
   RunHeader::Filters& filters = header.filters;
   const FilterChainParams& chain = config.pipeline.filters;
-  filters.preset = config.filters_preset;
+  filters.preset = filter_preset_name(config.filters_preset);
   filters.domain = filter_domain(chain, info.stereo_baseline_mm);
   const bool wants_disparity =
       has_block(chain.order, FilterBlock::to_disparity);

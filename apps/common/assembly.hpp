@@ -24,6 +24,10 @@
 
 namespace hrcsense {
 
+/// What messages call the configuration: its file, or "configuration" when it has none (the
+/// defaults and --set alone).
+std::string config_where(const Config& config);
+
 /// The configured arm as a static simulator object named "robot": its rendering capsules
 /// (robot_render_capsules: the visual body, no padding) at robot.joints_rad in the
 /// robot.base_frame frame, so the arm is part of the learnt background. Empty for robot.model
@@ -58,6 +62,10 @@ class SourceStartError : public std::runtime_error {
 
 /// Throws ConfigError for what the configuration gets wrong, SourceStartError as above.
 std::unique_ptr<Source> make_source(const Config& config, const SourceOptions& options = {});
+
+/// The live camera's parameters from `source.*` (source.type realsense): the SDK adapter is
+/// given plain values and never sees the configuration.
+RealSenseParams realsense_params(const SourceConfig& source, const std::atomic<bool>* stop_requested);
 
 /// The RealSense cameras connected (`hrcsense devices`); throws ConfigError in a build without
 /// the SDK, saying how to get it.

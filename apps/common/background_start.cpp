@@ -21,15 +21,12 @@
 namespace hrcsense {
 namespace {
 
-// Where the configuration came from, for errors about its keys.
-std::string where(const Config& config) { return config.file.empty() ? "<defaults>" : config.file; }
-
 // The reference file: it must exist (a configuration that names one must never start without
 // it), be undamaged and be of the filtered resolution the background is learnt at.
 BackgroundModel load_reference(const Config& config, const SourceInfo& info) {
   const std::string& path = config.background_reference;
   if (!std::filesystem::exists(path)) {
-    throw ConfigError(where(config) + ": key 'background.reference': no such file '" + path +
+    throw ConfigError(config_where(config) + ": key 'background.reference': no such file '" + path +
                       "'; teach one with the cell empty: hrcsense teach --config FILE --out " + path);
   }
   BackgroundModel model = load_background(path);  // IoError naming the file: damaged, a folder, a FIFO
@@ -37,8 +34,8 @@ BackgroundModel load_reference(const Config& config, const SourceInfo& info) {
   if (model.width != filtered.width || model.height != filtered.height) {
     throw IoError(path + ": reference background is " + std::to_string(model.width) + "x" +
                   std::to_string(model.height) + " but the filtered source is " + std::to_string(filtered.width) +
-                  "x" + std::to_string(filtered.height) + " (filters.preset " + config.filters_preset +
-                  "); teach it again with this configuration");
+                  "x" + std::to_string(filtered.height) + " (filters.preset " +
+                  filter_preset_name(config.filters_preset) + "); teach it again with this configuration");
   }
   return model;
 }

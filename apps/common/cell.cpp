@@ -28,8 +28,6 @@ class UnstartedSource final : public Source {
   std::string error_;
 };
 
-bool is_recording(const Config& config) { return config.source.type == "bag" || config.source.type == "folder"; }
-
 // The source and the robot states it brings or needs (a bag's joint states), wrapped for a
 // viewer's playback when asked.
 void open_source(Cell& cell, const Config& config, const CellOptions& options, bool paced) {
@@ -43,11 +41,11 @@ void open_source(Cell& cell, const Config& config, const CellOptions& options, b
   try {
     cell.source = make_source(config, source_options);
   } catch (const SourceStartError& e) {
-    cell.source = std::make_unique<UnstartedSource>(config.source.type, e.what());
+    cell.source = std::make_unique<UnstartedSource>(source_type_name(config.source.type), e.what());
     cell.source_started = false;
   }
   cell.robot_states = make_robot_state_source(config, *cell.source, nullptr, cell.trajectory_clock);
-  if (options.wrap_recording && is_recording(config)) {
+  if (options.wrap_recording && is_recording(config.source.type)) {
     // The robot states may come from the first source: the wrapper keeps it alive.
     cell.source = options.wrap_recording(std::move(cell.source),
                                          [config, source_options] { return make_source(config, source_options); });
@@ -70,7 +68,7 @@ void add_recording(Cell& cell, const Config& config, const CellOptions& options,
 void add_links(Cell& cell, const Config& config) {
   cell.udp_link = make_udp_link_sink(config);
   if (cell.udp_link) {
-    spdlog::info("link: verdicts to {} ({}, heartbeat {} Hz)", cell.udp_link->address(), config.link.udp_format,
+    spdlog::info("link: verdicts to {} ({}, heartbeat {} Hz)", cell.udp_link->address(), udp_format_name(config.link.udp_format),
                  config.link.heartbeat_hz);
   }
   cell.rtde_link = make_rtde_link_sink(config);
@@ -117,7 +115,7 @@ std::unique_ptr<Cell> assemble_cell(const Config& config, const CellOptions& opt
   // follow_link: the simulated arm takes the scale the links have just sent.
   if (cell->trajectory_clock) cell->follow = std::make_unique<FollowLinkSink>(cell->trajectory_clock);
   // Simulated runs: truth.contact_label from the simulator's own labels.
-  if (config.source.type == "sim") cell->truth.emplace(make_simulator(config, cell->trajectory_clock));
+  if (config.source.type == SourceType::sim) cell->truth.emplace(make_simulator(config, cell->trajectory_clock));
   cell->header = make_run_header(config, info);
   cell->header.unknown_background_share = cell->pipeline->unknown_background_share();  // a loaded background's
   if (!cell->header.filters.note.empty()) spdlog::warn("filters: {}", cell->header.filters.note);

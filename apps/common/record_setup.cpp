@@ -18,12 +18,12 @@ RecorderParams recorder_params(const Config& config, const std::string& path, co
   RecorderParams params;
   params.path = path;
   params.split_mb = config.record.split_mb;
-  params.on_error = config.record.on_error == "stop" ? RecordOnError::stop_run : RecordOnError::continue_run;
+  params.on_error = config.record.on_error;
   params.queue_frames = config.record.queue_frames;
   params.bag.fps = static_cast<uint32_t>(std::lround(std::max(1.0, info.nominal_fps)));
   params.bag.stereo_baseline_mm = info.stereo_baseline_mm;
   // A UR arm's joints under UR's ROS names; other arms' descriptions name none: joint_0..5.
-  if (config.robot_model == "ur5" || config.robot_model == "ur5e" || config.robot_model == "ur10e") {
+  if (builtin_arm_of(config.robot_model)) {  // every built-in arm is a UR
     params.bag.joint_names.assign(kUrJointNames.begin(), kUrJointNames.end());
   }
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();

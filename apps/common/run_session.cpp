@@ -152,7 +152,7 @@ CellOptions cell_options(const SessionOptions& args) {
 class SessionSinks {
  public:
   SessionSinks(Cell& cell, std::ostream& out, const Config& config, const SessionOptions& args)
-      : jsonl_(out, config.pipeline.backend, extras(cell, args)),
+      : jsonl_(out, proximity_backend_name(config.pipeline.backend), extras(cell, args)),
         tee_(sinks(cell, args)),
         faults_(tee_, fault_probes(*cell.robot_states, cell.recorder.get(), cell.udp_link.get(), cell.rtde_link.get()),
                 [] { return SteadyClock().now_ns(); }) {}

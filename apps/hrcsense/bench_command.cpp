@@ -87,13 +87,14 @@ BackgroundModel learn(const PipelineParams& params, const std::vector<Frame>& fr
 // state to replay, so their frames get robot.joints_rad, with a warning.
 std::vector<RobotState> robot_states_for(const Config& config, Source& source, const std::vector<Frame>& frames) {
   std::unique_ptr<RobotStateSource> states;
-  const std::string& origin = config.robot_state.source;
-  if (origin == "fixed" || origin == "sim") {
+  const RobotStateOrigin origin = config.robot_state.source;
+  if (origin == RobotStateOrigin::fixed || origin == RobotStateOrigin::sim) {
     states = make_robot_state_source(config);
-  } else if (origin == "recorded") {
+  } else if (origin == RobotStateOrigin::recorded) {
     states = make_robot_state_source(config, source);
   } else {
-    spdlog::warn("bench: robot.state.source {} is live; the frames get robot.joints_rad instead", origin);
+    spdlog::warn("bench: robot.state.source {} is live; the frames get robot.joints_rad instead",
+                 robot_state_origin_name(origin));
   }
   std::vector<RobotState> out(frames.size(), fixed_robot_state(config.robot_state.joints_rad));
   if (!states) return out;

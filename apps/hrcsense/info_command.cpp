@@ -70,8 +70,7 @@ int print_sim(const Config& config) {
   const Simulator simulator = make_simulator(config);
   const SimParams& sim = simulator.params;
   const Intrinsics in = simulator.intrinsics();
-  std::printf("source: sim (seed %llu)%s\n", static_cast<unsigned long long>(sim.seed),
-              config.file.empty() ? "" : (", " + config.file).c_str());
+  std::printf("source: sim (seed %llu), %s\n", static_cast<unsigned long long>(sim.seed), config_where(config).c_str());
   std::printf("sensor: %s\n", sim_sensor_name(sim.sensor));
   std::printf("resolution: %dx%d at %.3g frames/s\n", in.width, in.height, sim.fps);
   std::printf("intrinsics: fx=%.4f fy=%.4f ppx=%.4f ppy=%.4f model=%s\n", static_cast<double>(in.fx),
@@ -87,7 +86,8 @@ int print_sim(const Config& config) {
   std::printf("frames: %lld (%.3f s)\n", static_cast<long long>(sim.frames), static_cast<double>(sim.frames) / sim.fps);
   print_sensor_effects(simulator);
   print_scene(config.scene);
-  std::printf("robot: %s, %zu capsule(s)\n", config.robot_model.c_str(), fixed_robot_model(config).capsules.size());
+  std::printf("robot: %s, %zu capsule(s)\n", robot_model_name(config.robot_model),
+              fixed_robot_model(config).capsules.size());
   std::printf("config hash: %s\n", config_hash(config).c_str());
   return 0;
 }
@@ -96,8 +96,8 @@ int print_sim(const Config& config) {
 int print_recording(const std::string& path) {
   const RecordingSummary s = summarize_recording(path);
   std::printf("recording: %s\n", s.path.c_str());
-  std::printf("format: %s", s.format.c_str());
-  if (s.format == "bag") {
+  std::printf("format: %s", recording_format_text(s).c_str());
+  if (s.format == RecordingFormat::bag) {
     std::printf(" (%s, file version %d)", s.indexed ? "indexed" : "no usable index, scanned", s.file_version);
   }
   std::printf("\ncompression: %s\n", s.compression.c_str());
@@ -155,8 +155,8 @@ void print_background(const Config& config, int64_t max_frames) {
     print_share(("loaded from " + config.background_path).c_str());
     return;
   }
-  const std::string& state_source = config.robot_state.source;
-  const bool placed = state_source == "fixed" || state_source == "sim";
+  const RobotStateOrigin state_source = config.robot_state.source;
+  const bool placed = state_source == RobotStateOrigin::fixed || state_source == RobotStateOrigin::sim;
   std::unique_ptr<RobotStateSource> robot_states = placed ? make_robot_state_source(config) : nullptr;
   Frame frame;
   FrameResult result;
@@ -172,7 +172,10 @@ void print_background(const Config& config, int64_t max_frames) {
     ++frames;
     learnt += result.withheld_code == ReasonCode::learning_background ? 1 : 0;
   }
-  if (!placed) std::printf("background: robot.state.source %s not connected: motion counted everywhere\n", state_source.c_str());
+  if (!placed) {
+    std::printf("background: robot.state.source %s not connected: motion counted everywhere\n",
+                robot_state_origin_name(state_source));
+  }
   // Every refused batch is background.frames learnt frames (a change of image size, which also
   // restarts, cannot happen within one source).
   const int64_t batch = std::max(config.pipeline.background.frames, 1);
@@ -204,13 +207,13 @@ int info_command(const CommandArgs& args) {
     return print_recording(args.input);
   }
   const Config config = load_config(args.config_path, args.sets);
-  if (config.source.type == "folder" || config.source.type == "bag") {
+  if (is_recording(config.source.type)) {
     if (config.source.path.empty()) make_source(config);  // throws: source.path is required
     const int status = print_recording(config.source.path);
     if (status == 0) print_background(config, args.frames);
     return status;
   }
-  if (config.source.type == "realsense") {
+  if (config.source.type == SourceType::realsense) {
     // Without the SDK: the ConfigError saying so. With it: what the camera (or .bag) reports.
     const SourceInfo info = make_source(config)->info();
     std::printf("source: realsense, %s (serial %s, firmware %s)\n", info.camera_name.c_str(),
@@ -219,7 +222,7 @@ int info_command(const CommandArgs& args) {
                 info.nominal_fps);
     return 0;
   }
-  if (config.source.type != "sim") {
+  if (config.source.type != SourceType::sim) {
     make_source(config);  // ros2 in a build without DDS: throws "not built into this hrcsense"
   }
   const int status = print_sim(config);

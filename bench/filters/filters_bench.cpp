@@ -224,10 +224,10 @@ void bm_hole_filling(benchmark::State& state, int w, int h, int mode) {
 }
 
 // The whole chain as the pipeline runs it, including the copy of the source frame.
-void bm_chain(benchmark::State& state, int w, int h, const char* preset) {
+void bm_chain(benchmark::State& state, int w, int h, FilterPreset preset) {
   const Inputs& in = inputs(w, h);
   FilterChain chain;
-  chain.params = *filter_preset(preset);
+  chain.params = filter_preset(preset);
   Frame out;
   size_t i = 0;
   for (auto _ : state) {
@@ -349,8 +349,8 @@ const bool registered = [] {
     add("HoleFilling/left", w, h, bm_hole_filling, 0);
     add("HoleFilling/farthest", w, h, bm_hole_filling, 1);
     add("HoleFilling/nearest", w, h, bm_hole_filling, 2);
-    add("Chain/thesis", w, h, bm_chain, "thesis");
-    add("Chain/sdk", w, h, bm_chain, "sdk");
+    add("Chain/thesis", w, h, bm_chain, FilterPreset::thesis);
+    add("Chain/sdk", w, h, bm_chain, FilterPreset::sdk);
     add("Chain/no_decimation", w, h, bm_chain_no_decimation);
     add("Reference/Spatial/disparity", w, h, bm_reference_spatial_disparity);
     add("Reference/Temporal/disparity", w, h, bm_reference_temporal_disparity);
@@ -363,7 +363,7 @@ const bool registered = [] {
     add_portable("HoleFilling/left", w, h, bm_hole_filling, 0);
     add_portable("HoleFilling/farthest", w, h, bm_hole_filling, 1);
     add_portable("HoleFilling/nearest", w, h, bm_hole_filling, 2);
-    add_portable("Chain/thesis", w, h, bm_chain, "thesis");
+    add_portable("Chain/thesis", w, h, bm_chain, FilterPreset::thesis);
   }
   return true;
 }();

@@ -16,6 +16,29 @@
 
 namespace hrcsense {
 
+// Closed choices (a key with a fixed list of names) are enums, parsed once in src/config; the
+// rest of the code compares the enum, and prints the name with the *_name function below.
+
+/// `source.type`: where the frames come from.
+enum class SourceType { sim, folder, bag, realsense, ros2 };
+/// A recording played back (folder or bag), not a live or simulated camera.
+inline bool is_recording(SourceType type) { return type == SourceType::folder || type == SourceType::bag; }
+/// `link.udp.format`: the datagram's layout.
+enum class UdpFormat { binary, json };
+/// `link.rtde.write`: what goes to the controller over RTDE (input_register is `register`).
+enum class RtdeWrite { off, speed_slider, input_register };
+/// `robot.model`: padded points, a built-in arm, or an arm from `robot.description`.
+enum class RobotModelType { points, ur5, ur5e, ur10e, custom };
+
+/// The configuration's name of each choice (a static string): "sim", "json", "register", ...
+const char* source_type_name(SourceType type);
+const char* udp_format_name(UdpFormat format);
+const char* rtde_write_name(RtdeWrite write);
+const char* robot_model_name(RobotModelType model);
+const char* record_on_error_name(RecordOnError on_error);  ///< "continue", "stop"
+/// The built-in arm a model names; nullopt for points and custom.
+std::optional<BuiltinArm> builtin_arm_of(RobotModelType model);
+
 /// A configuration problem; what() names the file and the key.
 class ConfigError : public std::runtime_error {
  public:
@@ -62,11 +85,10 @@ struct ColorStreamConfig {
 };
 
 struct SourceConfig {
-  std::string type = "sim";        ///< sim (default), folder, bag, realsense, ros2
+  SourceType type = SourceType::sim;  ///< `source.type`
   std::string path;                ///< file or folder for recorded sources (realsense: a .bag to play through the SDK)
   bool pace = false;               ///< play at the recorded / nominal rate
   bool loop = false;               ///< start over at the end
-  uint64_t seed = 1;               ///< simulator noise seed
   float stereo_baseline_mm = 0.0F; ///< for sources that do not carry one
   // The live camera (`source.type: realsense`, docs/CAMERAS.md).
   std::string serial;              ///< `source.serial`: the camera's serial number; empty: the first camera found
@@ -87,7 +109,7 @@ struct SourceConfig {
 struct RobotStateConfig {
   /// `robot.state.source`: fixed (robot.joints_rad), sim (robot.trajectory), rtde (a UR
   /// controller), udp_json (any robot), recorded (a .bag from hrcsense record).
-  std::string source = "fixed";
+  RobotStateOrigin source = RobotStateOrigin::fixed;
   /// `robot.joints_rad`: the fixed pose, joint 1 first (required for an arm with the fixed
   /// source; zeros when not given).
   JointAngles joints_rad{};
@@ -109,7 +131,8 @@ struct RobotStateConfig {
 /// `record.*`: recordings made by `hrcsense record` and `hrcsense run --record` (docs/RECORDINGS.md).
 struct RecordConfig {
   int64_t split_mb = 0;             ///< `record.split_mb`: > 0: a new file (NAME-000.bag, ...) past this many MiB; 0: one file
-  std::string on_error = "continue";  ///< `record.on_error`: continue (processing goes on unrecorded) or stop
+  /// `record.on_error`: continue (processing goes on unrecorded) or stop
+  RecordOnError on_error = RecordOnError::continue_run;
   int queue_frames = 16;            ///< `record.queue_frames`: frames waiting for the disk before drops
 };
 
@@ -118,11 +141,11 @@ struct LinkConfig {
   /// `link.udp.address`: "host:port" (numeric IPv4 or [IPv6]) the datagrams go to; empty: no
   /// UDP link.
   std::string udp_address;
-  std::string udp_format = "binary";  ///< `link.udp.format`: binary (the HRCS layout) or json (the frame line)
+  UdpFormat udp_format = UdpFormat::binary;  ///< `link.udp.format`: binary (the HRCS layout) or json (the frame line)
   double heartbeat_hz = 20.0;         ///< `link.heartbeat_hz`: heartbeats while no frame comes, Hz
   /// `link.rtde.write`: off (default), speed_slider or register: the speed scale written to the
   /// controller at robot.state.host over RTDE.
-  std::string rtde_write = "off";
+  RtdeWrite rtde_write = RtdeWrite::off;
   int rtde_register = 24;             ///< `link.rtde.register`: input_double_register_N, N in 24..47
   /// `link.rtde.min_speed_slider`: the slider never goes below this fraction (a hard 0 then
   /// another value has caused protective stops); stops go through the register path.
@@ -136,11 +159,11 @@ struct LinkConfig {
 struct Config {
   std::string file;                ///< where it was read from ("" for defaults only)
   SourceConfig source;
-  SimParams sim;                   ///< `sim.*`: the simulated camera
+  SimParams sim;                   ///< `sim.*`: the simulated camera; `source.seed` is sim.seed
   Scene scene;                     ///< `scene.objects`: the simulated scene
   /// `filters.preset`: none, sdk (default: the RealSense Viewer's) or thesis; the chain itself
   /// is in pipeline.filters.
-  std::string filters_preset = "sdk";
+  FilterPreset filters_preset = FilterPreset::sdk;
   std::string background_path;     ///< `background.path`: load if it exists, else save after learning
   /// `background.reference`: a background taught with the cell empty (`hrcsense teach`); each
   /// start learns afresh and compares the learnt background with it (background_path is then
@@ -149,11 +172,10 @@ struct Config {
   PipelineParams pipeline;         ///< camera pose, robot, background, foreground, proximity, safety
   /// `robot.model`: points, ur5, ur5e, ur10e or custom. The arm (built in or from
   /// `robot.description`), `robot.padding_m` in effect (an arm's own padding by default) and
-  /// `robot.base_frame` are in pipeline.robot.
-  std::string robot_model = "points";
-  std::string robot_base_frame = "base"; ///< `robot.base_frame`: base or base_link (pipeline.robot.base_frame)
+  /// `robot.base_frame` are in pipeline.robot; `proximity.*` in pipeline.backend and
+  /// pipeline.proximity.
+  RobotModelType robot_model = RobotModelType::points;
   RobotStateConfig robot_state;          ///< `robot.state.*` and `robot.joints_rad`
-  int proximity_octree_height = 4;       ///< `proximity.octree.height` (1-10), for the octree backend
   RecordConfig record;                   ///< `record.*`
   PublishConfig publish;                 ///< `publish.*`
   LinkConfig link;                       ///< `link.*`

@@ -172,9 +172,17 @@ struct FilterChainParams {
   HoleFillingParams hole_filling;
 };
 
-/// The chains of the presets: "none" (empty), "sdk" (the RealSense Viewer's defaults) and
-/// "thesis" (the 2020 thesis's settings). nullopt for an unknown name.
-std::optional<FilterChainParams> filter_preset(std::string_view name);
+/// `filters.preset`: the chain a configuration starts from.
+enum class FilterPreset {
+  none,    ///< no filters
+  sdk,     ///< the RealSense Viewer's defaults
+  thesis,  ///< the 2020 thesis's settings
+};
+inline constexpr FilterPreset kFilterPresets[] = {FilterPreset::none, FilterPreset::sdk, FilterPreset::thesis};
+/// The configuration's name of a preset (static string): "none", "sdk" or "thesis".
+const char* filter_preset_name(FilterPreset preset);
+/// The preset's chain: its order and its options.
+FilterChainParams filter_preset(FilterPreset preset);
 
 /// The intrinsics of the chain's output for a source with intrinsics `source`: decimation
 /// scales them, the other blocks keep them. This is the resolution the pipeline learns its

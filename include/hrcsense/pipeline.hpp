@@ -45,9 +45,7 @@ struct PipelineParams {
   SelfFilterParams self_filter;
   SafetyParams safety;
   CellCheckParams checks;  ///< the image watchdogs (camera blocked or moved, robot envelope invalid)
-  /// `proximity.backend`: brute, kdtree, octree or auto (depth_space later); the pipeline throws
-  /// std::invalid_argument for another name.
-  std::string backend = "brute";
+  ProximityBackend backend = ProximityBackend::brute;  ///< `proximity.backend`
   ProximityParams proximity;  ///< octree height, brute threads
 };
 
@@ -58,7 +56,7 @@ struct PipelineParams {
 struct LiveTuning {
   FilterChainParams filters;
   ForegroundParams foreground;
-  std::string backend = "brute";  ///< as PipelineParams::backend
+  ProximityBackend backend = ProximityBackend::brute;  ///< as PipelineParams::backend
 };
 
 /// The tunable part of `params`.
@@ -106,7 +104,7 @@ class Pipeline {
   LiveTuning tuning() const;
   /// Takes `tuning` from the next frame on (call it between frames, on the processing thread).
   /// Throws std::invalid_argument, naming the field, when it changes the filter order or the
-  /// decimation, or names no backend; the pipeline is then unchanged.
+  /// decimation; the pipeline is then unchanged.
   void retune(const LiveTuning& tuning);
   /// Forgets the background (learnt or loaded) and learns a new one from the next frames,
   /// which are stops (`learning_background`) until it is ready.

@@ -37,9 +37,11 @@ enum class ProximityBackend {
   automatic,  ///< picks one by cloud size (config name "auto")
 };
 
-/// "brute", "kdtree", "octree" or "auto"; nullopt for anything else.
-std::optional<ProximityBackend> parse_proximity_backend(std::string_view name);
-/// The configuration name of a backend (static string).
+/// Every backend, in the order the configuration lists them.
+inline constexpr ProximityBackend kProximityBackends[] = {ProximityBackend::brute, ProximityBackend::kdtree,
+                                                         ProximityBackend::octree, ProximityBackend::automatic};
+/// The configuration name of a backend (static string): "brute", "kdtree", "octree" or "auto".
+/// The name is parsed in src/config (proximity.backend), nowhere else.
 const char* proximity_backend_name(ProximityBackend backend);
 
 /// Tuning of the search; which backend is chosen separately (ProximitySearch's constructor).

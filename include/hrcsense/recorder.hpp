@@ -22,9 +22,6 @@
 
 namespace hrcsense {
 
-/// `record.on_error`: after a write error, go on without recording (continue) or end the run (stop).
-enum class RecordOnError { continue_run, stop_run };
-
 struct RecorderParams {
   std::string path;               ///< FILE.bag; with split_mb > 0 the files are FILE-000.bag, FILE-001.bag, ...
   int64_t split_mb = 0;           ///< `record.split_mb`: start a new file past this many MiB; 0: one file

@@ -27,9 +27,13 @@ struct RecordingStream {
 
 /// What a recording holds, for `hrcsense info` and for tests. Read by going through the
 /// whole recording once.
+/// A recording's kind: the SDK's .bag file or a folder of PNG frames.
+enum class RecordingFormat { bag, folder };
+
 struct RecordingSummary {
   std::string path;
-  std::string format;               ///< "bag", "folder (ist layout)", "folder (TUM layout)"
+  RecordingFormat format = RecordingFormat::bag;
+  std::string folder_layout;        ///< folder: "ist" or "TUM"; bag: empty
   std::string compression;          ///< bag: chunk compressions seen ("lz4", "none", "lz4+none"); folder: "png"
   std::vector<RecordingStream> streams;  ///< depth first
   float depth_units_m = 0.001F;     ///< metres per raw depth unit
@@ -46,6 +50,10 @@ struct RecordingSummary {
 /// Throws IoError when the recording cannot be opened at all (missing, wrong magic, no
 /// intrinsics); damage later in the file is reported in `damage` instead.
 RecordingSummary summarize_recording(const std::string& path);
+
+/// The recording's format as `hrcsense info` prints it: "bag", "folder (ist layout)",
+/// "folder (TUM layout)".
+std::string recording_format_text(const RecordingSummary& summary);
 
 /// Options shared by the recorded sources.
 struct RecordingParams {

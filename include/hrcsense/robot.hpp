@@ -77,10 +77,11 @@ struct LinkFrames {
   std::array<Pose, kArmLinkCount> T_base_link;
 };
 
-/// The built-in arms: "ur5" (CB3), "ur5e", "ur10e".
-const std::vector<std::string>& builtin_robot_names();
-/// A built-in arm by name; throws std::invalid_argument for an unknown name.
-const RobotDescription& builtin_robot(const std::string& name);
+/// The built-in arms (robot.model ur5, ur5e, ur10e): UR's CB3 UR5, the e-Series UR5e and UR10e.
+enum class BuiltinArm { ur5, ur5e, ur10e };
+inline constexpr BuiltinArm kBuiltinArms[] = {BuiltinArm::ur5, BuiltinArm::ur5e, BuiltinArm::ur10e};
+/// A built-in arm's description; its `name` is the arm's robot.model name ("ur5", ...).
+const RobotDescription& builtin_robot(BuiltinArm arm);
 
 /// ROS-style name of a link index (0..7): base, shoulder, upper_arm, forearm, wrist_1,
 /// wrist_2, wrist_3, tool; "link<i>" outside that range.

@@ -155,10 +155,9 @@ struct SimParams {
   Eigen::Vector3f color_translation_m{0.01508F, 0.0000046F, 0.00017F};
 };
 
-/// The name `sim.sensor` gives `sensor`: "d435" or "structured_light".
+/// The name `sim.sensor` gives `sensor`: "d435" or "structured_light" (the configuration parses
+/// it, src/config).
 const char* sim_sensor_name(SimSensor sensor);
-/// The sensor called `name` (as sim_sensor_name writes it); nullopt for any other name.
-std::optional<SimSensor> parse_sim_sensor(const std::string& name);
 
 /// Sets `sensor` and the effects' values that model it in `p` (docs/SIMULATOR.md, "Sensor
 /// models"): d435 restores SimParams{}'s, structured_light its own (640x480, baseline 75 mm,

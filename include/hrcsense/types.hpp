@@ -180,6 +180,9 @@ using JointAngles = std::array<double, kJointCount>;
 /// Where a robot state came from (`robot.state.source`).
 enum class RobotStateOrigin { fixed, sim, rtde, udp_json, recorded };
 
+/// `record.on_error`: after a write error, go on without recording (continue) or end the run (stop).
+enum class RecordOnError { continue_run, stop_run };
+
 /// What the robot controller says of itself at a robot state's time: UR RTDE's robot_mode,
 /// safety_mode, speed_scaling and target_speed_fraction (../shared/specs/ur-rtde.md) and the
 /// check of its actual_TCP_pose. The modes are reported only: the robot's own safety system acts

@@ -3,8 +3,10 @@
 // filters.<block>.<option> with the RealSense SDK's option ranges (specs/depth-filters.md).
 #include "key_reader.hpp"
 
+#include "hrcsense/number_text.hpp"
+
 #include <algorithm>
-#include <cstdio>
+#include <string>
 
 namespace hrcsense::config_detail {
 namespace {
@@ -107,7 +109,7 @@ void refuse_options_outside_the_chain(KeyReader& r, const Config& c, const Filte
   for (const BlockOption& option : kBlockOptions) {
     if (has_block(f.order, option.block) || option.value(f) == option.value(preset)) continue;
     r.fail(option.key, std::string("the ") + filter_block_name(option.block) +
-                           " block is not in the chain (filters.preset " + c.filters_preset +
+                           " block is not in the chain (filters.preset " + filter_preset_name(c.filters_preset) +
                            "), so this option would be ignored; add the block to filters.order or remove the option");
   }
 }
@@ -117,9 +119,9 @@ void refuse_options_outside_the_chain(KeyReader& r, const Config& c, const Filte
 void read_filters(KeyReader& r, Config& c) {
   // Without filters.preset the default of Config::filters_preset stands: "sdk", the chain a
   // RealSense Viewer user runs, so that settings tuned there carry over unchanged.
-  r.choice("filters.preset", c.filters_preset, {"none", "sdk", "thesis"});
+  r.choice("filters.preset", c.filters_preset, kFilterPresets, filter_preset_name);
   FilterChainParams& f = c.pipeline.filters;
-  f = *filter_preset(c.filters_preset);
+  f = filter_preset(c.filters_preset);
   bool order_given = false;
   const std::vector<FilterBlock> order = read_order(r, f.order, order_given);
   f.order = apply_enabled(r, order, order_given);
@@ -138,12 +140,7 @@ void read_filters(KeyReader& r, Config& c) {
 namespace hrcsense {
 
 std::vector<std::string> tuning_overrides(const LiveTuning& tuning) {
-  // %.9g: enough digits for a float to read back as the same float.
-  const auto entry = [](const char* key, double value) {
-    char text[96];
-    std::snprintf(text, sizeof text, "%s=%.9g", key, value);
-    return std::string(text);
-  };
+  const auto entry = [](const char* key, double value) { return std::string(key) + "=" + float_digits_text(value); };
   std::vector<std::string> sets;
   for (const config_detail::BlockOption& option : config_detail::kBlockOptions) {
     // Options of blocks outside the chain are refused by read_filters (they would be ignored).
@@ -152,7 +149,7 @@ std::vector<std::string> tuning_overrides(const LiveTuning& tuning) {
   sets.push_back(entry("foreground.k_sigma", tuning.foreground.k_sigma));
   sets.push_back(entry("foreground.min_margin_m", tuning.foreground.min_margin_m));
   sets.push_back(entry("foreground.min_object_mm", tuning.foreground.min_object_mm));
-  sets.push_back("proximity.backend=" + tuning.backend);
+  sets.push_back(std::string("proximity.backend=") + proximity_backend_name(tuning.backend));
   return sets;
 }
 

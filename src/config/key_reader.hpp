@@ -61,6 +61,18 @@ class KeyReader {
   void text(const std::string& key, std::string& value);
   /// A string that must be one of `allowed`.
   void choice(const std::string& key, std::string& value, const std::vector<std::string>& allowed);
+  /// A closed choice: the name of one of `values` (as `name` spells it), turned into that value
+  /// here, once; the effective configuration gets the name back.
+  template <class Choice, size_t N>
+  void choice(const std::string& key, Choice& value, const Choice (&values)[N], const char* (*name)(Choice)) {
+    std::string text = name(value);
+    std::vector<std::string> allowed;
+    for (const Choice option : values) allowed.emplace_back(name(option));
+    choice(key, text, allowed);
+    for (const Choice option : values) {
+      if (text == name(option)) value = option;
+    }
+  }
   void flag(const std::string& key, bool& value);
   void integer(const std::string& key, int64_t& value, int64_t min, int64_t max);
   void integer(const std::string& key, int& value, int min, int max);

@@ -49,11 +49,13 @@ Pose pose_from_rpy(const Eigen::Vector3f& translation_m, const Eigen::Vector3f& 
 }
 
 void read_source_and_sim(KeyReader& r, Config& c) {
-  r.choice("source.type", c.source.type, {"sim", "folder", "bag", "realsense", "ros2"});
+  constexpr SourceType kSourceTypes[] = {SourceType::sim, SourceType::folder, SourceType::bag, SourceType::realsense,
+                                         SourceType::ros2};
+  r.choice("source.type", c.source.type, kSourceTypes, source_type_name);
   r.text("source.path", c.source.path);
   r.flag("source.pace", c.source.pace);
   r.flag("source.loop", c.source.loop);
-  r.integer("source.seed", c.source.seed);
+  r.integer("source.seed", c.sim.seed);  // the simulator's noise and the sim robot state's jitter
   r.number("source.stereo_baseline_mm", c.source.stereo_baseline_mm, Bound::non_negative, kMaxBaselineMm);
   // A baseline of 1e-39 mm would make the stereo noise model infinite: nothing would be foreground.
   if (c.source.stereo_baseline_mm > 0.0F && c.source.stereo_baseline_mm < kMinBaselineMm) {
@@ -61,12 +63,12 @@ void read_source_and_sim(KeyReader& r, Config& c) {
                                             config_detail::float_text(c.source.stereo_baseline_mm));
   }
   config_detail::read_camera_source(r, c.source);  // src/config/camera_config.cpp
-  c.sim.seed = c.source.seed;
 
   // The sensor first: its preset fills the effects, and every sim.* key given overrides it.
-  std::string sensor = sim_sensor_name(c.sim.sensor);
-  r.choice("sim.sensor", sensor, {"d435", "structured_light"});
-  apply_sim_sensor(*parse_sim_sensor(sensor), c.sim);
+  SimSensor sensor = c.sim.sensor;
+  constexpr SimSensor kSensors[] = {SimSensor::d435, SimSensor::structured_light};
+  r.choice("sim.sensor", sensor, kSensors, sim_sensor_name);
+  apply_sim_sensor(sensor, c.sim);
   r.integer("sim.width", c.sim.width, 1, 65535);
   r.integer("sim.height", c.sim.height, 1, 65535);
   const std::string size = std::to_string(c.sim.width) + "x" + std::to_string(c.sim.height);
@@ -143,13 +145,22 @@ void read_segmentation(KeyReader& r, Config& c) {
   r.integer("self_filter.memory_frames", sf.memory_frames, 1, 30);
 }
 
+// `proximity.backend`: the core's backends by their names, and depth_space, which is named in
+// the schema (docs/PROXIMITY.md) but refused until it exists.
+void read_backend(KeyReader& r, ProximityBackend& backend) {
+  std::string name = proximity_backend_name(backend);
+  r.choice("proximity.backend", name, {"brute", "kdtree", "octree", "depth_space", "auto"});
+  if (name == "depth_space") not_implemented(r, "proximity.backend", name, "brute");
+  for (const ProximityBackend option : kProximityBackends) {
+    if (name == proximity_backend_name(option)) backend = option;
+  }
+}
+
 void read_robot_and_safety(KeyReader& r, Config& c) {
   config_detail::read_robot(r, c);  // src/config/robot_config.cpp
 
-  r.choice("proximity.backend", c.pipeline.backend, {"brute", "kdtree", "octree", "depth_space", "auto"});
-  if (c.pipeline.backend == "depth_space") not_implemented(r, "proximity.backend", c.pipeline.backend, "brute");
-  r.integer("proximity.octree.height", c.proximity_octree_height, 1, 10);
-  c.pipeline.proximity.octree_height = c.proximity_octree_height;
+  read_backend(r, c.pipeline.backend);
+  r.integer("proximity.octree.height", c.pipeline.proximity.octree_height, 1, 10);
   r.integer("proximity.threads", c.pipeline.proximity.threads, 1, 2);
 
   SafetyParams& safety = c.pipeline.safety;
@@ -251,21 +262,23 @@ void read_link(KeyReader& r, Config& c) {
       r.fail("link.udp.address", "expected host:port (e.g. 127.0.0.1:30020), not '" + link.udp_address + "'");
     }
   }
-  r.choice("link.udp.format", link.udp_format, {"binary", "json"});
+  constexpr UdpFormat kUdpFormats[] = {UdpFormat::binary, UdpFormat::json};
+  r.choice("link.udp.format", link.udp_format, kUdpFormats, udp_format_name);
   r.number_in("link.heartbeat_hz", link.heartbeat_hz, 0.1, 1000.0, " Hz");
-  r.choice("link.rtde.write", link.rtde_write, {"off", "speed_slider", "register"});
+  constexpr RtdeWrite kRtdeWrites[] = {RtdeWrite::off, RtdeWrite::speed_slider, RtdeWrite::input_register};
+  r.choice("link.rtde.write", link.rtde_write, kRtdeWrites, rtde_write_name);
   // Registers 0-23 belong to the controller's fieldbus adapters; 24-47 are free for RTDE clients.
   r.integer("link.rtde.register", link.rtde_register, 24, 47);
   r.number_in("link.rtde.min_speed_slider", link.rtde_min_speed_slider, 0.001, 1.0, "");
   r.flag("link.rtde.slider_unguarded_ok", link.rtde_slider_unguarded_ok);
-  if (link.rtde_write != "off" && c.robot_state.host.empty()) {
+  if (link.rtde_write != RtdeWrite::off && c.robot_state.host.empty()) {
     r.fail_pair("link.rtde.write", "robot.state.host", "link.rtde.write needs the controller's address");
   }
   // The slider is a value the controller keeps: when hrcsense dies (kill -9, a crash, a lost
   // host) it stays where the last write left it, 1.0 after a `run`, and nothing on the robot
   // notices. In ssm mode the scale is the protection against the person, so the slider is
   // refused there until the integrator has guarded it on the robot (docs/SAFETY.md) and says so.
-  if (link.rtde_write == "speed_slider" && c.pipeline.safety.mode == SafetyParams::Mode::ssm &&
+  if (link.rtde_write == RtdeWrite::speed_slider && c.pipeline.safety.mode == SafetyParams::Mode::ssm &&
       !link.rtde_slider_unguarded_ok) {
     r.fail_pair("link.rtde.write", "safety.mode",
                 "speed_slider in ssm mode keeps the robot at the last speed written (1.0 after a run) when "
@@ -309,7 +322,8 @@ void read_ros2(KeyReader& r, Config& c) {
 void read_record(KeyReader& r, Config& c) {
   // Up to 1 TiB per file; a bag's chunk positions are 64-bit, so only the file system limits it.
   r.integer("record.split_mb", c.record.split_mb, 0, int64_t{1} << 20);
-  r.choice("record.on_error", c.record.on_error, {"continue", "stop"});
+  constexpr RecordOnError kOnErrors[] = {RecordOnError::continue_run, RecordOnError::stop_run};
+  r.choice("record.on_error", c.record.on_error, kOnErrors, record_on_error_name);
   // Each queued 848x480 depth + colour frame holds about 2 MB: 1024 frames are 2 GB.
   r.integer("record.queue_frames", c.record.queue_frames, 1, 1024);
 }

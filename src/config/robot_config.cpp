@@ -5,6 +5,8 @@
 
 #include "yaml_tree.hpp"
 
+#include "hrcsense/robot_state.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -182,29 +184,21 @@ struct TrajectoryReader : YamlTree {
     const YAML::Node loop = child(map, "loop");
     if (loop.IsDefined()) out.loop = flag(loop, key + ".loop");
     // follow_link is read as a key of its own (read_robot), so that --set can reach it.
-    const YAML::Node waypoints = required(map, key, "waypoints");
-    if (!waypoints.IsSequence() || waypoints.size() < 2) {
+    const YAML::Node list = required(map, key, "waypoints");
+    if (!list.IsSequence() || list.size() < 2) {
       fail(key + ".waypoints", "expected a list of at least 2 waypoints {t_s, joints_rad}");
     }
-    for (size_t i = 0; i < waypoints.size(); ++i) {
-      const std::string item = key + ".waypoints[" + std::to_string(i) + "]";
-      only_keys(waypoints[i], item, {"t_s", "joints_rad"});
-      TrajectoryWaypoint point;
-      point.t_s = number(required(waypoints[i], item, "t_s"), item + ".t_s");
-      point.q_rad = joints(required(waypoints[i], item, "joints_rad"), item + ".joints_rad");
-      if (!out.waypoints.empty() && !(point.t_s > out.waypoints.back().t_s)) {
-        fail(item + ".t_s", "expected times strictly increasing (" + double_text(point.t_s) + " s after " +
-                                double_text(out.waypoints.back().t_s) + " s)");
-      }
+    const auto read_joints = [this, &arm](const YAML::Node& value, const std::string& value_key,
+                                          TrajectoryWaypoint& point) {
+      point.q_rad = joints(value, value_key);
       const int outside = joint_outside_limits(arm, point.q_rad);
       if (outside >= 0) {
         const size_t j = static_cast<size_t>(outside);
-        fail(item + ".joints_rad", "joint " + std::to_string(outside + 1) + " (" + joint_name(outside) + ") is " +
-                                       double_text(point.q_rad[j]) + " rad, outside its limits " +
-                                       limit_text(arm.limits[j]));
+        fail(value_key, "joint " + std::to_string(outside + 1) + " (" + joint_name(outside) + ") is " +
+                            double_text(point.q_rad[j]) + " rad, outside its limits " + limit_text(arm.limits[j]));
       }
-      out.waypoints.push_back(point);
-    }
+    };
+    out.waypoints = waypoints<TrajectoryWaypoint>(list, key + ".waypoints", "joints_rad", read_joints);
     // Looping from the last waypoint back to the first would make the arm jump.
     if (out.loop && out.waypoints.back().q_rad != out.waypoints.front().q_rad) {
       fail(key + ".waypoints[" + std::to_string(out.waypoints.size() - 1) + "].joints_rad",
@@ -234,10 +228,10 @@ YAML::Node trajectory_node(const RobotTrajectory& trajectory) {
 }
 
 // The description robot.model names: built in, or from robot.description (a file or inline).
-RobotDescription arm_description(KeyReader& r, const std::string& model, const YAML::Node& description) {
-  if (model != "custom") {
+RobotDescription arm_description(KeyReader& r, RobotModelType model, const YAML::Node& description) {
+  if (const std::optional<BuiltinArm> builtin = builtin_arm_of(model)) {
     if (description.IsDefined()) r.fail("robot.description", "is only read with robot.model custom");
-    return builtin_robot(model);
+    return builtin_robot(*builtin);
   }
   if (!description.IsDefined()) {
     r.fail("robot.description", "is required for robot.model custom: a description file or an inline map");
@@ -311,7 +305,9 @@ YAML::Node robot_description_node(const RobotDescription& description) {
 // `robot.state.*`: every key is read whatever the source, so the schema knows them all; the
 // assembly builds the source or says it is not built.
 void read_robot_state(KeyReader& r, RobotStateConfig& s) {
-  r.choice("robot.state.source", s.source, {"fixed", "sim", "rtde", "udp_json", "recorded"});
+  constexpr RobotStateOrigin kOrigins[] = {RobotStateOrigin::fixed, RobotStateOrigin::sim, RobotStateOrigin::rtde,
+                                           RobotStateOrigin::udp_json, RobotStateOrigin::recorded};
+  r.choice("robot.state.source", s.source, kOrigins, robot_state_origin_name);
   r.text("robot.state.host", s.host);
   r.integer("robot.state.port", s.port, 1, 65535);
   r.number_in("robot.state.frequency_hz", s.frequency_hz, 1.0, 500.0, " Hz");
@@ -320,7 +316,7 @@ void read_robot_state(KeyReader& r, RobotStateConfig& s) {
   r.number_in("robot.state.camera_latency_s", s.camera_latency_s, -1.0, 1.0, " s");
   r.number_in("robot.state.sim_latency_s", s.sim_latency_s, 0.0, 1.0, " s");
   r.number_in("robot.state.sim_jitter_s", s.sim_jitter_s, 0.0, 1.0, " s");
-  if (s.source == "rtde" && s.host.empty()) {
+  if (s.source == RobotStateOrigin::rtde && s.host.empty()) {
     r.fail("robot.state.host", "is required for robot.state.source rtde: the controller's address");
   }
   const size_t colon = s.listen.rfind(':');
@@ -342,10 +338,14 @@ struct RobotKeys {
   std::vector<double> joints_list;  ///< robot.joints_rad as given: empty when absent
 };
 
+const char* base_frame_name(BaseFrame frame) { return frame == BaseFrame::base_link ? "base_link" : "base"; }
+
 RobotKeys read_robot_keys(KeyReader& r, Config& c) {
   // Every key is read unconditionally first: known_keys() learns the schema from these reads.
   RobotKeys keys;
-  r.choice("robot.model", c.robot_model, {"points", "ur5", "ur5e", "ur10e", "custom"});
+  constexpr RobotModelType kModels[] = {RobotModelType::points, RobotModelType::ur5, RobotModelType::ur5e,
+                                        RobotModelType::ur10e, RobotModelType::custom};
+  r.choice("robot.model", c.robot_model, kModels, robot_model_name);
   read_robot_state(r, c.robot_state);
   keys.description = r.raw("robot.description");
   keys.tool = r.raw("robot.tool");
@@ -362,8 +362,8 @@ RobotKeys read_robot_keys(KeyReader& r, Config& c) {
   r.number_list("robot.joints_rad", keys.joints_list, kJointCount);
   JointAngles& joints_rad = c.robot_state.joints_rad;
   if (keys.joints_list.size() == kJointCount) std::copy(keys.joints_list.begin(), keys.joints_list.end(), joints_rad.begin());
-  r.choice("robot.base_frame", c.robot_base_frame, {"base", "base_link"});
-  c.pipeline.robot.base_frame = c.robot_base_frame == "base_link" ? BaseFrame::base_link : BaseFrame::base;
+  constexpr BaseFrame kBaseFrames[] = {BaseFrame::base, BaseFrame::base_link};
+  r.choice("robot.base_frame", c.pipeline.robot.base_frame, kBaseFrames, base_frame_name);
   return keys;
 }
 
@@ -375,7 +375,7 @@ void read_point_robot(KeyReader& r, Config& c, const RobotKeys& keys) {
   if (keys.trajectory.IsDefined()) {
     r.fail("robot.trajectory", "is only read with an arm (robot.model ur5, ur5e, ur10e or custom)");
   }
-  if (c.robot_state.source == "sim") {
+  if (c.robot_state.source == RobotStateOrigin::sim) {
     r.fail("robot.state.source", "sim moves an arm along robot.trajectory: it needs robot.model ur5, ur5e, ur10e or custom");
   }
   r.number("robot.padding_m", robot.padding_m, Bound::non_negative, kMaxCoordinateM);
@@ -403,8 +403,8 @@ void read_arm(KeyReader& r, Config& c, const RobotKeys& keys) {
   // No default pose: a wrong pose would put the arm where it is not, which is not fail-safe.
   // Live and simulated states bring their own; robot.joints_rad then only places the arm the
   // simulator renders when it has no trajectory.
-  if (keys.joints_list.size() != kJointCount && c.robot_state.source == "fixed") {
-    r.fail("robot.joints_rad", "is required for robot.model " + c.robot_model +
+  if (keys.joints_list.size() != kJointCount && c.robot_state.source == RobotStateOrigin::fixed) {
+    r.fail("robot.joints_rad", std::string("is required for robot.model ") + robot_model_name(c.robot_model) +
                                    " with robot.state.source fixed: 6 joint angles in radians, joint 1 (base) first");
   }
   const int outside = joint_outside_limits(arm, joints_rad);
@@ -419,7 +419,7 @@ void read_arm(KeyReader& r, Config& c, const RobotKeys& keys) {
     c.robot_state.trajectory = TrajectoryReader{{r.where(), prefix}}.trajectory(keys.trajectory, arm);
     c.robot_state.trajectory->follow_link = keys.follow_link;
     r.set_effective("robot.trajectory", trajectory_node(*c.robot_state.trajectory));
-  } else if (c.robot_state.source == "sim") {
+  } else if (c.robot_state.source == RobotStateOrigin::sim) {
     r.fail("robot.trajectory", "is required for robot.state.source sim: {interpolation: linear | cubic, loop, "
                                "waypoints: [{t_s, joints_rad}, ...]}");
   }
@@ -436,7 +436,7 @@ void read_arm(KeyReader& r, Config& c, const RobotKeys& keys) {
 
 void read_robot(KeyReader& r, Config& c) {
   const RobotKeys keys = read_robot_keys(r, c);
-  if (c.robot_model == "points") {
+  if (c.robot_model == RobotModelType::points) {
     read_point_robot(r, c, keys);
   } else {
     read_arm(r, c, keys);

@@ -74,17 +74,10 @@ struct SceneReader : YamlTree {
 
   std::vector<Waypoint> path(const YAML::Node& node, const std::string& key) const {
     if (!node.IsSequence()) fail(key, "expected a list of {t_s, offset_m}");
-    std::vector<Waypoint> out;
-    for (size_t i = 0; i < node.size(); ++i) {
-      const std::string item = key + "[" + std::to_string(i) + "]";
-      only_keys(node[i], item, {"t_s", "offset_m"});
-      Waypoint point;
-      point.t_s = number(required(node[i], item, "t_s"), item + ".t_s");
-      point.offset_m = vec3f(required(node[i], item, "offset_m"), item + ".offset_m");
-      if (!out.empty() && point.t_s < out.back().t_s) fail(item + ".t_s", "expected times in increasing order");
-      out.push_back(point);
-    }
-    return out;
+    const auto read_offset = [this](const YAML::Node& value, const std::string& value_key, Waypoint& point) {
+      point.offset_m = vec3f(value, value_key);
+    };
+    return waypoints<Waypoint>(node, key, "offset_m", read_offset);
   }
 
   /// `material: [dark, shiny, low_texture]` (any of them; a single flag may stand alone).

@@ -49,6 +49,30 @@ struct YamlTree {
   Eigen::Vector3d vec3(const YAML::Node& node, const std::string& key) const;
   /// As vec3, in float (safe: number() bounds every component to a float's range).
   Eigen::Vector3f vec3f(const YAML::Node& node, const std::string& key) const { return vec3(node, key).cast<float>(); }
+
+  /// The one reader of waypoint lists (robot.trajectory's waypoints, a scene object's path):
+  /// each item a map of `t_s` (seconds) and `value_key`, which `read_value(node, key, point)`
+  /// reads into `point`. Times must be strictly increasing: two waypoints at one time would be
+  /// a jump, which neither a person nor an arm can make, and the interpolation between them
+  /// would divide by a zero interval (docs/CONFIG.md). `list` must be a sequence.
+  template <class Waypoint, class ReadValue>
+  std::vector<Waypoint> waypoints(const YAML::Node& list, const std::string& key, const std::string& value_key,
+                                  ReadValue read_value) const {
+    std::vector<Waypoint> out;
+    for (size_t i = 0; i < list.size(); ++i) {
+      const std::string item = key + "[" + std::to_string(i) + "]";
+      only_keys(list[i], item, {"t_s", value_key});
+      Waypoint point;
+      point.t_s = number(required(list[i], item, "t_s"), item + ".t_s");
+      read_value(required(list[i], item, value_key), item + "." + value_key, point);
+      if (!out.empty() && !(point.t_s > out.back().t_s)) {
+        fail(item + ".t_s", "expected times strictly increasing (" + double_text(point.t_s) + " s after " +
+                                double_text(out.back().t_s) + " s)");
+      }
+      out.push_back(point);
+    }
+    return out;
+  }
 };
 
 }  // namespace hrcsense::config_detail

@@ -30,27 +30,36 @@ std::optional<FilterBlock> filter_block_from_name(std::string_view name) {
   return std::nullopt;
 }
 
-std::optional<FilterChainParams> filter_preset(std::string_view name) {
+const char* filter_preset_name(FilterPreset preset) {
+  switch (preset) {
+    case FilterPreset::none: return "none";
+    case FilterPreset::sdk: return "sdk";
+    case FilterPreset::thesis: return "thesis";
+  }
+  return "unknown";
+}
+
+FilterChainParams filter_preset(FilterPreset preset) {
   FilterChainParams chain;
-  if (name == "none") return chain;
-  if (name == "sdk") {
-    // The RealSense Viewer's defaults: everything on except hole filling, in the order of
-    // specs/depth-filters.md §1 (threshold first).
-    chain.order = {FilterBlock::threshold, FilterBlock::decimation, FilterBlock::to_disparity,
-                   FilterBlock::spatial,   FilterBlock::temporal,   FilterBlock::to_depth};
-    return chain;
+  switch (preset) {
+    case FilterPreset::none: break;
+    case FilterPreset::sdk:
+      // The RealSense Viewer's defaults: everything on except hole filling, in the order of
+      // specs/depth-filters.md §1 (threshold first).
+      chain.order = {FilterBlock::threshold, FilterBlock::decimation, FilterBlock::to_disparity,
+                     FilterBlock::spatial,   FilterBlock::temporal,   FilterBlock::to_depth};
+      break;
+    case FilterPreset::thesis:
+      // The 2020 thesis: spatial α 0.4, δ 20, magnitude 2; temporal persistence 3, α 0.4, δ 20;
+      // no decimation. The thesis does not say which domain it used; we use disparity.
+      chain.order = {FilterBlock::to_disparity, FilterBlock::spatial, FilterBlock::temporal, FilterBlock::to_depth};
+      chain.spatial.alpha = 0.4F;
+      chain.spatial.delta = 20;
+      chain.spatial.magnitude = 2;
+      chain.temporal = TemporalParams{0.4F, 20, 3};
+      break;
   }
-  if (name == "thesis") {
-    // The 2020 thesis: spatial α 0.4, δ 20, magnitude 2; temporal persistence 3, α 0.4, δ 20;
-    // no decimation. The thesis does not say which domain it used; we use disparity.
-    chain.order = {FilterBlock::to_disparity, FilterBlock::spatial, FilterBlock::temporal, FilterBlock::to_depth};
-    chain.spatial.alpha = 0.4F;
-    chain.spatial.delta = 20;
-    chain.spatial.magnitude = 2;
-    chain.temporal = TemporalParams{0.4F, 20, 3};
-    return chain;
-  }
-  return std::nullopt;
+  return chain;
 }
 
 Intrinsics filtered_intrinsics(const FilterChainParams& params, const Intrinsics& source) {

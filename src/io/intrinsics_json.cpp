@@ -6,7 +6,6 @@
 
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -17,6 +16,7 @@
 #include "hrcsense/camera.hpp"
 #include "io_fail.hpp"
 #include "hrcsense/io.hpp"
+#include "hrcsense/number_text.hpp"
 
 namespace hrcsense {
 namespace {
@@ -39,12 +39,6 @@ double shortest_decimal(float value) {
   const auto result = std::to_chars(text, text + sizeof(text) - 1, value);
   *result.ptr = '\0';
   return std::strtod(text, nullptr);
-}
-
-std::string number_text(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9g", value);
-  return text;
 }
 
 using io_detail::fail;
@@ -80,14 +74,14 @@ float float_value(const Json& value, const std::string& name, const std::string&
 std::string focal_problem(float f, const char* name) {
   if (std::isnormal(f) && f > kMinFocalPx && f < kMaxFocalPx) return {};
   return std::string("field '") + name + "' (focal length) must be a normal number in (1, 100000) px, found " +
-         number_text(f);
+         float_digits_text(f);
 }
 
 std::string principal_problem(float p, int size, const char* name) {
   if (std::isfinite(p) && p >= -static_cast<float>(size) && p <= 2.0F * static_cast<float>(size)) return {};
   return std::string("field '") + name + "' (principal point) must be in [-" + std::to_string(size) + ", " +
          std::to_string(2 * size) + "] px for an image " + std::to_string(size) + " px across, found " +
-         number_text(p);
+         float_digits_text(p);
 }
 
 /// A 3x3 matrix given as rows, or an error naming the field.
@@ -194,7 +188,7 @@ std::string intrinsics_problem(const Intrinsics& in, const IntrinsicsFieldNames&
   for (size_t i = 0; i < in.coeffs.size(); ++i) {
     if (!std::isfinite(in.coeffs[i])) {
       return std::string("field '") + names.coeffs + "[" + std::to_string(i) + "]' must be finite, found " +
-             number_text(in.coeffs[i]);
+             float_digits_text(in.coeffs[i]);
     }
   }
   return {};

@@ -154,11 +154,8 @@ const Frame& run_filters(FilterChain& chain, const Frame& frame, Frame& filtered
   return filtered;
 }
 
-// The configured backend; config validates the name first, so a bad one here is a caller's bug.
 ProximitySearch make_proximity_search(const PipelineParams& params) {
-  const std::optional<ProximityBackend> backend = parse_proximity_backend(params.backend);
-  if (!backend) throw std::invalid_argument("proximity.backend '" + params.backend + "' is not a backend");
-  return ProximitySearch(*backend, params.proximity);
+  return ProximitySearch(params.backend, params.proximity);
 }
 
 }  // namespace
@@ -189,7 +186,7 @@ void Pipeline::retune(const LiveTuning& tuning) {
   next.filters = tuning.filters;
   next.foreground = tuning.foreground;
   next.backend = tuning.backend;
-  ProximitySearch search = make_proximity_search(next);  // throws for a bad name, nothing changed yet
+  ProximitySearch search = make_proximity_search(next);
   params_ = std::move(next);
   proximity_ = std::move(search);
   filters_.params = params_.filters;

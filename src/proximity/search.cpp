@@ -40,14 +40,6 @@ ProximityBackend pick_automatic(size_t /*points*/) { return ProximityBackend::br
 
 }  // namespace
 
-std::optional<ProximityBackend> parse_proximity_backend(std::string_view name) {
-  if (name == "brute") return ProximityBackend::brute;
-  if (name == "kdtree") return ProximityBackend::kdtree;
-  if (name == "octree") return ProximityBackend::octree;
-  if (name == "auto") return ProximityBackend::automatic;
-  return std::nullopt;
-}
-
 const char* proximity_backend_name(ProximityBackend backend) {
   switch (backend) {
     case ProximityBackend::brute: return "brute";

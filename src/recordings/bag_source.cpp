@@ -339,7 +339,7 @@ RecordingSummary summarize_bag(const std::string& path) {
   BagState s(path);
   RecordingSummary summary;
   summary.path = path;
-  summary.format = "bag";
+  summary.format = RecordingFormat::bag;
   Frame frame;
   try {
     while (read_depth_frame(s, false, frame)) {

@@ -327,7 +327,8 @@ RecordingSummary summarize_folder(const std::string& path) {
   FolderSource source(RecordingParams{path});
   RecordingSummary summary;
   summary.path = path;
-  summary.format = "folder (" + source.layout() + " layout)";
+  summary.format = RecordingFormat::folder;
+  summary.folder_layout = source.layout();
   summary.compression = "png";
   RecordingStream depth{"depth", "png (16-bit)", source.info().intrinsics, 0, 0, 0, 0};
   Frame frame;
@@ -362,6 +363,14 @@ RecordingSummary summarize_recording(const std::string& path) {
   if (fs::is_directory(path)) return summarize_folder(path);
   if (!fs::exists(path)) throw IoError(path + ": no such file or folder");
   return summarize_bag(path);
+}
+
+std::string recording_format_text(const RecordingSummary& summary) {
+  switch (summary.format) {
+    case RecordingFormat::bag: return "bag";
+    case RecordingFormat::folder: return "folder (" + summary.folder_layout + " layout)";
+  }
+  return "unknown";
 }
 
 }  // namespace hrcsense

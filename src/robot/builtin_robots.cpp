@@ -92,19 +92,16 @@ const UrGeometry kUr10e{"ur10e", 0.1807, -0.6127, -0.57155, 0.17415, 0.11985, 0.
 
 }  // namespace
 
-const std::vector<std::string>& builtin_robot_names() {
-  static const std::vector<std::string> names{"ur5", "ur5e", "ur10e"};
-  return names;
-}
-
-const RobotDescription& builtin_robot(const std::string& name) {
+const RobotDescription& builtin_robot(BuiltinArm arm) {
   static const RobotDescription ur5 = ur_arm(kUr5);
   static const RobotDescription ur5e = ur_arm(kUr5e);
   static const RobotDescription ur10e = ur_arm(kUr10e);
-  if (name == "ur5") return ur5;
-  if (name == "ur5e") return ur5e;
-  if (name == "ur10e") return ur10e;
-  throw std::invalid_argument("unknown built-in robot '" + name + "'; expected ur5, ur5e or ur10e");
+  switch (arm) {
+    case BuiltinArm::ur5: return ur5;
+    case BuiltinArm::ur5e: return ur5e;
+    case BuiltinArm::ur10e: return ur10e;
+  }
+  throw std::invalid_argument("builtin_robot: " + std::to_string(static_cast<int>(arm)) + " is not a built-in arm");
 }
 
 }  // namespace hrcsense

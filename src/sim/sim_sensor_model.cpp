@@ -68,12 +68,6 @@ const char* sim_sensor_name(SimSensor sensor) {
   return sensor == SimSensor::structured_light ? "structured_light" : "d435";
 }
 
-std::optional<SimSensor> parse_sim_sensor(const std::string& name) {
-  if (name == "d435") return SimSensor::d435;
-  if (name == "structured_light") return SimSensor::structured_light;
-  return std::nullopt;
-}
-
 void apply_sim_sensor(SimSensor sensor, SimParams& p) {
   SimParams preset;  // the D435's values
   if (sensor == SimSensor::structured_light) set_structured_light(preset);

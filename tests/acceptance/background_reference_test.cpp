@@ -7,6 +7,7 @@
 // they stand there; with a reference taught from the same cell empty (`hrcsense teach`'s
 // path), every frame stops with `background_not_empty` until they have gone and a clean batch
 // is learnt, and the cell then runs.
+#include "../support/scenes.hpp"
 #include "../support/decide.hpp"
 #include "common/assembly.hpp"
 #include "common/background_start.hpp"
@@ -36,7 +37,7 @@ constexpr double kGoneAtS = 6.0;      // frame 180: beyond the left edge of the 
 // The cell, its person standing at the far side of the table (their place in cell-ur5.yaml)
 // from frame 0; `with_person` false: the same cell empty, as it is taught.
 Config standing_person_cell(bool with_person) {
-  Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5.yaml",
+  Config config = load_config(test::scene_path("cell-ur5.yaml"),
                               {"background.frames=" + std::to_string(kLearningFrames),
                                "sim.frames=" + std::to_string(kFrames), "sim.color=false"});
   std::vector<SceneObject>& objects = config.scene.objects;

@@ -2,6 +2,7 @@
 // Acceptance: the UR5 cell. The arm is rendered as part of the static scene, learnt as
 // background, and searched as capsules; a person walks up to it.
 
+#include "../support/scenes.hpp"
 #include "../support/decide.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
@@ -29,7 +30,7 @@ constexpr int kFrameStep = 1;
 // (the only error left is the 1 mm depth quantisation of the sensor model). The person enters
 // at frame 100, so 30 learning frames leave 70 empty frames to check.
 Config noise_free_cell(const std::string& backend) {
-  return load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5.yaml",
+  return load_config(test::scene_path("cell-ur5.yaml"),
                      {"sim.noise=false", "filters.preset=none", "background.frames=30",
                       "proximity.backend=" + backend});
 }
@@ -109,7 +110,7 @@ TEST(CellUr5, ContactIsOnTheTrueLinkWithinOneMillimetre) {
 // smear are the self-filter's (docs/ROBOT.md, "Self-filter"), and the nearest person pixel left
 // is next to another link, nearer than the truth by the noise.
 TEST(CellUr5, NoisyContactOnTheTrueLinkAndNeverFartherThanTheTruth) {
-  const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5.yaml", {});
+  const Config config = load_config(test::scene_path("cell-ur5.yaml"), {});
   Simulator sim = make_simulator(config);
   Pipeline pipeline(config.pipeline);
   Frame frame;

@@ -10,6 +10,7 @@
 // The allowed speed is worked out here from ISO/TS 15066's linear S_p with the configured terms
 // (no deceleration), Z_d 0 (the truth is exact).
 
+#include "../support/scenes.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/pipeline.hpp"
@@ -28,7 +29,7 @@
 namespace hrcsense {
 namespace {
 
-std::string config_path(const std::string& name) { return std::string(HRCSENSE_SOURCE_DIR) + "/config/" + name; }
+using test::scene_path;
 
 // The moving UR5 cell with the person standing 2.25 m to the side of the base from frame 100
 // on, where the wrist's swing comes towards them at up to ≈ 1 m/s, and the arm following the
@@ -37,7 +38,7 @@ std::string config_path(const std::string& name) { return std::string(HRCSENSE_S
 Config closed_loop_cell(bool hold) {
   std::vector<std::string> overrides{"robot.trajectory.follow_link=true"};
   if (!hold) overrides.insert(overrides.end(), {"safety.min_hold_s=0", "safety.hysteresis_m=0"});
-  Config config = load_config(config_path("cell-ur5-moving.yaml"), overrides);
+  Config config = load_config(scene_path("cell-ur5-moving.yaml"), overrides);
   for (SceneObject& object : config.scene.objects) {
     if (object.name != "person") continue;
     object.path = {{0.0, Eigen::Vector3f(0.0F, -2.25F, -0.75F)}};

@@ -5,6 +5,7 @@
 // frames at 848x480; and the default sdk preset runs the pipeline at the decimated resolution.
 // The numbers these tests print are the ones in docs/ACCURACY.md.
 
+#include "../support/scenes.hpp"
 #include "../support/decide.hpp"
 #include "../support/sanitized.hpp"
 #include "common/assembly.hpp"
@@ -23,9 +24,9 @@
 namespace hrcsense {
 namespace {
 
-using test::kSanitized;
+using test::scene_path;
 
-std::string scene_path(const char* name) { return std::string(HRCSENSE_SOURCE_DIR) + "/config/" + name; }
+using test::kSanitized;
 
 /// The thesis box scene with `preset`; learning shortened to `learn_frames` and the box moved to
 /// appear right after it, so that no frame is rendered for nothing. No colour camera.

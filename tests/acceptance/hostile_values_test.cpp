@@ -7,6 +7,7 @@
 // The cell: the thesis box (1.22 m from the robot point, so the unharmed run says `run`,
 // "clear", with foreground) entering right after 3 learning frames, at 424x240.
 
+#include "../support/scenes.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/robot_state.hpp"
@@ -33,7 +34,7 @@ const char* const kHostile[] = {".nan", ".inf", "-.inf", "1e39", "-1e39", "1e-39
 
 // thesis-box.yaml with the box entering at frame 3 instead of 100.
 std::string early_box_config() {
-  std::ifstream in(std::string(HRCSENSE_SOURCE_DIR) + "/config/thesis-box.yaml");
+  std::ifstream in(test::scene_path("thesis-box.yaml"));
   std::stringstream text;
   text << in.rdbuf();
   std::string yaml = text.str();

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Acceptance: the whole processing path on the thesis's box scene against the simulator's truth.
 
+#include "../support/scenes.hpp"
 #include "../support/decide.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/camera.hpp"
@@ -18,13 +19,13 @@
 namespace hrcsense {
 namespace {
 
+using test::scene_path;
+
 #if defined(__SANITIZE_ADDRESS__)
 constexpr int kScale = 5;  // sanitizers run the same checks on fewer frames
 #else
 constexpr int kScale = 1;
 #endif
-
-std::string box_scene(const char* name) { return std::string(HRCSENSE_SOURCE_DIR) + "/config/" + name; }
 
 /// Runs `frames` frames of a scene through the pipeline, calling `check` for each frame after
 /// the background is ready.
@@ -49,7 +50,7 @@ double truth_sigma_m(const Frame& frame) {
 
 // Noise-free frames: the measured contact equals the truth within 1 mm.
 TEST(ThesisBox, NoiseFreeContactMatchesTruth) {
-  const Config config = load_config(box_scene("thesis-box.yaml"), {"sim.noise=false"});
+  const Config config = load_config(scene_path("thesis-box.yaml"), {"sim.noise=false"});
   int checked = 0;
   run_scene(config, 100 + 60 / kScale, [&](const Frame& frame, const FrameResult& result, const Pipeline&) {
     ASSERT_TRUE(frame.truth->contact.valid);
@@ -65,7 +66,7 @@ TEST(ThesisBox, NoiseFreeContactMatchesTruth) {
 // towards the robot (negative error): the safe side.
 TEST(ThesisBox, NoisyContactErrorWithinModelNoise) {
   for (const char* seed : {"source.seed=7001", "source.seed=7002"}) {
-    const Config config = load_config(box_scene("thesis-box.yaml"), {seed});
+    const Config config = load_config(scene_path("thesis-box.yaml"), {seed});
     double sum_abs_m = 0.0, sum_signed_m = 0.0, max_abs_m = 0.0, sigma_m = 0.0;
     int n = 0;
     run_scene(config, 100 + 300 / kScale, [&](const Frame& frame, const FrameResult& result, const Pipeline&) {
@@ -94,7 +95,7 @@ TEST(ThesisBox, NoisyContactErrorWithinModelNoise) {
 // that were not used while tuning the foreground parameters.
 TEST(ThesisBox, ForegroundIoU) {
   for (const char* seed : {"source.seed=9101", "source.seed=9202"}) {
-    const Config config = load_config(box_scene("thesis-box.yaml"), {seed});
+    const Config config = load_config(scene_path("thesis-box.yaml"), {seed});
     double min_iou = 1.0;
     int frames = 0;
     run_scene(config, 100 + 40 / kScale, [&](const Frame& frame, const FrameResult&, const Pipeline& pipeline) {
@@ -121,7 +122,7 @@ TEST(ThesisBox, ForegroundIoU) {
 // The empty scene: after learning, no blob survives in 500 frames.
 TEST(ThesisBox, EmptySceneHasNoForeground) {
   // Keep the box out of the whole run.
-  const Config config = load_config(box_scene("thesis-box.yaml"), {"source.seed=4242"});
+  const Config config = load_config(scene_path("thesis-box.yaml"), {"source.seed=4242"});
   Config empty = config;
   for (SceneObject& object : empty.scene.objects)
     if (!object.is_static) object.first_frame = 1'000'000;

@@ -6,6 +6,7 @@
 // (truth.contact_label), so the expectations are independent of the self-filter's code.
 // Release builds only, under the ctest label `long` (docs/ROBOT.md, "Self-filter").
 
+#include "../support/scenes.hpp"
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -20,6 +21,8 @@
 #include <vector>
 
 namespace {
+
+using hrcsense::test::scene_path;
 
 struct FrameLine {
   int64_t frame = 0;
@@ -39,10 +42,9 @@ struct StereoNoise {
   double sigma_m(double z_m) const { return z_m * z_m * subpixel_px / (fx * baseline_m); }
 };
 
-std::string moving_cell_path() { return std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml"; }
-
 std::vector<FrameLine> run_moving_cell(const std::string& extra, const std::string& name,
-                                       const std::string& config = moving_cell_path(), StereoNoise* noise = nullptr) {
+                                       const std::string& config = scene_path("cell-ur5-moving.yaml"),
+                                       StereoNoise* noise = nullptr) {
   const std::string out = std::string(::testing::TempDir()) + "moving_cell_" + name + ".jsonl";
   const std::string command = std::string(HRCSENSE_CLI) + " run --config " + config + " " + extra + " --out " + out +
                               " 2>/dev/null";
@@ -79,7 +81,7 @@ std::vector<FrameLine> run_moving_cell(const std::string& extra, const std::stri
 /// config/cell-ur5-moving.yaml with each `from` replaced by its `to`, written to a temporary file.
 std::string moving_cell_variant(const std::string& name,
                                 const std::vector<std::pair<std::string, std::string>>& replacements) {
-  std::ifstream in(moving_cell_path());
+  std::ifstream in(scene_path("cell-ur5-moving.yaml"));
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   for (const auto& [from, to] : replacements) {
     const size_t at = text.find(from);
@@ -124,7 +126,7 @@ TEST(MovingCellAcceptance, NoContactOnTheArmWithTheSelfFilterAndManyWithout) {
 // A frame without a measured contact while the person is present counts as outside.
 TEST(MovingCellAcceptance, TheContactErrorStaysInTheWindow) {
   StereoNoise noise;
-  const std::vector<FrameLine> frames = run_moving_cell("", "window", moving_cell_path(), &noise);
+  const std::vector<FrameLine> frames = run_moving_cell("", "window", scene_path("cell-ur5-moving.yaml"), &noise);
   ASSERT_EQ(frames.size(), 1000U);
   ASSERT_GT(noise.fx, 0.0);
   ASSERT_GT(noise.baseline_m, 0.0);

@@ -7,6 +7,7 @@
 // trajectory's joint velocities; the truth contact is the simulator's, over its noise-free
 // rendered pixels. Release builds only, under the ctest label `long`.
 
+#include "../support/scenes.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/pipeline.hpp"
@@ -25,7 +26,7 @@
 namespace hrcsense {
 namespace {
 
-std::string config_path(const std::string& name) { return std::string(HRCSENSE_SOURCE_DIR) + "/config/" + name; }
+using test::scene_path;
 
 struct SimRun {
   Config config;
@@ -113,7 +114,7 @@ SafeAndAvailable check_against_truth(SimRun& run, int64_t first, int64_t last) {
 }
 
 TEST(SsmAcceptance, MovingCellNeverLaxerThanTheTruthAllows) {
-  const Config config = load_config(config_path("cell-ur5-moving.yaml"), {});
+  const Config config = load_config(scene_path("cell-ur5-moving.yaml"), {});
   ASSERT_EQ(config.pipeline.safety.mode, SafetyParams::Mode::ssm);
   SimRun run(config);
   const SafeAndAvailable count = check_against_truth(run, 0, config.sim.frames);
@@ -129,7 +130,7 @@ TEST(SsmAcceptance, MovingCellNeverLaxerThanTheTruthAllows) {
 // fast wrist was inside its own S_p (19 of 61 `run` frames before S1). Safe per link, and
 // still available: `run` frames remain where the person is beyond every link's S_p.
 TEST(SsmAcceptance, PersonStandingBesideTheFastWristNeverLaxerThanTheTruth) {
-  Config config = load_config(config_path("cell-ur5-moving.yaml"), {});
+  Config config = load_config(scene_path("cell-ur5-moving.yaml"), {});
   bool moved = false;
   for (SceneObject& object : config.scene.objects) {
     if (object.name != "person") continue;
@@ -153,7 +154,7 @@ TEST(SsmAcceptance, PersonStandingBesideTheFastWristNeverLaxerThanTheTruth) {
 // shadow beside them: neither may stop the cell. While the person is there, the space hidden
 // behind them is unknown, and the distance to it is reported.
 TEST(SsmAcceptance, MovingArmsOwnShadowAndPixelsDoNotFreezeTheCell) {
-  SimRun run(load_config(config_path("cell-ur5-moving.yaml"), {"safety.unknown_policy=stop_within_m"}));
+  SimRun run(load_config(scene_path("cell-ur5-moving.yaml"), {"safety.unknown_policy=stop_within_m"}));
   Frame frame;
   RobotState state;
   FrameResult result;
@@ -211,7 +212,7 @@ TEST(SsmAcceptance, DistanceUncertaintyCoversTheTruthPooledOverTheScenes) {
   std::vector<float> excess;  // measured − Z_d − truth where positive
   for (const std::string& scene : scenes) {
     for (const char* seed : {"source.seed=1", "source.seed=2"}) {
-      SimRun run(load_config(config_path(scene), {seed}));
+      SimRun run(load_config(scene_path(scene), {seed}));
       const double detection_mm = run.config.pipeline.safety.ssm.detection_mm;
       Frame frame;
       RobotState state;

@@ -12,6 +12,7 @@
 // Release builds only, under the ctest label `long`; docs/RECORDINGS.md ("What the background
 // learner does with such a camera") quotes the numbers this prints.
 
+#include "../support/scenes.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/sim.hpp"
@@ -41,7 +42,7 @@ const std::vector<std::string> kSensor{"sim.sensor=structured_light", "sim.width
 // The shipped scene with its filter options left out (they belong to the sdk chain, which
 // filters.preset none does not run), written to a temporary file.
 std::string scene_without_filters(const std::string& name) {
-  std::ifstream in(std::string(HRCSENSE_SOURCE_DIR) + "/config/" + name);
+  std::ifstream in(test::scene_path(name));
   const std::string path = std::string(::testing::TempDir()) + "structured_light_" + name;
   std::ofstream out(path);
   for (std::string line; std::getline(in, line);) {

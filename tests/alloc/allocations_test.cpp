@@ -7,6 +7,7 @@
 //
 // This binary replaces the global operator new to count allocations, so it holds no other
 // tests: a replacement in a family binary would count (and could disturb) all of them.
+#include "../support/scenes.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/robot_state.hpp"
@@ -58,7 +59,7 @@ std::vector<Frame> walk_frames(const Config& config) {
 // Allocations during the last of three passes over the person frames, after the first two
 // have grown every buffer to the largest cloud.
 long allocations_after_warm_up(const std::string& preset, const std::string& backend) {
-  const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/walk.yaml",
+  const Config config = load_config(test::scene_path("walk.yaml"),
                                     {"filters.preset=" + preset, "proximity.backend=" + backend,
                                      "background.frames=" + std::to_string(kLearnFrames), "sim.color=false"});
   const std::vector<Frame> frames = walk_frames(config);
@@ -104,7 +105,7 @@ TEST(PipelineAllocations, NoneAfterWarmUpForEveryPresetWithBruteAndOctree) {
 // allocates nothing either once warmed up; nor does the per-link measurement and its ssm
 // decision.
 TEST(PipelineAllocations, NoneWithAnArmMovingEveryFrame) {
-  const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5.yaml",
+  const Config config = load_config(test::scene_path("cell-ur5.yaml"),
                                     {"background.frames=" + std::to_string(kLearnFrames), "sim.color=false",
                                      "sim.width=424", "sim.height=240", "safety.mode=ssm"});
   const Simulator sim = make_simulator(config);
@@ -169,7 +170,7 @@ TEST(ProximityAllocations, RepeatedFramesAllocateNothing) {
 // The simulator renders a frame into the buffers of the previous one (docs/SIMULATOR.md):
 // depth, colour and truth without allocating once sized.
 TEST(SimulatorAllocations, NoneWhenRenderingAgain) {
-  const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/walk.yaml", {});
+  const Config config = load_config(test::scene_path("walk.yaml"), {});
   const Simulator sim = make_simulator(config);
   Frame frame;
   for (int i = 150; i < 160; ++i) sim.render(i, frame);  // the person in view: truth points too
@@ -187,7 +188,7 @@ namespace {
 // The moving arm (robot.trajectory) is placed anew every frame into the simulator's buffers:
 // still no allocation once sized, with the person in view.
 TEST(SimulatorAllocations, NoneWhenRenderingTheMovingArm) {
-  const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml", {});
+  const Config config = load_config(test::scene_path("cell-ur5-moving.yaml"), {});
   const Simulator sim = make_simulator(config);
   ASSERT_TRUE(sim.arm.has_value());
   Frame frame;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // R1 through the executable: the commands, signals, a reader that leaves, flushing,
 // exit codes. Each child process is bounded in time: a test that waits too long kills it.
+#include "../support/scenes.hpp"
 #include "../support/child_process.hpp"
 #include "../support/cli_folder.hpp"
 #include "../support/sanitized.hpp"
@@ -26,6 +27,8 @@
 
 namespace {
 
+using hrcsense::test::scene_path;
+
 using nlohmann::json;
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -40,8 +43,6 @@ std::vector<json> json_lines(const std::string& text) {
   }
   return lines;
 }
-
-std::string config(const char* name) { return std::string(HRCSENSE_SOURCE_DIR) + "/config/" + name; }
 
 // `hrcsense ARGS` as a child process, its stdout a pipe we read, its stderr a file.
 class Child : public hrcsense::test::ChildProcess {
@@ -74,7 +75,7 @@ class FailsafeCli : public hrcsense::test::CliFolder {
   // Sends `signal` to a paced run once its output has a frame line; returns the lines.
   std::vector<json> signal_a_paced_run(int signal, int& exit_status) {
     const fs::path out = dir_ / "out.jsonl";
-    Child child({"run", "--config", config("thesis-box.yaml"), "--set", "source.pace=true", "--set",
+    Child child({"run", "--config", scene_path("thesis-box.yaml"), "--set", "source.pace=true", "--set",
                  "sim.width=424", "--set", "sim.height=240", "--frames", "3000", "--out", out.string()},
                 dir_ / "stderr.txt");
     const Clock::time_point deadline = Clock::now() + std::chrono::seconds(60);
@@ -102,7 +103,7 @@ TEST_F(FailsafeCli, RotationThatOverflowsFloatIsAConfigError) {
 // Item 2, the command: a threshold at 0.5 m leaves (almost) nothing of the cell. No
 // frame may say run; frame 190, with the person 0.29 m from the robot, is a stop.
 TEST_F(FailsafeCli, ThresholdThatEmptiesTheFramesNeverRuns) {
-  const Outcome outcome = run("run --config '" + config("walk.yaml") + "' --set filters.threshold.max=0.5" +
+  const Outcome outcome = run("run --config '" + scene_path("walk.yaml") + "' --set filters.threshold.max=0.5" +
                               (hrcsense::test::kSanitized ? " --frames 200 --set sim.width=424 --set sim.height=240" : ""));
   ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
   int frames = 0;
@@ -121,12 +122,12 @@ TEST_F(FailsafeCli, ThresholdThatEmptiesTheFramesNeverRuns) {
 // a stop, and a stop distance of 0 is refused.
 TEST_F(FailsafeCli, InsideTheRobotIsAlwaysStop) {
   const std::string smaller = hrcsense::test::kSanitized ? " --set sim.width=424 --set sim.height=240" : "";
-  Outcome outcome = run("run --config '" + config("walk.yaml") +
+  Outcome outcome = run("run --config '" + scene_path("walk.yaml") +
                         "' --set safety.stop_distance_m=0 --set safety.slow_distance_m=0 --set robot.padding_m=0.35");
   EXPECT_EQ(outcome.exit_code, 2);
   EXPECT_NE(outcome.err.find("safety.stop_distance_m"), std::string::npos) << outcome.err;
 
-  outcome = run("run --config '" + config("walk.yaml") +
+  outcome = run("run --config '" + scene_path("walk.yaml") +
                 "' --set safety.stop_distance_m=0.001 --set safety.slow_distance_m=0.001 --set robot.padding_m=0.35" +
                 smaller);
   ASSERT_EQ(outcome.exit_code, 0) << outcome.err;
@@ -142,7 +143,7 @@ TEST_F(FailsafeCli, InsideTheRobotIsAlwaysStop) {
 // Item 4: every line is flushed. Paced at 1 frame/s, the first frame line must reach a pipe
 // while the run is still going (block-buffered, it arrived only when the run ended).
 TEST_F(FailsafeCli, FrameLinesReachAPipeWhileTheRunGoesOn) {
-  Child child({"run", "--config", config("thesis-box.yaml"), "--set", "source.pace=true", "--set", "sim.fps=1",
+  Child child({"run", "--config", scene_path("thesis-box.yaml"), "--set", "source.pace=true", "--set", "sim.fps=1",
                "--set", "safety.max_frame_age_s=5", "--set", "background.frames=1", "--set", "sim.width=424",
                "--set", "sim.height=240", "--frames", "3"},
               dir_ / "stderr.txt");
@@ -187,7 +188,7 @@ TEST_F(FailsafeCli, SigtstpEndsWithStopAndSummary) {
 // measurement and its write.
 TEST_F(FailsafeCli, FrozenProcessWritesNothingOldAsRunOrSlow) {
   const fs::path out = dir_ / "out.jsonl";
-  Child child({"run", "--config", config("thesis-box.yaml"), "--set", "source.pace=true", "--set",
+  Child child({"run", "--config", scene_path("thesis-box.yaml"), "--set", "source.pace=true", "--set",
                "sim.width=424", "--set", "sim.height=240", "--set", "background.frames=10", "--frames", "3000",
                "--out", out.string()},
               dir_ / "stderr.txt");
@@ -226,7 +227,7 @@ TEST_F(FailsafeCli, SigintEndsWithStopAndSummary) {
 // Item 5: a reader that goes away (SIGPIPE) makes the write fail; the run ends by itself with
 // one error line and exit 1 instead of dying of the signal.
 TEST_F(FailsafeCli, ClosedPipeEndsTheRunWithAnError) {
-  Child child({"run", "--config", config("thesis-box.yaml"), "--set", "source.pace=true", "--set",
+  Child child({"run", "--config", scene_path("thesis-box.yaml"), "--set", "source.pace=true", "--set",
                "sim.width=424", "--set", "sim.height=240", "--frames", "3000"},
               dir_ / "stderr.txt");
   std::string line;
@@ -277,7 +278,7 @@ TEST_F(FailsafeCli, FramesBeyondTheCapIsAUsageError) {
 // Also: a background file from another view (the camera turned by 20 degrees) is refused
 // after the first frames with one error line, exit 1.
 TEST_F(FailsafeCli, BackgroundFromAnotherViewIsRefused) {
-  const std::string base = "run --config '" + config("thesis-box.yaml") +
+  const std::string base = "run --config '" + scene_path("thesis-box.yaml") +
                            "' --set sim.width=424 --set sim.height=240 --set background.frames=10 "
                            "--set background.path=bg.bin ";
   Outcome outcome = run(base + "--frames 12");

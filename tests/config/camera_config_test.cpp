@@ -3,10 +3,12 @@
 // source.options.* (the SDK's names and ranges) and source.settle_frames.
 #include "config_test_util.hpp"
 
+#include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -41,7 +43,7 @@ TEST(CameraConfig, ReadsAFile) {
                                      "  options: {visual_preset: high_accuracy, laser_power: 150, emitter_enabled: true}\n"
                                      "  settle_frames: 10\n");
   const SourceConfig source = load_config(file, {}).source;
-  EXPECT_EQ(source.type, "realsense");
+  EXPECT_EQ(source.type, SourceType::realsense);
   EXPECT_EQ(source.serial, "825312072719");  // quoted: a serial is text, leading zeros and all
   EXPECT_EQ(source.fps, 90);
   EXPECT_TRUE(source.color.enabled);
@@ -57,6 +59,32 @@ TEST(CameraConfig, ReadsAFile) {
   EXPECT_EQ(source.options[1].value, 1.0F);
   EXPECT_EQ(source.options[2].name, "laser_power");
   EXPECT_EQ(source.options[2].value, 150.0F);
+}
+
+TEST(CameraConfig, TheAssemblyGivesTheAdapterTheseValues) {
+  // The SDK adapter never sees a Config: realsense_params copies source.* into its own params.
+  const Config config = load_config("", {"source.type=realsense", "source.serial='825312072719'", "source.fps=60",
+                                         "source.width=640", "source.height=480",
+                                         "source.color={enabled: true, width: 1280, height: 720, fps: 15}",
+                                         "source.options={laser_power: 150}", "source.settle_frames=12",
+                                         "source.path=cell.bag", "source.loop=true"});
+  std::atomic<bool> stop{false};
+  const RealSenseParams params = realsense_params(config.source, &stop);
+  EXPECT_EQ(params.serial, "825312072719");
+  EXPECT_EQ(params.width, 640);
+  EXPECT_EQ(params.height, 480);
+  EXPECT_EQ(params.fps, 60);
+  EXPECT_TRUE(params.color);
+  EXPECT_EQ(params.color_width, 1280);
+  EXPECT_EQ(params.color_height, 720);
+  EXPECT_EQ(params.color_fps, 15);
+  ASSERT_EQ(params.options.size(), 1U);
+  EXPECT_EQ(params.options[0].name, "laser_power");
+  EXPECT_EQ(params.options[0].value, 150.0F);
+  EXPECT_EQ(params.settle_frames, 12);
+  EXPECT_EQ(params.path, "cell.bag");
+  EXPECT_TRUE(params.loop);
+  EXPECT_EQ(params.stop_requested, &stop);
 }
 
 TEST(CameraConfig, VisualPresetsAreTheSdkNumbers) {

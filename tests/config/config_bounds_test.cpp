@@ -2,6 +2,7 @@
 // Tests of the numeric bounds: every number is checked as the float (or double) it is used as,
 // so 1e39 is not a finite config value that becomes inf inside the pipeline; the safety keys
 // and durations have bounds that keep verdicts and clocks meaningful.
+#include "../support/scenes.hpp"
 #include "config_test_util.hpp"
 #include "../support/run_cli.hpp"
 
@@ -138,12 +139,12 @@ TEST(ConfigBounds, SimulatorTimingAndNoiseKeepTimestampsAndCountsInRange) {
 
 TEST(ConfigBounds, SelfFilterKeysAreReadAndBounded) {
   // Defaults as docs/CONFIG.md states them, and each key reaches the pipeline's parameters.
-  const Config defaults = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml", {});
+  const Config defaults = load_config(test::scene_path("cell-ur5-moving.yaml"), {});
   EXPECT_TRUE(defaults.pipeline.self_filter.enabled);
   EXPECT_FLOAT_EQ(defaults.pipeline.self_filter.margin_m, 0.03F);
   EXPECT_EQ(defaults.pipeline.self_filter.dilate_px, 2);
   EXPECT_EQ(defaults.pipeline.self_filter.memory_frames, 3);
-  const Config set = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml",
+  const Config set = load_config(test::scene_path("cell-ur5-moving.yaml"),
                                  {"self_filter.enabled=false", "self_filter.margin_m=0.05", "self_filter.dilate_px=0",
                                   "self_filter.memory_frames=1"});
   EXPECT_FALSE(set.pipeline.self_filter.enabled);

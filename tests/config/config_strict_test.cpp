@@ -111,7 +111,7 @@ TEST(ConfigStrict, LeadingZerosAreRefusedForEveryNumber) {
                                     "source.seed=0x1F"});
   EXPECT_EQ(c.sim.frames, 17);
   EXPECT_EQ(c.pipeline.safety.slow_distance_m, 0.5F);
-  EXPECT_EQ(c.source.seed, 31U);  // hexadecimal is the same in YAML 1.1 and 1.2
+  EXPECT_EQ(c.sim.seed, 31U);  // hexadecimal is the same in YAML 1.1 and 1.2
 }
 
 TEST(ConfigStrict, RobotDescriptionFilesGoThroughTheSameChecks) {

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tests of load_config: defaults, every key family, --set overrides, errors, the camera pose.
+#include "../support/scenes.hpp"
 #include "config_test_util.hpp"
 
 #include "common/assembly.hpp"
@@ -19,26 +20,26 @@ TEST(Config, DefaultsWithoutFileMatchTheStructDefaults) {
   const Config config = load_config("", {});
   const SimParams sim;
   const PipelineParams pipeline;
-  EXPECT_EQ(config.source.type, "sim");
+  EXPECT_EQ(config.source.type, SourceType::sim);
   EXPECT_FALSE(config.source.pace);
-  EXPECT_EQ(config.source.seed, 1U);
+  EXPECT_EQ(config.sim.seed, 1U);
   EXPECT_EQ(config.sim.width, sim.width);
   EXPECT_EQ(config.sim.height, sim.height);
   EXPECT_EQ(config.sim.frames, sim.frames);
   EXPECT_DOUBLE_EQ(config.sim.fps, sim.fps);
   EXPECT_FLOAT_EQ(config.sim.disparity_noise_px, sim.disparity_noise_px);
   EXPECT_TRUE(config.scene.objects.empty());
-  EXPECT_EQ(config.filters_preset, "sdk");  // the RealSense Viewer's defaults (issue 4)
-  EXPECT_EQ(config.pipeline.filters.order, filter_preset("sdk")->order);
+  EXPECT_EQ(config.filters_preset, FilterPreset::sdk);  // the RealSense Viewer's defaults (issue 4)
+  EXPECT_EQ(config.pipeline.filters.order, filter_preset(FilterPreset::sdk).order);
   EXPECT_EQ(config.pipeline.background.frames, 100);
   EXPECT_FLOAT_EQ(config.pipeline.foreground.k_sigma, pipeline.foreground.k_sigma);
   EXPECT_FLOAT_EQ(config.pipeline.safety.slow_distance_m, pipeline.safety.slow_distance_m);
   EXPECT_FLOAT_EQ(config.pipeline.safety.stop_distance_m, pipeline.safety.stop_distance_m);
   ASSERT_EQ(fixed_robot_model(config).capsules.size(), 1U);  // the thesis's robot point, y down
   EXPECT_EQ(fixed_robot_model(config).capsules[0].a, Eigen::Vector3f(-0.5F, -0.5F, 0.5F));
-  EXPECT_EQ(config.pipeline.backend, "brute");
+  EXPECT_EQ(config.pipeline.backend, ProximityBackend::brute);
   EXPECT_TRUE(config.pipeline.T_base_camera.isApprox(Pose::Identity()));
-  EXPECT_EQ(config.robot_base_frame, "base");
+  EXPECT_EQ(config.pipeline.robot.base_frame, BaseFrame::base);
   EXPECT_FALSE(config.canonical_yaml.empty());
   const std::string hash = config_hash(config);
   ASSERT_EQ(hash.size(), 16U);
@@ -75,7 +76,6 @@ safety: {slow_distance_m: 1.5, stop_distance_m: 0.7, max_frame_age_s: 0.25}
   EXPECT_EQ(c.source.path, "rec/a");
   EXPECT_TRUE(c.source.pace);
   EXPECT_TRUE(c.source.loop);
-  EXPECT_EQ(c.source.seed, 42U);
   EXPECT_EQ(c.sim.seed, 42U);  // source.seed drives the simulator
   EXPECT_FLOAT_EQ(c.source.stereo_baseline_mm, 50.5F);
   EXPECT_EQ(c.sim.width, 640);
@@ -108,8 +108,8 @@ safety: {slow_distance_m: 1.5, stop_distance_m: 0.7, max_frame_age_s: 0.25}
   EXPECT_FLOAT_EQ(second.radius_m, 0.05F);
   EXPECT_EQ(second.link, 1);
   EXPECT_EQ(c.robot_state.joints_rad, (JointAngles{0, 1, 2, 3, 4, 5}));
-  EXPECT_EQ(c.robot_base_frame, "base_link");
-  EXPECT_EQ(c.proximity_octree_height, 6);
+  EXPECT_EQ(c.pipeline.robot.base_frame, BaseFrame::base_link);
+  EXPECT_EQ(c.pipeline.proximity.octree_height, 6);
   EXPECT_FLOAT_EQ(c.pipeline.safety.slow_distance_m, 1.5F);
   EXPECT_FLOAT_EQ(c.pipeline.safety.stop_distance_m, 0.7F);
   EXPECT_DOUBLE_EQ(c.pipeline.safety.max_frame_age_s, 0.25);
@@ -127,7 +127,7 @@ TEST(Config, SetOverridesScalarsAndListsInOrder) {
   EXPECT_EQ(fixed_robot_model(c).capsules[0].a, Eigen::Vector3f(0, 0, 1));
   EXPECT_EQ(fixed_robot_model(c).capsules[1].a, Eigen::Vector3f(0.5F, -1, 2));
   EXPECT_EQ(c.sim.frames, 20);  // the last override wins
-  EXPECT_EQ(c.source.type, "bag");
+  EXPECT_EQ(c.source.type, SourceType::bag);
   EXPECT_TRUE(c.pipeline.T_base_camera.translation().isApprox(Eigen::Vector3d(1, 2, 3), 1e-6));
 }
 
@@ -229,12 +229,12 @@ TEST(Config, ShippedConfigsLoad) {
     const std::string path = std::string(HRCSENSE_SOURCE_DIR) + name;
     if (!test::file_exists(path)) GTEST_SKIP() << path << " not written yet";
     const Config c = load_config(path, {});
-    EXPECT_EQ(c.source.type, "sim") << name;
+    EXPECT_EQ(c.source.type, SourceType::sim) << name;
     EXPECT_FALSE(c.scene.objects.empty()) << name;
     EXPECT_FALSE(fixed_robot_model(c).capsules.empty()) << name;
     EXPECT_NO_THROW(make_source(c)) << name;
   }
-  const Config box = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/thesis-box.yaml", {});
+  const Config box = load_config(test::scene_path("thesis-box.yaml"), {});
   // The thesis's robot point, y down (config/thesis-box.yaml says where it comes from).
   EXPECT_EQ(fixed_robot_model(box).capsules[0].a, Eigen::Vector3f(-0.5F, -0.5F, 0.5F));
 }

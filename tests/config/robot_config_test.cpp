@@ -76,7 +76,7 @@ TEST(RobotConfig, EveryBuiltinArmLoads) {
 
 TEST(RobotConfig, PointsModelIsTheThesisPoint) {
   const Config c = load_config("", {});
-  EXPECT_EQ(c.robot_model, "points");
+  EXPECT_EQ(c.robot_model, RobotModelType::points);
   EXPECT_FALSE(c.pipeline.robot.arm.has_value());
   ASSERT_EQ(fixed_robot_model(c).capsules.size(), 1U);
   EXPECT_EQ(fixed_robot_model(c).capsules[0].a, Eigen::Vector3f(-0.5F, -0.5F, 0.5F));
@@ -94,10 +94,10 @@ void expect_same_capsules(const std::vector<LinkCapsule>& file, const std::vecto
 }
 
 TEST(RobotConfig, ShippedDescriptionFilesEqualTheBuiltins) {
-  for (const std::string& name : builtin_robot_names()) {
-    const std::string path = robots_dir() + name + ".yaml";
+  for (const BuiltinArm arm : kBuiltinArms) {
+    const RobotDescription& builtin = builtin_robot(arm);
+    const std::string path = robots_dir() + builtin.name + ".yaml";
     const RobotDescription file = load_robot_description(path);
-    const RobotDescription& builtin = builtin_robot(name);
     EXPECT_EQ(file.name, builtin.name) << path;
     EXPECT_DOUBLE_EQ(file.padding_m, builtin.padding_m) << path;
     for (size_t j = 0; j < kJointCount; ++j) {
@@ -351,7 +351,7 @@ namespace {
 
 TEST(RobotStateConfig, DefaultsAreTheDocumentedOnes) {
   const Config c = load_config("", {});
-  EXPECT_EQ(c.robot_state.source, "fixed");
+  EXPECT_EQ(c.robot_state.source, RobotStateOrigin::fixed);
   EXPECT_EQ(c.robot_state.port, 30004);
   EXPECT_DOUBLE_EQ(c.robot_state.frequency_hz, 125.0);
   EXPECT_EQ(c.robot_state.listen, "127.0.0.1:30010");
@@ -365,7 +365,7 @@ TEST(RobotStateConfig, KeysAreReadAndChecked) {
   const Config c = load_config("", {"robot.state.source=rtde", "robot.state.host=192.168.1.10",
                                     "robot.state.frequency_hz=500", "robot.state.max_age_s=0.02",
                                     "robot.state.camera_latency_s=0.015"});
-  EXPECT_EQ(c.robot_state.source, "rtde");
+  EXPECT_EQ(c.robot_state.source, RobotStateOrigin::rtde);
   EXPECT_EQ(c.robot_state.host, "192.168.1.10");
   EXPECT_DOUBLE_EQ(c.robot_state.frequency_hz, 500.0);
   EXPECT_DOUBLE_EQ(c.robot_state.history.max_age_s, 0.02);
@@ -385,7 +385,7 @@ TEST(RobotStateConfig, KeysAreReadAndChecked) {
 TEST(RobotStateConfig, JointsAreRequiredOnlyForTheFixedSource) {
   test::expect_config_error("", {"robot.model=ur5"}, {"'robot.joints_rad'", "robot.state.source fixed"});
   const Config live = load_config("", {"robot.model=ur5", "robot.state.source=recorded"});
-  EXPECT_EQ(live.robot_state.source, "recorded");
+  EXPECT_EQ(live.robot_state.source, RobotStateOrigin::recorded);
   // Recorded joint states come from a bag source: the assembly says so, naming the key.
   try {
     (void)make_robot_state_source(live);

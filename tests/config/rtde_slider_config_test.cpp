@@ -41,7 +41,7 @@ TEST(RtdeSliderConfig, AcknowledgedSliderInSsmModeLoads) {
                                                                "# the robot pauses the program when the slider "
                                                                "input is not refreshed (docs/SAFETY.md)\n");
   const Config config = load_config(path, {"link.rtde.slider_unguarded_ok=true"});
-  EXPECT_EQ(config.link.rtde_write, "speed_slider");
+  EXPECT_EQ(config.link.rtde_write, RtdeWrite::speed_slider);
   EXPECT_TRUE(config.link.rtde_slider_unguarded_ok);
   EXPECT_EQ(config.pipeline.safety.mode, SafetyParams::Mode::ssm);
   // The key is part of the effective configuration (and so of config_hash).
@@ -57,11 +57,11 @@ TEST(RtdeSliderConfig, DefaultIsFalseAndOtherCombinationsNeedNoAcknowledgement) 
     return load_config("", extra);
   };
   // zones mode: the slider is allowed (the scale is not the protection there).
-  EXPECT_EQ(with({"link.rtde.write=speed_slider"}).link.rtde_write, "speed_slider");
+  EXPECT_EQ(with({"link.rtde.write=speed_slider"}).link.rtde_write, RtdeWrite::speed_slider);
   // ssm with the register path (a URScript watchdog stops the program): allowed.
-  EXPECT_EQ(with({"safety.mode=ssm", "link.rtde.write=register"}).link.rtde_write, "register");
+  EXPECT_EQ(with({"safety.mode=ssm", "link.rtde.write=register"}).link.rtde_write, RtdeWrite::input_register);
   // ssm without RTDE writing: allowed.
-  EXPECT_EQ(with({"safety.mode=ssm"}).link.rtde_write, "off");
+  EXPECT_EQ(with({"safety.mode=ssm"}).link.rtde_write, RtdeWrite::off);
   // A value that is not a boolean names the key.
   expect_config_error("", {"link.rtde.slider_unguarded_ok=maybe"}, {"link.rtde.slider_unguarded_ok"});
 }

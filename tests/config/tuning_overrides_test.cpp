@@ -42,7 +42,7 @@ TEST(TuningOverrides, ReadBackAsTheTunedValuesAndSaveAsAConfigThatLoads) {
   tuning.foreground.k_sigma = 3.5F;
   tuning.foreground.min_margin_m = 0.03F;
   tuning.foreground.min_object_mm = 55.0F;
-  tuning.backend = "kdtree";
+  tuning.backend = ProximityBackend::kdtree;
 
   const Config tuned = load_config(base, tuning_overrides(tuning));
   EXPECT_EQ(tuned.pipeline.filters.spatial.alpha, 0.7F);
@@ -52,7 +52,7 @@ TEST(TuningOverrides, ReadBackAsTheTunedValuesAndSaveAsAConfigThatLoads) {
   EXPECT_EQ(tuned.pipeline.foreground.k_sigma, 3.5F);
   EXPECT_EQ(tuned.pipeline.foreground.min_margin_m, 0.03F);
   EXPECT_EQ(tuned.pipeline.foreground.min_object_mm, 55.0F);
-  EXPECT_EQ(tuned.pipeline.backend, "kdtree");
+  EXPECT_EQ(tuned.pipeline.backend, ProximityBackend::kdtree);
   EXPECT_EQ(tuned.pipeline.safety.slow_distance_m, 1.25F);  // what was not tuned stays
   EXPECT_EQ(tuned.pipeline.filters.order, config.pipeline.filters.order);
 
@@ -62,7 +62,7 @@ TEST(TuningOverrides, ReadBackAsTheTunedValuesAndSaveAsAConfigThatLoads) {
   const Config reloaded = load_config(saved, {});
   EXPECT_EQ(config_hash(reloaded), config_hash(tuned));
   EXPECT_EQ(reloaded.pipeline.filters.spatial.alpha, 0.7F);
-  EXPECT_EQ(reloaded.pipeline.backend, "kdtree");
+  EXPECT_EQ(reloaded.pipeline.backend, ProximityBackend::kdtree);
 }
 
 TEST(TuningOverrides, OutOfRangeValuesAreRefusedByTheParser) {

@@ -2,6 +2,7 @@
 // `hrcsense run` with source.type ros2 fed by `hrcsense publish`, both child processes on
 // loopback: the cell stops (no_frame) while the camera is silent and carries on by itself
 // when a publisher is back. Every wait is bounded; a child still running at the end is killed.
+#include "../support/scenes.hpp"
 #include "dds_test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -75,7 +76,7 @@ bool has_watchdog_stop(const std::string& path) {
 }
 
 // A person walking through a simulated cell (the demo's scene).
-const std::string kWalk = std::string(HRCSENSE_SOURCE_DIR) + "/config/walk.yaml";
+const std::string kWalk = test::scene_path("walk.yaml");
 
 std::vector<std::string> publisher_args(const std::string& domain, int frames) {
   return {HRCSENSE_CLI, "publish", "--config", kWalk, "--set", "sim.width=424", "--set", "sim.height=240", "--set", "sim.frames=300",

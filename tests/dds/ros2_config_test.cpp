@@ -27,7 +27,7 @@ TEST(Ros2Config, KeysAreReadAndBounded) {
                                     "source.ros2.depth_topic=/cell/d435_left/aligned_depth_to_color/image_raw",
                                     "source.ros2.domain_id=42", "source.ros2.color=false", "publish.domain_id=232",
                                     "publish.wait_for_subscribers=2", "publish.wait_timeout_s=5"});
-  EXPECT_EQ(c.source.type, "ros2");
+  EXPECT_EQ(c.source.type, SourceType::ros2);
   EXPECT_EQ(c.source.ros2.node_namespace, "/cell/d435_left");
   EXPECT_EQ(c.source.ros2.depth_topic, "/cell/d435_left/aligned_depth_to_color/image_raw");
   EXPECT_EQ(c.source.ros2.domain_id, 42);

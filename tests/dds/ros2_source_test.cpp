@@ -3,6 +3,7 @@
 // was published (pixels, intrinsics, timestamps) for the simulator and for the shared D435
 // .bag through `hrcsense publish`; bad messages are rejected and counted; a publisher that
 // goes away and comes back is picked up again. Every wait is bounded.
+#include "../support/scenes.hpp"
 #include "dds/ros2_camera_source.hpp"
 #include "dds/ros2_publisher.hpp"
 #include "dds/dds_entity.hpp"
@@ -42,7 +43,7 @@ Ros2SourceParams source_params(const std::string& node_namespace, double startup
 // Frames of the demo's walking person at 424x240 with colour (deterministic: the same
 // config, the same frames).
 std::vector<Frame> simulated_frames(int count) {
-  const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/walk.yaml", {"sim.width=424", "sim.height=240", "sim.color=true",
+  const Config config = load_config(test::scene_path("walk.yaml"), {"sim.width=424", "sim.height=240", "sim.color=true",
                                          "sim.frames=" + std::to_string(count)});
   std::unique_ptr<Source> sim = make_source(config);
   std::vector<Frame> frames;

@@ -51,7 +51,7 @@ TEST(FilterChainChanges, SpatialParameterChangeTakesEffectOnTheNextFrame) {
 
 TEST(FilterChainChanges, ResolutionChangeResetsTheTemporalFilter) {
   FilterChain chain;
-  chain.params = *filter_preset("sdk");
+  chain.params = filter_preset(FilterPreset::sdk);
   Frame out;
   for (uint32_t seed = 1; seed <= 3; ++seed) chain.process(noisy_wall(seed), out);
   ASSERT_EQ(out.depth.width, 32);
@@ -78,7 +78,7 @@ TEST(FilterChainChanges, ResolutionChangeResetsTheTemporalFilter) {
 
 TEST(FilterChainChanges, TemporalParameterChangeRestartsTheHistory) {
   FilterChain chain;
-  chain.params = *filter_preset("thesis");
+  chain.params = filter_preset(FilterPreset::thesis);
   Frame out;
   for (uint32_t seed = 1; seed <= 3; ++seed) chain.process(noisy_wall(seed), out);
   chain.params.temporal.alpha = 0.8F;

@@ -35,15 +35,17 @@ TEST(FilterChain, NamesRoundTrip) {
 }
 
 TEST(FilterChain, Presets) {
-  EXPECT_TRUE(filter_preset("none")->order.empty());
-  EXPECT_STREQ(filter_domain(*filter_preset("none"), 50.0F), "none");
-  EXPECT_FALSE(filter_preset("fast"));
-  for (const char* name : {"none", "sdk", "thesis"}) EXPECT_EQ(check_filter_order(filter_preset(name)->order), "");
+  EXPECT_TRUE(filter_preset(FilterPreset::none).order.empty());
+  EXPECT_STREQ(filter_domain(filter_preset(FilterPreset::none), 50.0F), "none");
+  for (const FilterPreset preset : kFilterPresets) EXPECT_EQ(check_filter_order(filter_preset(preset).order), "");
+  EXPECT_STREQ(filter_preset_name(FilterPreset::none), "none");
+  EXPECT_STREQ(filter_preset_name(FilterPreset::sdk), "sdk");
+  EXPECT_STREQ(filter_preset_name(FilterPreset::thesis), "thesis");
 }
 
-TEST(FilterChain, SdkPresetHasEveryViewerDefault) { test::expect_sdk_preset(*filter_preset("sdk")); }
+TEST(FilterChain, SdkPresetHasEveryViewerDefault) { test::expect_sdk_preset(filter_preset(FilterPreset::sdk)); }
 
-TEST(FilterChain, ThesisPresetHasEveryThesisSetting) { test::expect_thesis_preset(*filter_preset("thesis")); }
+TEST(FilterChain, ThesisPresetHasEveryThesisSetting) { test::expect_thesis_preset(filter_preset(FilterPreset::thesis)); }
 
 // The presets as they run: sdk decimates ×2 (fx halved), thesis keeps the source's intrinsics.
 TEST(FilterChain, PresetsIntrinsics) {
@@ -53,12 +55,12 @@ TEST(FilterChain, PresetsIntrinsics) {
   source.fx = source.fy = 418.0F;
   source.ppx = 424.0F;
   source.ppy = 240.0F;
-  const Intrinsics sdk = filtered_intrinsics(*filter_preset("sdk"), source);
+  const Intrinsics sdk = filtered_intrinsics(filter_preset(FilterPreset::sdk), source);
   EXPECT_EQ(sdk.width, 424);  // 848 / 2, already a multiple of 4
   EXPECT_EQ(sdk.height, 240);
   EXPECT_EQ(sdk.fx, 209.0F);
   EXPECT_EQ(sdk.ppx, 212.0F);
-  const Intrinsics thesis = filtered_intrinsics(*filter_preset("thesis"), source);
+  const Intrinsics thesis = filtered_intrinsics(filter_preset(FilterPreset::thesis), source);
   EXPECT_EQ(thesis.width, 848);
   EXPECT_EQ(thesis.fx, 418.0F);
 }
@@ -74,7 +76,7 @@ TEST(FilterChain, OrderChecks) {
 
 TEST(FilterChain, WithoutBaselineRunsInTheDepthDomain) {
   FilterChain chain;
-  chain.params = *filter_preset("thesis");
+  chain.params = filter_preset(FilterPreset::thesis);
   Frame out;
   chain.process(noisy_frame(1, 0.0F), out);
   EXPECT_FALSE(chain.disparity_domain());
@@ -95,7 +97,7 @@ TEST(FilterChain, WithoutBaselineRunsInTheDepthDomain) {
 
 TEST(FilterChain, DecimationScalesTheFramesIntrinsics) {
   FilterChain chain;
-  chain.params = *filter_preset("sdk");
+  chain.params = filter_preset(FilterPreset::sdk);
   Frame out;
   chain.process(noisy_frame(3, 50.0F), out);
   EXPECT_EQ(out.depth.width, 32);
@@ -107,7 +109,7 @@ TEST(FilterChain, DecimationScalesTheFramesIntrinsics) {
 
 TEST(FilterChain, ResetGivesIdenticalOutputAndNoFilterInvalidatesValidPixels) {
   FilterChain chain;
-  chain.params = *filter_preset("thesis");
+  chain.params = filter_preset(FilterPreset::thesis);
   chain.params.order.push_back(FilterBlock::hole_filling);
   std::vector<std::vector<uint16_t>> first;
   Frame out;

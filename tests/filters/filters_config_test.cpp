@@ -41,16 +41,16 @@ TEST(FiltersConfig, Presets) {
 // No preset named: the RealSense Viewer's defaults (issue 4), every field as filters.preset=sdk.
 TEST(FiltersConfig, SdkPresetAndTheDefaultHaveEveryViewerDefault) {
   const Config sdk = load_config("", {"filters.preset=sdk"});
-  EXPECT_EQ(sdk.filters_preset, "sdk");
+  EXPECT_EQ(sdk.filters_preset, FilterPreset::sdk);
   test::expect_sdk_preset(sdk.pipeline.filters);
   const Config defaults = load_config("", {});
-  EXPECT_EQ(defaults.filters_preset, "sdk");
+  EXPECT_EQ(defaults.filters_preset, FilterPreset::sdk);
   test::expect_sdk_preset(defaults.pipeline.filters);
 }
 
 TEST(FiltersConfig, ThesisPresetHasEveryThesisSetting) {
   const Config thesis = load_config("", {"filters.preset=thesis"});
-  EXPECT_EQ(thesis.filters_preset, "thesis");
+  EXPECT_EQ(thesis.filters_preset, FilterPreset::thesis);
   test::expect_thesis_preset(thesis.pipeline.filters);
 }
 
@@ -98,7 +98,7 @@ TEST(FiltersConfig, OptionOfABlockOutsideTheChainIsAnError) {
                {"filters.temporal.persistence", "not in the chain", "filters.preset none"});
   expect_error({"filters.hole_filling.mode=2"}, {"filters.hole_filling.mode", "hole_filling block"});  // sdk: no hole fill
   expect_error({"filters.spatial.enabled=false", "filters.spatial.alpha=0.3"}, {"filters.spatial.alpha"});
-  const FilterChainParams none_defaults = *filter_preset("none");
+  const FilterChainParams none_defaults = filter_preset(FilterPreset::none);
   const Config same = load_config("", {"filters.preset=none", "filters.temporal.persistence=" +
                                                                   std::to_string(none_defaults.temporal.persistence)});
   EXPECT_TRUE(same.pipeline.filters.order.empty());
@@ -109,7 +109,7 @@ TEST(FiltersConfig, OptionOfABlockOutsideTheChainIsAnError) {
 
 TEST(FiltersPipeline, EveryBlockIsTimedUnderItsName) {
   PipelineParams params;
-  params.filters = *filter_preset("thesis");
+  params.filters = filter_preset(FilterPreset::thesis);
   params.filters.order.insert(params.filters.order.begin(), B::threshold);
   params.background.frames = 5;
   Pipeline pipeline(params);

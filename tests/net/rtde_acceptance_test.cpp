@@ -6,6 +6,7 @@
 // within an interpolation error bound derived by hand from the waypoints; a stalled controller
 // is a stop within robot.state.max_age_s plus one frame, and the verdict is run again once data
 // resumes.
+#include "../support/scenes.hpp"
 #include "../support/decide.hpp"
 #include "rtde_rig.hpp"
 
@@ -33,7 +34,7 @@ constexpr int64_t kStartNs = 1'000'000'000'000;      // Rig's FakeClock starts a
 constexpr int64_t kFramePeriodNs = 33'333'333;       // the camera at 30 frames/s
 constexpr int64_t kFramePhaseNs = 1'234'567;         // frames fall between the controller's samples
 
-Config moving_cell() { return load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml", {}); }
+Config moving_cell() { return load_config(test::scene_path("cell-ur5-moving.yaml"), {}); }
 
 // Trajectory time of a host time: the fake's controller clock is the FakeClock (offset 0), and
 // the trajectory starts with the stream at 1000 s.

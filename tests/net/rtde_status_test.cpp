@@ -157,7 +157,7 @@ FakeRtdeScript moving_arm(const Pose& turn) {
 }
 
 // The client with `arm` for the check.
-std::function<void(RtdeParams&)> with_arm(const char* arm) {
+std::function<void(RtdeParams&)> with_arm(BuiltinArm arm) {
   return [arm](RtdeParams& params) { params.arm = builtin_robot(arm); };
 }
 
@@ -178,7 +178,7 @@ void watch(Rig& rig, Seen& seen) {
 }
 
 TEST(RtdeTcpPoseCheck, ConsistentControllerGivesNoMismatch) {
-  Rig rig(moving_arm(Pose::Identity()), 500.0, with_arm("ur5"));
+  Rig rig(moving_arm(Pose::Identity()), 500.0, with_arm(BuiltinArm::ur5));
   Seen seen;
   watch(rig, seen);
   ASSERT_TRUE(rig.consumed(600));
@@ -193,7 +193,7 @@ TEST(RtdeTcpPoseCheck, ConsistentControllerGivesNoMismatch) {
 TEST(RtdeTcpPoseCheck, BaseFrameTurnedByPiIsAMismatchNamingTheMixUp) {
   Pose turned = Pose::Identity();
   turned.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  Rig rig(moving_arm(turned), 500.0, with_arm("ur5"));
+  Rig rig(moving_arm(turned), 500.0, with_arm(BuiltinArm::ur5));
   Seen seen;
   watch(rig, seen);
   ASSERT_TRUE(rig.consumed(600));
@@ -213,7 +213,7 @@ TEST(RtdeTcpPoseCheck, BaseFrameTurnedByPiIsAMismatchNamingTheMixUp) {
 TEST(RtdeTcpPoseCheck, AnotherArmIsAMismatchOnceTheWristTurns) {
   // A UR5 controller, hrcsense told ur10e: the flanges are 0.38 m apart at first (a plausible
   // tool), but that "tool" turns with the wrist instead of staying fixed to the flange.
-  Rig rig(moving_arm(Pose::Identity()), 500.0, with_arm("ur10e"));
+  Rig rig(moving_arm(Pose::Identity()), 500.0, with_arm(BuiltinArm::ur10e));
   Seen seen;
   watch(rig, seen);
   ASSERT_TRUE(rig.consumed(600));
@@ -227,7 +227,7 @@ TEST(RtdeTcpPoseCheck, AnotherArmIsAMismatchOnceTheWristTurns) {
 
 // check_tcp_pose on its own, at q = 0 (flange at (a2 + a3, -(d4 + d6), d1 - d5) in DH frame 0).
 TEST(TcpPoseCheck, ImpliedOffsetIsTheToolAndATurnedFrameIsNot) {
-  const RobotDescription& ur5 = builtin_robot("ur5");
+  const RobotDescription& ur5 = builtin_robot(BuiltinArm::ur5);
   const JointAngles zero{};
   const Pose reported = pendant_from_dh() * flange_dh(zero) * tool();
   const TcpPoseCheck good = check_tcp_pose(ur5, zero, ur_vector(reported), nullptr, TcpPoseCheckParams{});

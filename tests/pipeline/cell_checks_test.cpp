@@ -4,6 +4,7 @@
 // pipeline must stop with the fault's reason code within 100 ms of the frames' own time (the
 // frame times are the simulator's: the clock is the scene's, not the machine's).
 
+#include "../support/scenes.hpp"
 #include "../support/decide.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/cell_checks.hpp"
@@ -89,7 +90,7 @@ TEST(CellChecks, MovedCountsReferencePixelsFartherThanTheirMargin) {
 // The moving cell without noise on the arm's timeline; the background is learnt from its
 // first 100 frames, then frames 100.. are processed with a fault from frame 110 on.
 struct FaultRig {
-  Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml",
+  Config config = load_config(test::scene_path("cell-ur5-moving.yaml"),
                               {"sim.frames=130"});
   Pipeline pipeline{config.pipeline};
   Frame frame;
@@ -170,7 +171,7 @@ TEST(CellCheckFaults, CameraMovedStopsWithin100ms) {
   FaultRig rig;
   const Simulator clean = make_simulator(rig.config);
   // The camera knocked 0.15 m back along its mount (away from the cell) and tilted 3 degrees.
-  const Config moved_config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml",
+  const Config moved_config = load_config(test::scene_path("cell-ur5-moving.yaml"),
                                           {"sim.frames=130",
                                            "camera.T_base_camera.translation_m=[2.15, 0, 1.7]",
                                            "camera.T_base_camera.rotation_rpy_deg=[-128, 0, 90]"});

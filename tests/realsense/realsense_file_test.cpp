@@ -47,11 +47,11 @@ Seen feed(FrameClock& clock, double timestamp_ms, uint64_t number, int64_t arriv
 }
 
 TEST(RealSenseFile, EnablesOnlyTheStreamsAskedFor) {
-  SourceConfig source;
-  source.color.enabled = false;
-  EXPECT_EQ(file_streams(source), std::vector<StreamKind>{StreamKind::depth});
-  source.color.enabled = true;
-  EXPECT_EQ(file_streams(source), (std::vector<StreamKind>{StreamKind::depth, StreamKind::color}));
+  RealSenseParams params;
+  params.color = false;
+  EXPECT_EQ(file_streams(params), std::vector<StreamKind>{StreamKind::depth});
+  params.color = true;
+  EXPECT_EQ(file_streams(params), (std::vector<StreamKind>{StreamKind::depth, StreamKind::color}));
 }
 
 TEST(RealSenseFile, TheHostTimeIsLeftToTheRunAsForABagSource) {

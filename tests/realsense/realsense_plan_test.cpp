@@ -56,25 +56,25 @@ std::vector<ProfileDescriptor> d435_usb3() {
 }
 
 TEST(RealSenseProfiles, DefaultIs848x480At30AndNinetyWorks) {
-  SourceConfig source;
-  ProfileChoice choice = choose_profiles(d435_usb3(), source, false);
+  RealSenseParams params;
+  ProfileChoice choice = choose_profiles(d435_usb3(), params, false);
   EXPECT_EQ(choice.depth.width, 848);
   EXPECT_EQ(choice.depth.height, 480);
   EXPECT_EQ(choice.depth.fps, 30);
   EXPECT_EQ(choice.depth.format, "Z16");
   EXPECT_FALSE(choice.color);
-  source.fps = 90;
-  choice = choose_profiles(d435_usb3(), source, false);
+  params.fps = 90;
+  choice = choose_profiles(d435_usb3(), params, false);
   EXPECT_EQ(choice.depth.fps, 90);
   EXPECT_EQ(choice.depth.stream, StreamKind::depth);
 }
 
 TEST(RealSenseProfiles, ColourIsRgb8AtItsOwnMode) {
-  SourceConfig source;
-  source.color.enabled = true;
-  source.color.width = 1280;
-  source.color.height = 720;
-  const ProfileChoice choice = choose_profiles(d435_usb3(), source, false);
+  RealSenseParams params;
+  params.color = true;
+  params.color_width = 1280;
+  params.color_height = 720;
+  const ProfileChoice choice = choose_profiles(d435_usb3(), params, false);
   ASSERT_TRUE(choice.color);
   EXPECT_EQ(choice.color->format, "RGB8");  // not the YUYV one of the same size
   EXPECT_EQ(choice.color->width, 1280);
@@ -82,10 +82,10 @@ TEST(RealSenseProfiles, ColourIsRgb8AtItsOwnMode) {
 }
 
 TEST(RealSenseProfiles, NothingMatchingListsWhatTheCameraOffers) {
-  SourceConfig source;
-  source.fps = 15;
+  RealSenseParams params;
+  params.fps = 15;
   try {
-    (void)choose_profiles(d435_usb3(), source, false);
+    (void)choose_profiles(d435_usb3(), params, false);
     FAIL() << "848x480 @ 15 is not in the list";
   } catch (const RealSenseError& e) {
     const std::string message = e.what();
@@ -95,11 +95,11 @@ TEST(RealSenseProfiles, NothingMatchingListsWhatTheCameraOffers) {
     EXPECT_TRUE(contains(message, "it offers 1280x720 @ 30; 848x480 @ 90, 60, 30; 640x480 @ 30")) << message;
     EXPECT_FALSE(contains(message, "USB 2")) << message;
   }
-  source.fps = 30;
-  source.color.enabled = true;
-  source.color.fps = 60;
+  params.fps = 30;
+  params.color = true;
+  params.color_fps = 60;
   try {
-    (void)choose_profiles(d435_usb3(), source, false);
+    (void)choose_profiles(d435_usb3(), params, false);
     FAIL() << "colour 848x480 @ 60 is not in the list";
   } catch (const RealSenseError& e) {
     EXPECT_TRUE(contains(e.what(), "no colour RGB8 848x480 @ 60 (source.color); it offers 1280x720 @ 30; 848x480 @ 30"))
@@ -113,7 +113,7 @@ TEST(RealSenseProfiles, OnUsb2TheMessageExplainsTheLimit) {
                                                {StreamKind::depth, "Z16", 640, 480, 15},
                                                {StreamKind::depth, "Z16", 1280, 720, 6}};
   try {
-    (void)choose_profiles(usb2, SourceConfig{}, true);
+    (void)choose_profiles(usb2, RealSenseParams{}, true);
     FAIL() << "848x480 is not offered";
   } catch (const RealSenseError& e) {
     const std::string message = e.what();
@@ -134,16 +134,16 @@ TEST(RealSenseUsb, TypeDescriptorSaysUsb2) {
 }
 
 TEST(RealSenseOptions, AutoExposureAndSettling) {
-  SourceConfig source;
-  EXPECT_TRUE(auto_exposure_on(source.options));  // the D435 starts with it on
-  EXPECT_EQ(frames_to_settle(source), 30);
-  source.settle_frames = 12;
-  EXPECT_EQ(frames_to_settle(source), 12);
-  source.options = {{"visual_preset", 3.0F}, {"enable_auto_exposure", 0.0F}, {"exposure", 8500.0F}};
-  EXPECT_FALSE(auto_exposure_on(source.options));
-  EXPECT_EQ(frames_to_settle(source), 0);
-  source.options = {{"enable_auto_exposure", 1.0F}};
-  EXPECT_TRUE(auto_exposure_on(source.options));
+  RealSenseParams params;
+  EXPECT_TRUE(auto_exposure_on(params.options));  // the D435 starts with it on
+  EXPECT_EQ(frames_to_settle(params), 30);
+  params.settle_frames = 12;
+  EXPECT_EQ(frames_to_settle(params), 12);
+  params.options = {{"visual_preset", 3.0F}, {"enable_auto_exposure", 0.0F}, {"exposure", 8500.0F}};
+  EXPECT_FALSE(auto_exposure_on(params.options));
+  EXPECT_EQ(frames_to_settle(params), 0);
+  params.options = {{"enable_auto_exposure", 1.0F}};
+  EXPECT_TRUE(auto_exposure_on(params.options));
 }
 
 TEST(RealSenseSettle, SkipsTheFirstFramesAfterEachRestart) {

@@ -2,6 +2,7 @@
 // Simulator frames written with the test bag writer (tests/support/bag_writer.hpp) and read back
 // with BagSource: pixels, intrinsics, depth units and integer-nanosecond timestamps survive, with
 // LZ4 or uncompressed chunks, through the index or by a linear scan. Needs no ../shared data.
+#include "../support/scenes.hpp"
 #include "../support/bag_writer.hpp"
 #include "recordings_test_util.hpp"
 
@@ -26,7 +27,7 @@ constexpr int64_t kFirstStampNs = 1'700'000'000'123'456'789LL;
 /// Frames of config/walk.yaml at 640x480 with the person in view, stamped kFirstStampNs + i·33.3 ms.
 const std::vector<Frame>& walk_frames() {
   static const std::vector<Frame> frames = [] {
-    const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/walk.yaml",
+    const Config config = load_config(test::scene_path("walk.yaml"),
                                       {"sim.width=640", "sim.height=480"});
     const Simulator sim = make_simulator(config);
     std::vector<Frame> out(kFrames);

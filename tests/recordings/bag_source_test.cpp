@@ -29,7 +29,8 @@ TEST(BagSource, SummaryMatchesTheReadme) {
   REQUIRE_BAG();
   const RecordingSummary s = summarize_recording(bag);
   EXPECT_TRUE(s.damage.empty()) << s.damage;
-  EXPECT_EQ(s.format, "bag");
+  EXPECT_EQ(s.format, RecordingFormat::bag);
+  EXPECT_EQ(recording_format_text(s), "bag");
   EXPECT_EQ(s.compression, "lz4");
   EXPECT_TRUE(s.indexed);
   EXPECT_EQ(s.file_version, 3);

@@ -211,7 +211,9 @@ TEST(FolderSource, SummaryCountsFramesAndReportsDamage) {
   ScratchDir dir("folder");
   make_dataset_folder(dir, 3);
   RecordingSummary summary = summarize_recording(dir.path.string());
-  EXPECT_EQ(summary.format, "folder (ist layout)");
+  EXPECT_EQ(summary.format, RecordingFormat::folder);
+  EXPECT_EQ(summary.folder_layout, "ist");
+  EXPECT_EQ(recording_format_text(summary), "folder (ist layout)");
   ASSERT_EQ(summary.streams.size(), 1U);
   EXPECT_EQ(summary.streams[0].frames, 3);
   EXPECT_TRUE(summary.damage.empty()) << summary.damage;

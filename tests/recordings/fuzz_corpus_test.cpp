@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hrcsense {
@@ -30,18 +31,19 @@ std::vector<fs::path> files_under(const std::string& relative) {
   return files;
 }
 
-fuzz::Outcome replay(const fs::path& file, const std::string& target) {
+/// A fuzz target's entry code (fuzz/fuzz_entries.hpp).
+using FuzzEntry = fuzz::Outcome (*)(const uint8_t* data, size_t size);
+
+fuzz::Outcome replay(const fs::path& file, FuzzEntry entry) {
   const std::vector<char> bytes = test::read_bytes(file.string());
-  const auto* data = reinterpret_cast<const uint8_t*>(bytes.data());
-  if (target == "config") return fuzz::run_config(data, bytes.size());
-  return target == "bag" ? fuzz::run_bag(data, bytes.size()) : fuzz::run_folder(data, bytes.size());
+  return entry(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
 }
 
 TEST(FuzzCorpus, SeedBagsAreValidRecordings) {
   const std::vector<fs::path> seeds = files_under("fuzz/corpus/bag");
   ASSERT_GE(seeds.size(), 3U) << "fuzz/corpus/bag is missing";
   for (const fs::path& seed : seeds) {
-    const fuzz::Outcome outcome = replay(seed, "bag");
+    const fuzz::Outcome outcome = replay(seed, fuzz::run_bag);
     EXPECT_EQ(outcome.error, "") << seed;
     EXPECT_EQ(outcome.frames, 2) << seed;  // make_corpus.cpp writes 2 depth frames per bag
   }
@@ -51,7 +53,7 @@ TEST(FuzzCorpus, SeedFolderFilesGiveValidFolders) {
   const std::vector<fs::path> seeds = files_under("fuzz/corpus/folder");
   ASSERT_EQ(seeds.size(), static_cast<size_t>(fuzz::kFolderTargets)) << "one seed per folder file";
   for (const fs::path& seed : seeds) {
-    const fuzz::Outcome outcome = replay(seed, "folder");
+    const fuzz::Outcome outcome = replay(seed, fuzz::run_folder);
     if (!jpeg_supported() && outcome.error.find("libturbojpeg") != std::string::npos) continue;
     EXPECT_EQ(outcome.error, "") << seed;
     EXPECT_EQ(outcome.frames, 2) << seed;
@@ -63,7 +65,7 @@ TEST(FuzzCorpus, SeedConfigsLoad) {
   const std::vector<fs::path> seeds = files_under("fuzz/corpus/config");
   ASSERT_GE(seeds.size(), 5U) << "fuzz/corpus/config is missing";
   for (const fs::path& seed : seeds) {
-    const fuzz::Outcome outcome = replay(seed, "config");
+    const fuzz::Outcome outcome = replay(seed, fuzz::run_config);
     EXPECT_EQ(outcome.error, "") << seed;
     EXPECT_EQ(outcome.frames, 1) << seed;
   }
@@ -89,13 +91,16 @@ TEST(FuzzCorpus, SeedsMatchWhatTheEntryCodeStartsFrom) {
 
 TEST(FuzzCorpus, RegressionsEndCleanly) {
   int replayed = 0;
-  for (const std::string target : {"bag", "folder", "config"}) {
-    for (const fs::path& file : files_under("fuzz/regressions/" + target)) {
+  // Each target's reproducers are in the folder of its name.
+  const std::pair<const char*, FuzzEntry> targets[] = {
+      {"bag", fuzz::run_bag}, {"folder", fuzz::run_folder}, {"config", fuzz::run_config}};
+  for (const auto& [folder, entry] : targets) {
+    for (const fs::path& file : files_under(std::string("fuzz/regressions/") + folder)) {
       // The entry code aborts on a broken error contract and the sanitizers on memory errors;
       // here every reproducer (a damaged input) must end in a clean error, the same every time
       // (no state leaks from one input to the next).
-      const fuzz::Outcome first = replay(file, target);
-      const fuzz::Outcome second = replay(file, target);
+      const fuzz::Outcome first = replay(file, entry);
+      const fuzz::Outcome second = replay(file, entry);
       EXPECT_NE(first.error, "") << file << " plays as a valid recording";
       EXPECT_EQ(first.frames, second.frames) << file;
       EXPECT_EQ(first.error, second.error) << file;

@@ -2,6 +2,7 @@
 // `hrcsense record` and `hrcsense run --record` as child processes: frame and duration limits,
 // joint states, a full disk, SIGINT (closed and indexed) and SIGKILL (readable up to the last
 // complete chunk). Every child is bounded in time. Needs no ../shared data.
+#include "../support/scenes.hpp"
 #include "recordings_test_util.hpp"
 
 #include "common/assembly.hpp"
@@ -27,15 +28,15 @@
 namespace hrcsense {
 namespace {
 
+using test::scene_path;
+
 namespace fs = std::filesystem;
 using test::ScratchDir;
-
-std::string cell_config() { return std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5.yaml"; }
 
 std::unique_ptr<Source> cell_source(int frames, const std::vector<std::string>& extra = {}) {
   std::vector<std::string> sets = {"sim.frames=" + std::to_string(frames)};
   sets.insert(sets.end(), extra.begin(), extra.end());
-  return make_source(load_config(cell_config(), sets));
+  return make_source(load_config(scene_path("cell-ur5.yaml"), sets));
 }
 
 // Starts `hrcsense record` of an endless 424x240 cell-ur5 into `path` as a child process
@@ -45,7 +46,7 @@ pid_t start_endless_recording(const std::string& path, uintmax_t bytes) {
   if (pid == 0) {
     const int null = ::open("/dev/null", O_WRONLY);
     ::dup2(null, STDERR_FILENO);
-    std::vector<std::string> args = {HRCSENSE_CLI, "record", "--config", cell_config(), "--out", path,
+    std::vector<std::string> args = {HRCSENSE_CLI, "record", "--config", scene_path("cell-ur5.yaml"), "--out", path,
                                      "--set", "sim.width=424", "--set", "sim.height=240", "--set", "sim.frames=100000"};
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());
@@ -128,7 +129,7 @@ TEST(RecordCli, SigintClosesAndIndexesTheRecording) {
 TEST(RecordCli, RecordsTheRequestedFramesAndDuration) {
   ScratchDir dir("recorder");
   const auto run = [&](const std::vector<std::string>& extra) {
-    std::string command = std::string(HRCSENSE_CLI) + " record --config " + cell_config() +
+    std::string command = std::string(HRCSENSE_CLI) + " record --config " + scene_path("cell-ur5.yaml") +
                           " --set sim.width=424 --set sim.height=240 --set sim.frames=60";
     for (const std::string& e : extra) command += " " + e;
     return std::system((command + " 2>" + (dir / "err.txt")).c_str());
@@ -136,7 +137,7 @@ TEST(RecordCli, RecordsTheRequestedFramesAndDuration) {
   ASSERT_EQ(run({"--out", dir / "n.bag", "--frames", "7"}), 0);
   EXPECT_EQ(summarize_recording(dir / "n.bag").streams[0].frames, 7);
   // The cell's fixed arm: every frame's joint state is robot.joints_rad of the configuration.
-  const JointAngles joints_rad = load_config(cell_config(), {}).robot_state.joints_rad;
+  const JointAngles joints_rad = load_config(scene_path("cell-ur5.yaml"), {}).robot_state.joints_rad;
   BagReader reader(dir / "n.bag");
   BagMessage m;
   int joint_states = 0;
@@ -159,7 +160,7 @@ TEST(RecordCli, RecordsTheRequestedFramesAndDuration) {
 
 TEST(RecordCli, RunWithRecordWritesTheSourceFramesBeforeFilters) {
   ScratchDir dir("recorder");
-  const std::string command = std::string(HRCSENSE_CLI) + " run --config " + cell_config() +
+  const std::string command = std::string(HRCSENSE_CLI) + " run --config " + scene_path("cell-ur5.yaml") +
                               " --set sim.width=424 --set sim.height=240 --set sim.frames=12 --set record.queue_frames=64" +
                               " --record " + (dir / "run.bag") + " --out " + (dir / "out.jsonl") + " 2>/dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0);

@@ -6,6 +6,7 @@
 // its JSON output says. Also: `hrcsense record`'s bags replay the same way, the joints carry UR's
 // names, a bag without joint states is a clear error, and the summary's `record` counters.
 // 424x240 frames, at most 90 of them. No ../shared data.
+#include "../support/scenes.hpp"
 #include "recordings_test_util.hpp"
 
 #include "hrcsense/bag_writer.hpp"
@@ -30,20 +31,20 @@
 namespace hrcsense {
 namespace {
 
+using test::scene_path;
+
 using nlohmann::json;
 
 constexpr int kRecordedFrames = 90;  // a full 2.7 s pick-and-place cycle and some
 
-std::string moving_config() { return std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml"; }
-
 // The moving cell at 424x240 with a short background.
 std::string moving_cell(int frames) {
-  return "--config " + moving_config() + " --set sim.width=424 --set sim.height=240 --set sim.frames=" +
+  return "--config " + scene_path("cell-ur5-moving.yaml") + " --set sim.width=424 --set sim.height=240 --set sim.frames=" +
          std::to_string(frames) + " --set background.frames=20";
 }
 
 std::string replay(const std::string& bag) {
-  return "--config " + moving_config() + " --set source.type=bag --set source.path=" + bag +
+  return "--config " + scene_path("cell-ur5-moving.yaml") + " --set source.type=bag --set source.path=" + bag +
          " --set robot.state.source=recorded --set background.frames=20";
 }
 
@@ -147,7 +148,7 @@ TEST_F(RecordedState, APacedReplayLooksTheStatesUpOnTheRecordingsTimeline) {
 TEST_F(RecordedState, TheJointsCarryUrNamesAndTheSimulatedVelocities) {
   BagReader reader(*dir_ / "moving.bag");
   BagMessage m;
-  const Config config = load_config(moving_config(), {});
+  const Config config = load_config(scene_path("cell-ur5-moving.yaml"), {});
   int64_t states = 0;
   for (int guard = 0; guard < 100000 && reader.next(m); ++guard) {
     if (reader.connections().at(m.conn).topic != "/hrcsense/joint_states") continue;

@@ -3,6 +3,7 @@
 // read back by hrcsense's own reader frame for frame against a second, identical simulator; the
 // records the spec lists for SDK playback; joint states; split files; write errors and drops
 // (record_cli_test.cpp runs the commands). Needs no ../shared data.
+#include "../support/scenes.hpp"
 #include "recordings_test_util.hpp"
 
 #include "common/assembly.hpp"
@@ -27,19 +28,19 @@
 namespace hrcsense {
 namespace {
 
+using test::scene_path;
+
 namespace fs = std::filesystem;
 using test::ScratchDir;
 
 constexpr int kRoundTripFrames = 300;
 constexpr int kPushWaitMs = 10000;
 
-std::string cell_config() { return std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5.yaml"; }
-
 /// The colour simulator of config/cell-ur5.yaml (848x480 depth + colour), `frames` long.
 std::unique_ptr<Source> cell_source(int frames, const std::vector<std::string>& extra = {}) {
   std::vector<std::string> sets = {"sim.frames=" + std::to_string(frames)};
   sets.insert(sets.end(), extra.begin(), extra.end());
-  return make_source(load_config(cell_config(), sets));
+  return make_source(load_config(scene_path("cell-ur5.yaml"), sets));
 }
 
 RecorderParams recorder_params(const std::string& path) {
@@ -533,11 +534,11 @@ TEST(Recorder, WithOnErrorStopTheRecordingSourceEndsWithTheError) {
 TEST(Recorder, RecordKeysAreReadAndBounded) {
   const Config defaults = load_config("", {});
   EXPECT_EQ(defaults.record.split_mb, 0);  // docs/CONFIG.md: one file
-  EXPECT_EQ(defaults.record.on_error, "continue");
+  EXPECT_EQ(defaults.record.on_error, RecordOnError::continue_run);
   EXPECT_EQ(defaults.record.queue_frames, 16);
   const Config set = load_config("", {"record.split_mb=512", "record.on_error=stop", "record.queue_frames=1"});
   EXPECT_EQ(set.record.split_mb, 512);
-  EXPECT_EQ(set.record.on_error, "stop");
+  EXPECT_EQ(set.record.on_error, RecordOnError::stop_run);
   EXPECT_EQ(set.record.queue_frames, 1);
   for (const std::string bad : {"record.split_mb=-1", "record.split_mb=1048577", "record.split_mb=0.5",
                                 "record.on_error=retry", "record.queue_frames=0", "record.queue_frames=1025"}) {

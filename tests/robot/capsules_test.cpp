@@ -39,10 +39,11 @@ const Capsule& last_of(const RobotModel& model, int link) {
 
 TEST(RobotCapsules, ConsecutiveLinksMeetAtTheJoints) {
   std::mt19937 rng(7);
-  for (const std::string& name : builtin_robot_names()) {
+  for (const BuiltinArm arm : kBuiltinArms) {
+    const std::string& name = builtin_robot(arm).name;
     for (int trial = 0; trial < 50; ++trial) {
       const JointAngles q = random_joints(rng);
-      const RobotModel model = robot_capsules(builtin_robot(name), q, 0.0, BaseFrame::base);
+      const RobotModel model = robot_capsules(builtin_robot(arm), q, 0.0, BaseFrame::base);
       for (int link = 0; link + 1 < kArmLinkCount; ++link) {
         EXPECT_LT((last_of(model, link).b - first_of(model, link + 1).a).norm(), 1e-5F)
             << name << " between " << link_name(link) << " and " << link_name(link + 1);
@@ -62,7 +63,7 @@ TEST(RobotCapsules, ConsecutiveLinksMeetAtTheJoints) {
 }
 
 TEST(RobotCapsules, ChainEndsAtTheBaseAndTheFlange) {
-  const RobotDescription& ur5 = builtin_robot("ur5");
+  const RobotDescription& ur5 = builtin_robot(BuiltinArm::ur5);
   const JointAngles q{0.4, -1.2, 1.0, -0.3, 0.9, 0.2};
   const RobotModel model = robot_capsules(ur5, q, 0.0, BaseFrame::base);
   EXPECT_LT(first_of(model, 0).a.norm(), 1e-6F);  // on the mounting face, at the base origin
@@ -76,7 +77,7 @@ TEST(RobotCapsules, ChainEndsAtTheBaseAndTheFlange) {
 }
 
 TEST(RobotCapsules, RadiusIsLinkRadiusPlusPadding) {
-  const RobotDescription& ur10e = builtin_robot("ur10e");
+  const RobotDescription& ur10e = builtin_robot(BuiltinArm::ur10e);
   const JointAngles q{0.1, -0.5, 0.5, 0.0, 1.0, 0.0};
   const RobotModel bare = robot_capsules(ur10e, q, 0.0, BaseFrame::base);
   const RobotModel padded = robot_capsules(ur10e, q, 0.05, BaseFrame::base);
@@ -96,8 +97,8 @@ TEST(RobotCapsules, RadiusIsLinkRadiusPlusPadding) {
 
 TEST(RobotCapsules, BaseFrameTurnsEveryCapsuleHalfAroundZ) {
   const JointAngles q{1.0, -0.7, 1.3, -2.0, 0.5, 3.0};
-  const RobotModel in_base_link = robot_capsules(builtin_robot("ur5e"), q, 0.02, BaseFrame::base_link);
-  const RobotModel in_base = robot_capsules(builtin_robot("ur5e"), q, 0.02, BaseFrame::base);
+  const RobotModel in_base_link = robot_capsules(builtin_robot(BuiltinArm::ur5e), q, 0.02, BaseFrame::base_link);
+  const RobotModel in_base = robot_capsules(builtin_robot(BuiltinArm::ur5e), q, 0.02, BaseFrame::base);
   ASSERT_EQ(in_base.capsules.size(), in_base_link.capsules.size());
   for (size_t i = 0; i < in_base.capsules.size(); ++i) {
     const Capsule& l = in_base_link.capsules[i];
@@ -110,7 +111,7 @@ TEST(RobotCapsules, BaseFrameTurnsEveryCapsuleHalfAroundZ) {
 }
 
 TEST(RobotCapsules, ToolHangsOffTheFlange) {
-  RobotDescription arm = builtin_robot("ur5");
+  RobotDescription arm = builtin_robot(BuiltinArm::ur5);
   // A 0.15 m gripper along the flange's z.
   arm.tool.push_back(LinkCapsule{Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.15), 0.04});
   // At q = 0 the flange's z is −y of base_link (see kinematics_test), so the tool tip is
@@ -126,9 +127,9 @@ TEST(RobotCapsules, ToolHangsOffTheFlange) {
 
 TEST(RobotCapsules, ReusesTheCallersBuffer) {
   RobotModel model;
-  robot_capsules(builtin_robot("ur5"), JointAngles{}, 0.0, BaseFrame::base, model);
+  robot_capsules(builtin_robot(BuiltinArm::ur5), JointAngles{}, 0.0, BaseFrame::base, model);
   const Capsule* storage = model.capsules.data();
-  robot_capsules(builtin_robot("ur5"), JointAngles{0.1, 0.2, 0.3, 0.4, 0.5, 0.6}, 0.0, BaseFrame::base, model);
+  robot_capsules(builtin_robot(BuiltinArm::ur5), JointAngles{0.1, 0.2, 0.3, 0.4, 0.5, 0.6}, 0.0, BaseFrame::base, model);
   EXPECT_EQ(model.capsules.data(), storage);  // same size: no reallocation
   EXPECT_EQ(model.capsules.size(), 8U);
 }
@@ -152,11 +153,12 @@ TEST(RobotRenderCapsules, VisualBodyLiesInsideTheUnpaddedCapsules) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> gauss(0.0, 1.0);
-  for (const std::string& name : builtin_robot_names()) {
+  for (const BuiltinArm arm : kBuiltinArms) {
+    const std::string& name = builtin_robot(arm).name;
     for (int pose = 0; pose < 20; ++pose) {
       const JointAngles q = random_joints(rng);
-      const RobotModel visual = robot_render_capsules(builtin_robot(name), q, BaseFrame::base);
-      const RobotModel bare = robot_capsules(builtin_robot(name), q, 0.0, BaseFrame::base);
+      const RobotModel visual = robot_render_capsules(builtin_robot(arm), q, BaseFrame::base);
+      const RobotModel bare = robot_capsules(builtin_robot(arm), q, 0.0, BaseFrame::base);
       ASSERT_EQ(visual.capsules.size(), 8U) << name;
       for (const Capsule& c : visual.capsules) {
         for (int k = 0; k < 200; ++k) {
@@ -171,7 +173,7 @@ TEST(RobotRenderCapsules, VisualBodyLiesInsideTheUnpaddedCapsules) {
 }
 
 TEST(RobotRenderCapsules, ALinkWithoutVisualShapesIsDrawnAsItsCapsules) {
-  RobotDescription arm = builtin_robot("ur5");
+  RobotDescription arm = builtin_robot(BuiltinArm::ur5);
   arm.visual[2].clear();  // the upper arm
   arm.tool.push_back(LinkCapsule{Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.15), 0.04});
   const JointAngles q{0.5, -1.0, 1.5, -0.5, -1.0, 0.3};

@@ -10,7 +10,7 @@ namespace hrcsense {
 namespace {
 
 TEST(PointVelocity, ShoulderPanAloneTurnsAboutTheBaseZ) {
-  const RobotDescription& ur5 = builtin_robot("ur5");
+  const RobotDescription& ur5 = builtin_robot(BuiltinArm::ur5);
   JointAngles q{};
   JointAngles qd{};
   qd[0] = 0.5;
@@ -42,13 +42,13 @@ TEST(PointVelocity, MatchesCentralDifferencesOfTheKinematics) {
     q_plus[j] += qd[j] * h;
     q_minus[j] -= qd[j] * h;
   }
-  for (const char* name : {"ur5", "ur10e"}) {
+  for (const BuiltinArm name : {BuiltinArm::ur5, BuiltinArm::ur10e}) {
     const RobotDescription& arm = builtin_robot(name);
     for (int link = 1; link <= kJointCount; ++link) {
       const Eigen::Vector3d expected =
           (point_at(arm, q_plus, link, p_link) - point_at(arm, q_minus, link, p_link)) / (2.0 * h);
       const Eigen::Vector3d v = point_velocity(arm, q, qd, link, point_at(arm, q, link, p_link), BaseFrame::base);
-      EXPECT_NEAR((v - expected).norm(), 0.0, 1e-6) << name << " link " << link;
+      EXPECT_NEAR((v - expected).norm(), 0.0, 1e-6) << arm.name << " link " << link;
     }
   }
 }

@@ -5,6 +5,7 @@
 // rules themselves are checked on hand-worked frames (foreground_hand_test.cpp). Also the
 // fail-safe side of preparing.
 
+#include "../support/scenes.hpp"
 #include "../support/decide.hpp"
 #include "src/segmentation/foreground_tables.hpp"
 #include "synthetic_frames.hpp"
@@ -208,7 +209,7 @@ void expect_moves_with_image(const Frame& frame, const BackgroundModel& backgrou
 /// Renders a configured scene, learns its background, and checks on `frames` that the
 /// foreground moves with the image.
 void moves_on_scene(const std::string& config_name, uint64_t seed, const std::vector<int64_t>& frames) {
-  const std::string path = std::string(HRCSENSE_SOURCE_DIR) + "/config/" + config_name;
+  const std::string path = test::scene_path(config_name);
   const Config config = load_config(path, {"source.seed=" + std::to_string(seed)});
   const Simulator sim = make_simulator(config);
   BackgroundLearner learner;

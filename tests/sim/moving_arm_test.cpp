@@ -3,6 +3,7 @@
 // scene's timeline from the simulator's own truth, the arm's label and motion, the tool speed,
 // the truth contact against the arm's searched capsules at each frame's time, and
 // truth.contact_label (label_at, source_pixel_of, TruthLabeller).
+#include "../support/scenes.hpp"
 #include "common/assembly.hpp"
 #include "common/truth_labeller.hpp"
 #include "hrcsense/camera.hpp"
@@ -21,7 +22,7 @@ namespace hrcsense {
 namespace {
 
 Config moving_cell() {
-  return load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml",
+  return load_config(test::scene_path("cell-ur5-moving.yaml"),
                      {"sim.noise=false", "sim.color=false"});
 }
 
@@ -45,7 +46,7 @@ uint16_t label_named(const Simulator& sim, const std::string& name) {
 TEST(MovingArmScene, PersonVisibleInAtLeast150FramesBefore1000AndNotWhileLearning) {
   const Config config = moving_cell();
   ASSERT_EQ(config.sim.frames, 1000);
-  ASSERT_EQ(config.robot_state.source, "sim");
+  ASSERT_EQ(config.robot_state.source, RobotStateOrigin::sim);
   const Simulator sim = make_simulator(config);
   const uint16_t person = label_named(sim, "person");
   ASSERT_NE(person, kStaticLabel);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The shipped scene files (config/*.yaml) do what their comments promise, checked numerically.
 
+#include "../support/scenes.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/io.hpp"
@@ -17,13 +18,13 @@
 namespace hrcsense {
 namespace {
 
+using test::scene_path;
+
 #if defined(__SANITIZE_ADDRESS__)
 constexpr int64_t kStep = 3;  // sanitizers: every third frame (the closest approach lasts 30)
 #else
 constexpr int64_t kStep = 1;
 #endif
-
-std::string scene_path(const char* name) { return std::string(HRCSENSE_SOURCE_DIR) + "/config/" + name; }
 
 TEST(Scenes, WalkApproachesTheRobotPointTo029Metres) {
   // The truth does not depend on the noise; without it rendering is faster.
@@ -149,7 +150,7 @@ TEST(Scenes, EmptyWhileLearningThenPeopleEnter) {
 // box, so the true closest point is the box's front top left vertex in every frame.
 TEST(Scenes, ThesisBoxHumanContactIsOnTheBoxInEveryFrame) {
   const Config config = load_config(scene_path("thesis-box-human.yaml"), {"sim.noise=false", "sim.color=false"});
-  EXPECT_EQ(config.filters_preset, "thesis");
+  EXPECT_EQ(config.filters_preset, FilterPreset::thesis);
   const Simulator sim = make_simulator(config);
   Simulator person_only = sim;  // the same scene without the box: the person's own distance
   const auto box_it = std::find_if(person_only.scene.objects.begin(), person_only.scene.objects.end(),
@@ -243,7 +244,7 @@ TEST(Scenes, CellUr5IsAUr5CellSeenAt848x480) {
   ASSERT_TRUE(f.color);
   EXPECT_EQ(f.color->width, 848);
   EXPECT_EQ(f.color->height, 480);
-  EXPECT_EQ(config.robot_model, "ur5");
+  EXPECT_EQ(config.robot_model, RobotModelType::ur5);
   EXPECT_GT(sim.robot.capsules.size(), 1U) << "an arm of capsules, not one point";
   const auto robot = std::find_if(sim.scene.objects.begin(), sim.scene.objects.end(),
                                   [](const SceneObject& o) { return o.name == "robot"; });

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tests of SimRobotState (robot.state.source: sim): exact on the simulator's timeline, late
 // by the latency with a seeded jitter, stale beyond robot.state.max_age_s.
+#include "../support/scenes.hpp"
 #include "common/assembly.hpp"
 #include "hrcsense/config.hpp"
 #include "hrcsense/sim.hpp"
@@ -12,6 +13,8 @@
 namespace hrcsense {
 namespace {
 
+using test::scene_path;
+
 /// Joint 1 from 0 to 1 rad over 10 s (0.1 rad/s), the others at rest at 0.3 rad.
 RobotTrajectory ramp() {
   RobotTrajectory t;
@@ -20,10 +23,8 @@ RobotTrajectory ramp() {
   return t;
 }
 
-std::string moving_cell_path() { return std::string(HRCSENSE_SOURCE_DIR) + "/config/cell-ur5-moving.yaml"; }
-
 TEST(SimRobotState, WithoutLatencyGivesTheTrajectoryAtTheFramesTimestamp) {
-  const Config config = load_config(moving_cell_path(), {"sim.noise=false", "sim.color=false"});
+  const Config config = load_config(scene_path("cell-ur5-moving.yaml"), {"sim.noise=false", "sim.color=false"});
   Simulator sim = make_simulator(config);
   std::unique_ptr<RobotStateSource> states = make_robot_state_source(config);
   ASSERT_EQ(states->origin(), RobotStateOrigin::sim);

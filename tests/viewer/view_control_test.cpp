@@ -153,13 +153,14 @@ TEST(ControlInbox, RefusedTuningIsReportedAndChangesNothing) {
   Pipeline pipeline(point_robot_params());
   ControlInbox inbox;
   LiveTuning tuning = pipeline.tuning();
-  tuning.backend = "no_such_backend";
+  tuning.filters.order.push_back(FilterBlock::temporal);  // the order is fixed while the cell runs
+  tuning.backend = ProximityBackend::octree;
   inbox.post_tuning(tuning);
   inbox.apply(pipeline, still_and_clear());
   const std::vector<ControlEvent> events = inbox.take_events();
   ASSERT_EQ(events.size(), 1U);
   EXPECT_TRUE(events[0].refused);
-  EXPECT_EQ(pipeline.params().backend, "brute");
+  EXPECT_EQ(pipeline.params().backend, ProximityBackend::brute);
 }
 
 TEST(ControlInbox, RelearnRefusedNearTheRobotThenDoneWhenClear) {
@@ -210,14 +211,14 @@ TEST(SaveTuned, TheSavedFileRunsAsTheTunedCellWithTheRunsOverrides) {
   const std::vector<std::string> sets = {"safety.slow_distance_m=1.4", "filters.preset=thesis"};
   LiveTuning tuning = tuning_of(load_config("", sets).pipeline);
   tuning.foreground.k_sigma = 5.5F;
-  tuning.backend = "octree";
+  tuning.backend = ProximityBackend::octree;
   const Config tuned = tuned_config("", sets, tuning);
   save_tuned_config(tuned, saved);
   const Config reloaded = load_config(saved, {});
   EXPECT_EQ(reloaded.pipeline.foreground.k_sigma, 5.5F);
-  EXPECT_EQ(reloaded.pipeline.backend, "octree");
+  EXPECT_EQ(reloaded.pipeline.backend, ProximityBackend::octree);
   EXPECT_EQ(reloaded.pipeline.safety.slow_distance_m, 1.4F);
-  EXPECT_EQ(reloaded.filters_preset, "thesis");
+  EXPECT_EQ(reloaded.filters_preset, FilterPreset::thesis);
   EXPECT_EQ(config_hash(reloaded), config_hash(tuned));
   EXPECT_THROW(save_tuned_config(tuned, (dir / "no_such_dir" / "x.yaml").string()), IoError);
   std::filesystem::remove_all(dir);

@@ -4,6 +4,7 @@
 // pinhole projections, the shown state (NO DATA) on injected times, the layout rule, and the
 // view tap (each picture published with its own decided verdict, drops counted, snapshot
 // frames waited for).
+#include "../support/scenes.hpp"
 #include "viewer/view_model.hpp"
 #include "viewer/view_tap.hpp"
 
@@ -261,7 +262,7 @@ TEST(Timeline, RatesAndLatencyPercentiles) {
 }
 
 Pipeline walk_pipeline() {
-  const Config config = load_config(std::string(HRCSENSE_SOURCE_DIR) + "/config/walk.yaml", {});
+  const Config config = load_config(test::scene_path("walk.yaml"), {});
   return Pipeline(config.pipeline);
 }
 
