@@ -5,7 +5,7 @@
 #include "hrcsense/eval/goldens.hpp"
 
 #include "hrcsense/filters.hpp"
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 #include <nlohmann/json.hpp>
 

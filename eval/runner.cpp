@@ -5,7 +5,7 @@
 #include "hrcsense/eval/runner.hpp"
 
 #include "hrcsense/eval/run.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/eval/metrics.hpp"
 #include "hrcsense/number_text.hpp"
 

@@ -5,7 +5,7 @@
 // single point beside it. The timing is of the search stage alone (tree build included, as the
 // cloud is new every frame): the median of five serial repetitions.
 #include "hrcsense/eval/studies.hpp"
-#include "hrcsense/person_cloud.hpp"
+#include "hrcsense/sim/person_cloud.hpp"
 #include "hrcsense/proximity.hpp"
 
 #include <algorithm>

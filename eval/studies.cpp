@@ -8,7 +8,7 @@
 #include "hrcsense/eval/plots.hpp"
 #include "hrcsense/eval/runner.hpp"
 #include "hrcsense/eval/studies.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 
 #include <spdlog/spdlog.h>
 

@@ -5,9 +5,9 @@
 // stays failed (fail safe: no frames after damage).
 #include "fuzz_entries.hpp"
 
-#include "hrcsense/config.hpp"
-#include "hrcsense/io.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/io/io.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 #include "hrcsense/robot_state_history.hpp"
 
 #include <sys/mman.h>

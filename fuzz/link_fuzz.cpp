@@ -5,7 +5,7 @@
 // value in its documented range, a non-zero session among them, and the same bytes again when
 // encoded, or an error naming a field; never an exception. Each 45-byte input is decoded a second
 // time with its CRC made right.
-#include "hrcsense/link.hpp"
+#include "hrcsense/net/link.hpp"
 
 #include <cmath>
 #include <cstdlib>

@@ -3,7 +3,7 @@
 // Usage: hrcsense-fuzz-corpus <fuzz/corpus>. The files are committed; rerun after a format change.
 #include "../tests/support/bag_writer.hpp"
 #include "fuzz_entries.hpp"
-#include "hrcsense/link.hpp"
+#include "hrcsense/net/link.hpp"
 
 #include <cstdio>
 #include <filesystem>

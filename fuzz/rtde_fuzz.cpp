@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
-// libFuzzer target: any bytes as a stream from an RTDE controller, framed by split_frame and each
+// libFuzzer target: any bytes as a stream from an RTDE controller, framed by split_package and each
 // package given to the parser of its type, as the client does: a setup reply becomes the recipe
 // for the data packages after it (hrcsense's own recipe until then). Nothing may read past a
 // package, crash or loop; a size below 3 ends the stream, as it ends the client's connection.
-#include "hrcsense/rtde.hpp"
+#include "src/net/rtde_protocol.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -17,11 +17,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (!make_output_recipe(own, kOutputVariables, recipe, error)) __builtin_trap();
   size_t at = 0;
   while (at < size) {
-    const FrameSplit split = split_frame(data + at, size - at);
-    if (split.status != SplitStatus::frame) break;  // truncated at the end, or malformed
+    const PackageSplit split = split_package(data + at, size - at);
+    if (split.status != SplitStatus::package) break;  // truncated at the end, or malformed
     if (split.consumed < kHeaderSize || split.consumed > size - at) __builtin_trap();
     at += split.consumed;
-    const Frame& frame = split.frame;
+    const Package& frame = split.package;
     bool accepted = false;
     ControllerVersion version;
     TextMessage text;

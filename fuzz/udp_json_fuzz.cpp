@@ -3,7 +3,7 @@
 // contract checked here: no crash or sanitizer report; a result is either ok with finite
 // joints, t_ns in 0..2^62 and speed_fraction NaN (absent) or in 0..1, non_finite with a
 // message naming q or qd, or an error message; never an exception.
-#include "hrcsense/udp_json.hpp"
+#include "hrcsense/net/udp_json.hpp"
 
 #include <cmath>
 #include <cstdlib>

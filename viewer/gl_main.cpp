@@ -17,8 +17,8 @@
 #include "common/app_errors.hpp"
 #include "common/run_session.hpp"
 
-#include "hrcsense/config.hpp"
-#include "hrcsense/io.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/io/io.hpp"
 
 #include <CLI/CLI.hpp>
 #include <GLFW/glfw3.h>

@@ -9,7 +9,7 @@
 #include "viewer/view_control.hpp"
 #include "viewer/view_model.hpp"
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 
 #include <array>
 #include <cstdint>

@@ -4,7 +4,7 @@
 
 #include "common/assembly.hpp"
 
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 #include "hrcsense/safety.hpp"
 
 #include <spdlog/spdlog.h>

@@ -4,7 +4,7 @@
 // frames (RunOptions::before_process), so the pipeline is never touched by two threads.
 #pragma once
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/pipeline.hpp"
 
 #include <cstdint>

@@ -2,7 +2,7 @@
 // hrcsense CLI — one-line error reports and the exit codes they map to.
 #include "common/app_errors.hpp"
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 
 #include <cstdio>
 

@@ -3,12 +3,12 @@
 // configuration.
 #include "common/assembly.hpp"
 
-#include "hrcsense/io.hpp"
-#include "hrcsense/link.hpp"
-#include "hrcsense/recordings.hpp"
-#include "hrcsense/rtde.hpp"
+#include "hrcsense/io/io.hpp"
+#include "hrcsense/net/link.hpp"
+#include "hrcsense/recordings/recordings.hpp"
+#include "hrcsense/net/rtde.hpp"
 #include "hrcsense/session.hpp"
-#include "hrcsense/udp_json.hpp"
+#include "hrcsense/net/udp_json.hpp"
 
 #if HRCSENSE_HAVE_DDS
 #include "dds/ros2_camera_source.hpp"

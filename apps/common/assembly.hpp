@@ -6,12 +6,12 @@
 #pragma once
 
 #include "hrcsense/clock.hpp"
-#include "hrcsense/config.hpp"
-#include "hrcsense/link.hpp"
-#include "hrcsense/rtde.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/net/link.hpp"
+#include "hrcsense/net/rtde.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/robot_state.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include "realsense/realsense_plan.hpp"
 

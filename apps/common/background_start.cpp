@@ -7,7 +7,7 @@
 #include "common/assembly.hpp"
 
 #include "hrcsense/filters.hpp"
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 #include <spdlog/spdlog.h>
 

@@ -5,7 +5,7 @@
 // "Commissioning a cell").
 #pragma once
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/source.hpp"
 

@@ -11,10 +11,10 @@
 #include "common/background_start.hpp"
 #include "common/follow_link_sink.hpp"
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/pipeline.hpp"
-#include "hrcsense/recorder.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/recordings/recorder.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <atomic>
 #include <cstdint>

@@ -4,7 +4,7 @@
 
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/safety.hpp"
-#include "hrcsense/sinks.hpp"
+#include "hrcsense/sinks/sinks.hpp"
 
 #include <spdlog/spdlog.h>
 

@@ -3,7 +3,7 @@
 // written result carries, which is what the controller link sends (a test and demo feature).
 #pragma once
 
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 #include "hrcsense/sink.hpp"
 
 #include <memory>

@@ -3,9 +3,9 @@
 // `hrcsense-view --record` share.
 #pragma once
 
-#include "hrcsense/config.hpp"
-#include "hrcsense/recorder.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/recordings/recorder.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <memory>
 #include <string>

@@ -13,8 +13,8 @@
 #include "common/tee_sink.hpp"
 #include "common/truth_labeller.hpp"
 
-#include "hrcsense/recorder.hpp"
-#include "hrcsense/sinks.hpp"
+#include "hrcsense/recordings/recorder.hpp"
+#include "hrcsense/sinks/sinks.hpp"
 
 #include <spdlog/spdlog.h>
 

@@ -5,7 +5,7 @@
 // viewer joins through the hooks; nothing here knows it.
 #pragma once
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/sink.hpp"
 

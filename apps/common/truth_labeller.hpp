@@ -4,7 +4,7 @@
 // (JsonLinesExtras::contact_label).
 #pragma once
 
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 #include "hrcsense/sink.hpp"
 #include "hrcsense/types.hpp"
 

@@ -8,7 +8,7 @@
 //   session 439041101 sequence 17 frame taken: run 1 (frame, reason no_foreground)
 //   nothing taken for 200 ms: stop 0 (timed_out, reason no_frame)
 // --datagrams N ends after N datagrams (0: never; SIGINT ends it).
-#include "hrcsense/link_receiver.hpp"
+#include "hrcsense/net/link_receiver.hpp"
 #include "hrcsense/safety.hpp"
 
 #include <arpa/inet.h>

@@ -6,7 +6,7 @@
 #include "commands.hpp"
 
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/safety.hpp"
 

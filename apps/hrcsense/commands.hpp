@@ -2,8 +2,8 @@
 // hrcsense CLI — the subcommands. Each returns the process exit code and logs to stderr.
 #pragma once
 
-#include "hrcsense/config.hpp"
-#include "hrcsense/recorder.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/recordings/recorder.hpp"
 
 #include <cstdint>
 #include <memory>

@@ -5,10 +5,10 @@
 
 #include "common/assembly.hpp"
 #include "hrcsense/camera.hpp"
-#include "hrcsense/config.hpp"
-#include "hrcsense/io.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/io/io.hpp"
 #include "hrcsense/pipeline.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 
 #include <algorithm>
 #include <cstdio>

@@ -6,7 +6,7 @@
 #include "common/app_errors.hpp"
 #include "common/assembly.hpp"
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 
 #if HRCSENSE_HAVE_DDS
 #include "dds/ros2_publisher.hpp"

@@ -6,8 +6,8 @@
 #include "common/cell.hpp"
 #include "common/record_setup.hpp"
 
-#include "hrcsense/config.hpp"
-#include "hrcsense/recorder.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/recordings/recorder.hpp"
 
 #include <spdlog/spdlog.h>
 

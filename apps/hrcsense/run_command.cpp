@@ -3,7 +3,7 @@
 #include "commands.hpp"
 #include "common/run_session.hpp"
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 
 namespace hrcsense::app {
 

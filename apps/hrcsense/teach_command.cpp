@@ -7,8 +7,8 @@
 #include "common/app_errors.hpp"
 #include "common/background_start.hpp"
 
-#include "hrcsense/config.hpp"
-#include "hrcsense/io.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/io/io.hpp"
 #include "hrcsense/pipeline.hpp"
 
 #include <spdlog/spdlog.h>

@@ -5,7 +5,7 @@
 
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/robot_state.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <stdexcept>
 #include <vector>

@@ -9,7 +9,7 @@
 #include "dds/ros2_publisher.hpp"
 
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 
 #include <benchmark/benchmark.h>
 

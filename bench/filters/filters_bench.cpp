@@ -10,7 +10,7 @@
 
 #include "tests/filters/reference.hpp"
 #include "hrcsense/filters.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <benchmark/benchmark.h>
 

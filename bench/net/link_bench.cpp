@@ -8,7 +8,7 @@
 // - Link/heartbeat_period: heartbeats at the default 20 Hz with no frames; the intervals
 //   between their arrivals against the nominal 50 ms (jitter p50, p99, max) and their mean.
 #include "../common/percentile.hpp"
-#include "hrcsense/link.hpp"
+#include "hrcsense/net/link.hpp"
 
 #include "hrcsense/clock.hpp"
 

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
-// The RTDE reader's per-package work: framing (split_frame) and decoding (parse_data_package) of
+// The RTDE reader's per-package work: framing (split_package) and decoding (parse_data_package) of
 // the data packages of hrcsense's output recipe (kOutputVariables: 180 bytes each), as a byte
 // stream of 64 packages is drained from the socket. Packages/s is the figure: a 500 Hz
 // controller needs 500 of them per second.
-#include "hrcsense/rtde.hpp"
+#include "src/net/rtde_protocol.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -62,7 +62,7 @@ std::vector<uint8_t> data_stream(int count) {
 void Rtde_parse_data(benchmark::State& state) {
   const rtde::OutputRecipe recipe = hrcsense_recipe();
   const std::vector<uint8_t> bytes = data_stream(1);
-  const rtde::Frame frame = rtde::split_frame(bytes.data(), bytes.size()).frame;
+  const rtde::Package frame = rtde::split_package(bytes.data(), bytes.size()).package;
   rtde::DataSample sample;
   std::string error;
   for (auto _ : state) {
@@ -85,9 +85,9 @@ void Rtde_split_and_parse(benchmark::State& state) {
     size_t at = 0;
     int parsed = 0;
     while (at < bytes.size()) {
-      const rtde::FrameSplit split = rtde::split_frame(bytes.data() + at, bytes.size() - at);
-      if (split.status != rtde::SplitStatus::frame) break;
-      parsed += rtde::parse_data_package(split.frame, recipe, sample, error) ? 1 : 0;
+      const rtde::PackageSplit split = rtde::split_package(bytes.data() + at, bytes.size() - at);
+      if (split.status != rtde::SplitStatus::package) break;
+      parsed += rtde::parse_data_package(split.package, recipe, sample, error) ? 1 : 0;
       at += split.consumed;
     }
     benchmark::DoNotOptimize(parsed);

@@ -4,7 +4,7 @@
 // nearest-point query from the robot point. The copy into PCL's cloud type is left out of the
 // timing (users of PCL would already hold one), which favours PCL.
 
-#include "hrcsense/person_cloud.hpp"
+#include "hrcsense/sim/person_cloud.hpp"
 
 #include <benchmark/benchmark.h>
 #include <pcl/kdtree/kdtree_flann.h>

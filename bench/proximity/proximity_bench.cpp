@@ -3,7 +3,7 @@
 // cloud of N points; Peer/nanoflann/point/N: nanoflann used directly; and the build and query
 // halves of the trees, for the crossover against brute force (docs/PROXIMITY.md).
 
-#include "hrcsense/person_cloud.hpp"
+#include "hrcsense/sim/person_cloud.hpp"
 
 #include "src/proximity/brute.hpp"
 #include "src/proximity/kdtree.hpp"

@@ -9,7 +9,7 @@
 #include "tests/support/bag_writer.hpp"
 #include "../common/thesis_scene.hpp"
 
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
-// Record/depth_color_<compression>/848x480: the production bag writer (hrcsense/bag_writer.hpp)
+// Record/depth_color_<compression>/848x480: the production bag writer (hrcsense/recordings/bag_writer.hpp)
 // writing config/cell-ur5.yaml's simulated 848x480 depth + rgb8 colour, with the SDK's metadata
 // and chunking, into a temp file; frames/s as items_per_second (DESIGN.md's budget: LZ4 ≥ 300).
 // Thirty distinct frames are rendered once and written in turn (rendering is the slow part);
 // a new file every 300 frames keeps the temp file small (its close, with the index, is timed too).
 
 #include "common/assembly.hpp"
-#include "hrcsense/bag_writer.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/recordings/bag_writer.hpp"
+#include "hrcsense/config/config.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -5,12 +5,12 @@
 // the self-filter and the arm's pose of each frame.
 
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/robot.hpp"
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/self_filter.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <benchmark/benchmark.h>
 

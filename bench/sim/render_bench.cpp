@@ -4,8 +4,8 @@
 // simulator source delivers it; Sim/render_depth/WxH without the colour camera.
 
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -2,7 +2,7 @@
 // The cost of flushing every JSON Lines line (R1): one frame line with a contact written to a
 // file (a write(2) per line) against the same line into memory (flush is a no-op there). The
 // difference is what the per-line flush costs; docs/BENCHMARKS.md puts it beside a frame's budget.
-#include "hrcsense/sinks.hpp"
+#include "hrcsense/sinks/sinks.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -8,7 +8,7 @@
 #include "viewer/view_tap.hpp"
 
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/pipeline.hpp"
 
 #include <benchmark/benchmark.h>

@@ -8,6 +8,7 @@
 #include "hrcsense/clock.hpp"
 #include "hrcsense/filters.hpp"
 #include "hrcsense/mailbox.hpp"
+#include "hrcsense/pipeline_params.hpp"
 #include "hrcsense/proximity.hpp"
 #include "hrcsense/robot.hpp"
 #include "hrcsense/robot_state.hpp"
@@ -32,35 +33,6 @@ class BackgroundMismatch : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
-
-/// Everything the processing path needs, already parsed (see config.hpp).
-struct PipelineParams {
-  FilterChainParams filters;  ///< depth filters run before segmentation; empty order: none
-  Pose T_base_camera = Pose::Identity();
-  RobotParams robot;  ///< the arm (capsules from each frame's robot state) or fixed points
-  BackgroundParams background;
-  ForegroundParams foreground;
-  /// The arm's own pixels (arms only; robot.model points have no body to render). The learner
-  /// masks them whatever self_filter.enabled says.
-  SelfFilterParams self_filter;
-  SafetyParams safety;
-  CellCheckParams checks;  ///< the image watchdogs (camera blocked or moved, robot envelope invalid)
-  ProximityBackend backend = ProximityBackend::brute;  ///< `proximity.backend`
-  ProximityParams proximity;  ///< octree height, brute threads
-};
-
-/// What may change while the cell runs, between two frames (hrcsense-view's panels): the
-/// filters' parameters, the foreground extraction and the search backend. Not the filter
-/// order nor the decimation (they set the resolution the background was learnt at), and never
-/// the safety distances, the robot or the camera pose: those need a new run.
-struct LiveTuning {
-  FilterChainParams filters;
-  ForegroundParams foreground;
-  ProximityBackend backend = ProximityBackend::brute;  ///< as PipelineParams::backend
-};
-
-/// The tunable part of `params`.
-LiveTuning tuning_of(const PipelineParams& params);
 
 /// The per-frame processing path: depth filters → background (and the camera checks) → robot
 /// capsules → self-filter → foreground → per-link proximity → unknown space → per-link v_i and

@@ -2,7 +2,7 @@
 // hrcsense config — the names of the closed choices (config.hpp): the one place each name is
 // spelt, for the reader (load_config turns a name into its enum) and for every message,
 // header and effective configuration that prints it.
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 
 namespace hrcsense {
 

@@ -2,7 +2,7 @@
 // hrcsense config internals — typed reading of dotted keys from the merged YAML tree.
 #pragma once
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 
 #include <yaml-cpp/yaml.h>
 

@@ -2,7 +2,7 @@
 // hrcsense config — `scene.objects`: simulated objects made of planes, boxes, spheres, capsules.
 #include "yaml_tree.hpp"
 
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <array>
 #include <cmath>

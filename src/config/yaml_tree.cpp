@@ -3,7 +3,7 @@
 // the field.
 #include "yaml_tree.hpp"
 
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 #include <yaml-cpp/eventhandler.h>
 

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 #include "io_fail.hpp"
 
 namespace hrcsense {

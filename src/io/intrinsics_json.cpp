@@ -15,7 +15,7 @@
 
 #include "hrcsense/camera.hpp"
 #include "io_fail.hpp"
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 #include "hrcsense/number_text.hpp"
 
 namespace hrcsense {

@@ -2,7 +2,7 @@
 // The io library's one way to report a bad file: an IoError naming the file (or field) first.
 #pragma once
 
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 #include <string>
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — JPEG colour images in and out with libturbojpeg (optional: without it, every call
 // is an IoError naming the file, and folders with JPEG colour still play their depth).
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 #include "io_fail.hpp"
 
 #include <cstdio>

@@ -11,7 +11,7 @@
 #include <memory>
 #include <string>
 
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 #include "io_fail.hpp"
 
 namespace hrcsense {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — "is this a file we can read?", asked before open(): opening a FIFO with no writer
 // blocks forever, a character device may never end, and a directory opens but fails on read.
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 #include <filesystem>
 #include <system_error>

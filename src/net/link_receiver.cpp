@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — LinkReceiver: session, sequence and timeout of the link's datagrams
 // (link_receiver.hpp has the rules, docs/SAFETY.md "Receiving" the why).
-#include "hrcsense/link_receiver.hpp"
+#include "hrcsense/net/link_receiver.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -2,7 +2,8 @@
 // hrcsense — the RTDE client's reader thread: connect, handshake, drain the socket into the
 // robot state history, reconnect with back-off. POSIX sockets; the library never prints, so
 // every problem goes into the stats (last_problem) and error().
-#include "hrcsense/rtde.hpp"
+#include "hrcsense/net/rtde.hpp"
+#include "rtde_protocol.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -222,12 +223,12 @@ namespace {
 // end of stream, a socket error, silence for longer than `timeout_ns`, a stop request or an
 // unframeable stream (`malformed` set).
 bool next_frame(int fd, std::vector<uint8_t>& buffer, size_t& begin, size_t& end, int64_t& last_byte_ns,
-                RunClock& clock, int64_t timeout_ns, const std::atomic<bool>& stop, rtde::Frame& frame,
+                RunClock& clock, int64_t timeout_ns, const std::atomic<bool>& stop, rtde::Package& frame,
                 std::string& error, bool& malformed) {
   while (!stop) {
-    const rtde::FrameSplit split = rtde::split_frame(buffer.data() + begin, end - begin);
-    if (split.status == rtde::SplitStatus::frame) {
-      frame = split.frame;
+    const rtde::PackageSplit split = rtde::split_package(buffer.data() + begin, end - begin);
+    if (split.status == rtde::SplitStatus::package) {
+      frame = split.package;
       begin += split.consumed;
       return true;
     }
@@ -281,7 +282,7 @@ bool next_frame(int fd, std::vector<uint8_t>& buffer, size_t& begin, size_t& end
 
 bool RtdeRobotState::handshake(Connection& c) {
   bool malformed = false;
-  rtde::Frame frame;
+  rtde::Package frame;
   const int64_t timeout_ns = to_ns(params_.receive_timeout_s);
   // The reply of type `type`, skipping text messages and anything else on the way.
   auto reply = [&](rtde::PackageType type) {
@@ -345,7 +346,7 @@ bool RtdeRobotState::session(Connection& c) {
     error_.clear();
   }
   bool malformed = false;
-  rtde::Frame frame;
+  rtde::Package frame;
   const int64_t timeout_ns = to_ns(params_.receive_timeout_s);
   while (next_frame(c.fd, c.buffer, c.begin, c.end, c.last_byte_ns, clock_, timeout_ns, stop_, frame, c.error,
                     malformed)) {
@@ -367,7 +368,7 @@ bool RtdeRobotState::session(Connection& c) {
   return true;
 }
 
-void RtdeRobotState::on_text(const rtde::Frame& frame) {
+void RtdeRobotState::on_text(const rtde::Package& frame) {
   rtde::TextMessage text;
   std::string error;
   const bool parsed = rtde::parse_text_message(frame, text, error);
@@ -381,7 +382,7 @@ void RtdeRobotState::on_text(const rtde::Frame& frame) {
   }
 }
 
-void RtdeRobotState::on_data(const rtde::Frame& frame, Connection& c) {
+void RtdeRobotState::on_data(const rtde::Package& frame, Connection& c) {
   rtde::DataSample data;
   std::string error;
   const bool parsed = rtde::parse_data_package(frame, c.recipe, data, error);

@@ -2,7 +2,8 @@
 // hrcsense — `link.rtde.write`: the verdict's speed scale written to a UR controller's RTDE
 // inputs (the speed slider, or a double register for a URScript) by a writer thread with its
 // own connection; frame() never touches the network (../shared/specs/ur-rtde.md, docs/SAFETY.md).
-#include "hrcsense/rtde.hpp"
+#include "hrcsense/net/rtde.hpp"
+#include "rtde_protocol.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -67,7 +68,7 @@ struct RtdeLinkSink::Connection {
 
   // Reads what is there (waiting at most `wait_ms`) and takes the next package into `frame`.
   // 1: a package; 0: none yet; -1: the connection ended (error, malformed set).
-  int next(rtde::Frame& frame, int wait_ms) {
+  int next(rtde::Package& frame, int wait_ms) {
     const int buffered = next_buffered(frame);
     if (buffered != 0) return buffered;
     if (begin > 0) {  // keep room for a read
@@ -98,10 +99,10 @@ struct RtdeLinkSink::Connection {
 
  private:
   // The next package already in the buffer: 1 taken, 0 none complete yet, -1 malformed.
-  int next_buffered(rtde::Frame& frame) {
-    const rtde::FrameSplit split = rtde::split_frame(buffer.data() + begin, end - begin);
-    if (split.status == rtde::SplitStatus::frame) {
-      frame = split.frame;
+  int next_buffered(rtde::Package& frame) {
+    const rtde::PackageSplit split = rtde::split_package(buffer.data() + begin, end - begin);
+    if (split.status == rtde::SplitStatus::package) {
+      frame = split.package;
       begin += split.consumed;
       return 1;
     }
@@ -243,7 +244,7 @@ bool RtdeLinkSink::connect_and_stream() {
 
 bool RtdeLinkSink::setup(Connection& c) {
   const int timeout_ms = static_cast<int>(std::lround(params_.receive_timeout_s * 1000.0));
-  rtde::Frame frame;
+  rtde::Package frame;
   // The reply of `type`, skipping text messages and other packages on the way, within the
   // receive timeout (real time).
   const auto reply = [&](rtde::PackageType type) {
@@ -320,7 +321,7 @@ bool RtdeLinkSink::write(Connection& c, double value, bool stop_value) {
 }
 
 bool RtdeLinkSink::drain(Connection& c) {
-  rtde::Frame frame;
+  rtde::Package frame;
   for (int k = 0; k < 64; ++k) {  // bounded: a controller that floods the link waits for the next look
     const int got = c.next(frame, 0);
     if (got <= 0) return got == 0;

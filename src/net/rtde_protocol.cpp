@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — RTDE packages: the client's, encoded, and the controller's, framed and parsed.
 // Pure functions over byte buffers; everything big-endian (../shared/specs/ur-rtde.md).
-#include "hrcsense/rtde.hpp"
+#include "hrcsense/net/rtde.hpp"
+#include "rtde_protocol.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -44,14 +45,14 @@ double get_f64(const uint8_t* p) {
 
 std::string name_of(uint8_t type) { return package_type_name(type); }
 
-bool expect_type(const Frame& frame, PackageType expected, std::string& error) {
+bool expect_type(const Package& frame, PackageType expected, std::string& error) {
   if (frame.type == static_cast<uint8_t>(expected)) return true;
   error = std::string(package_type_name(static_cast<uint8_t>(expected))) + ": got a " + name_of(frame.type) +
           " (type " + std::to_string(frame.type) + ") instead";
   return false;
 }
 
-bool expect_size(const Frame& frame, size_t size, const char* what, std::string& error) {
+bool expect_size(const Package& frame, size_t size, const char* what, std::string& error) {
   if (frame.payload_size == size) return true;
   error = name_of(frame.type) + ": payload of " + std::to_string(frame.payload_size) + " bytes, expected " +
           std::to_string(size) + " (" + what + ")";
@@ -135,8 +136,8 @@ std::vector<uint8_t> encode_setup_outputs(double frequency_hz, const std::string
 std::vector<uint8_t> encode_start() { return package(PackageType::start, 0); }
 std::vector<uint8_t> encode_pause() { return package(PackageType::pause, 0); }
 
-FrameSplit split_frame(const uint8_t* data, size_t size) {
-  FrameSplit out;
+PackageSplit split_package(const uint8_t* data, size_t size) {
+  PackageSplit out;
   if (size < kHeaderSize) return out;  // need_more
   const size_t package_size = (size_t{data[0]} << 8) | data[1];
   if (package_size < kHeaderSize) {
@@ -146,19 +147,19 @@ FrameSplit split_frame(const uint8_t* data, size_t size) {
     return out;
   }
   if (package_size > size) return out;  // truncated so far: need_more
-  out.status = SplitStatus::frame;
-  out.frame = Frame{data[2], data + kHeaderSize, package_size - kHeaderSize};
+  out.status = SplitStatus::package;
+  out.package = Package{data[2], data + kHeaderSize, package_size - kHeaderSize};
   out.consumed = package_size;
   return out;
 }
 
-bool parse_accepted(const Frame& frame, PackageType expected, bool& accepted, std::string& error) {
+bool parse_accepted(const Package& frame, PackageType expected, bool& accepted, std::string& error) {
   if (!expect_type(frame, expected, error) || !expect_size(frame, 1, "uint8 accepted", error)) return false;
   accepted = frame.payload[0] != 0;
   return true;
 }
 
-bool parse_controller_version(const Frame& frame, ControllerVersion& out, std::string& error) {
+bool parse_controller_version(const Package& frame, ControllerVersion& out, std::string& error) {
   if (!expect_type(frame, PackageType::get_urcontrol_version, error) ||
       !expect_size(frame, 16, "uint32 major, minor, bugfix, build", error)) {
     return false;
@@ -168,7 +169,7 @@ bool parse_controller_version(const Frame& frame, ControllerVersion& out, std::s
   return true;
 }
 
-bool parse_text_message(const Frame& frame, TextMessage& out, std::string& error) {
+bool parse_text_message(const Package& frame, TextMessage& out, std::string& error) {
   if (!expect_type(frame, PackageType::text_message, error)) return false;
   const uint8_t* p = frame.payload;
   const size_t n = frame.payload_size;
@@ -189,7 +190,7 @@ bool parse_text_message(const Frame& frame, TextMessage& out, std::string& error
   return true;
 }
 
-bool parse_setup_reply(const Frame& frame, PackageType expected, SetupReply& out, std::string& error) {
+bool parse_setup_reply(const Package& frame, PackageType expected, SetupReply& out, std::string& error) {
   if (!expect_type(frame, expected, error)) return false;
   if (frame.payload_size < 1) {
     error = name_of(frame.type) + ": empty reply (no recipe id)";
@@ -237,7 +238,7 @@ bool make_output_recipe(const SetupReply& reply, const std::string& names, Outpu
   return true;
 }
 
-bool parse_data_package(const Frame& frame, const OutputRecipe& recipe, DataSample& out, std::string& error) {
+bool parse_data_package(const Package& frame, const OutputRecipe& recipe, DataSample& out, std::string& error) {
   if (!expect_type(frame, PackageType::data, error)) return false;
   if (frame.payload_size < 1) {
     error = "DATA_PACKAGE: empty (no recipe id)";

@@ -8,7 +8,7 @@
 // Python's NaN / Infinity tokens in q and qd so that a sender reporting a non-finite joint is
 // counted by the history as non-finite rather than as garbage, and (e) allocate nothing on a
 // good datagram. It accepts a strict subset of JSON: keys without escapes, nothing nested.
-#include "hrcsense/udp_json.hpp"
+#include "hrcsense/net/udp_json.hpp"
 
 #include <algorithm>
 #include <charconv>

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — UdpJsonRobotState: the socket that receives udp_json datagrams, and the robot states they give.
 
-#include "hrcsense/udp_json.hpp"
+#include "hrcsense/net/udp_json.hpp"
 
 #include <arpa/inet.h>
 #include <fcntl.h>

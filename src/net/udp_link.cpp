@@ -4,11 +4,11 @@
 //
 // Bytes are written and read one at a time by shifts, so the layout is little-endian whatever
 // the host's byte order, and nothing depends on struct packing.
-#include "hrcsense/link.hpp"
+#include "hrcsense/net/link.hpp"
 
 #include "hrcsense/safety.hpp"
 #include "hrcsense/session.hpp"
-#include "hrcsense/sinks.hpp"
+#include "hrcsense/sinks/sinks.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>

@@ -2,9 +2,9 @@
 // hrcsense — the SDK's topics and messages in a bag: classification and ROS1 deserialisation.
 #include "bag_messages.hpp"
 
-#include "hrcsense/bag_writer.hpp"
+#include "hrcsense/recordings/bag_writer.hpp"
 #include "hrcsense/camera.hpp"
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 #include <array>
 #include <cmath>

@@ -2,7 +2,7 @@
 // hrcsense — ROS bag 2.0 records: header fields, chunks (none / lz4 frame / bz2), the index.
 #include "bag_reader.hpp"
 
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 #include <bzlib.h>
 #include <lz4frame.h>

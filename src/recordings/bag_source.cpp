@@ -4,8 +4,8 @@
 #include "bag_reader.hpp"
 #include "recorded_robot_state.hpp"
 
-#include "hrcsense/io.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/io/io.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 
 #include <cmath>
 #include <cstring>

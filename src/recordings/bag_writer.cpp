@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — the RealSense .bag writer (ROS bag 2.0, ../shared/specs/realsense-bag-format.md).
-#include "hrcsense/bag_writer.hpp"
+#include "hrcsense/recordings/bag_writer.hpp"
 
 #include "hrcsense/camera.hpp"
 

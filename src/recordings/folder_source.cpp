@@ -3,8 +3,8 @@
 #include "bag_messages.hpp"
 
 #include "hrcsense/camera.hpp"
-#include "hrcsense/io.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/io/io.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 
 #include <algorithm>
 #include <cctype>

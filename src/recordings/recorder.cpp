@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — the recorder's writer thread and bounded queue.
-#include "hrcsense/recorder.hpp"
+#include "hrcsense/recordings/recorder.hpp"
 
 #include <algorithm>
 #include <chrono>

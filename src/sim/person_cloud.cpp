@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — the synthetic person-shaped cloud and the robots beside it (person_cloud.hpp).
 
-#include "hrcsense/person_cloud.hpp"
+#include "hrcsense/sim/person_cloud.hpp"
 
 #include <algorithm>
 #include <cmath>

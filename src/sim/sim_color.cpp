@@ -3,7 +3,7 @@
 
 #include "sim_color.hpp"
 
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <cstring>
 

@@ -2,7 +2,7 @@
 // hrcsense — the simulator's geometry: ray/shape intersections and analytic closest points.
 #pragma once
 
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 #include "hrcsense/types.hpp"
 
 #include <cmath>

@@ -2,7 +2,7 @@
 // hrcsense — the simulator's ray caster: the nearest shape per pixel of a camera.
 #pragma once
 
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 #include "hrcsense/types.hpp"
 
 #include <cstdint>

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — `robot.state.source: sim`: the simulator's scripted arm as a robot state source,
 // exact or delivered late with a seeded jitter through a RobotStateHistory.
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <algorithm>
 #include <cmath>

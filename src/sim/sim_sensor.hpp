@@ -2,7 +2,7 @@
 // hrcsense — the simulated D435's sensor: true depth in, raw Z16 with stereo artefacts out.
 #pragma once
 
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 #include "hrcsense/types.hpp"
 
 #include <cstdint>

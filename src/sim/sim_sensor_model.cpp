@@ -3,7 +3,7 @@
 // structured-light camera, as values of SimParams (docs/SIMULATOR.md, "Sensor models").
 
 #include "hrcsense/camera.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <array>
 

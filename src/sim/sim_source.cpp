@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — the simulator as a Source: frames 0 .. frames-1, then the end.
 
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <cmath>
 #include <string>

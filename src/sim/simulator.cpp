@@ -2,7 +2,7 @@
 // hrcsense — the simulated D435: places the scene's objects for a frame, casts the depth and
 // colour cameras' rays, applies the sensor model and computes the ground truth.
 
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 #include "sim_color.hpp"
 #include "sim_geometry.hpp"
 #include "sim_raycast.hpp"

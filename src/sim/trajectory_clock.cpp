@@ -3,7 +3,7 @@
 // speed scale hrcsense last sent, so that the rendered arm, the `sim` robot state and the
 // truth all see a robot that obeys the link (a closed loop for tests and demos).
 
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense sinks — JSON Lines: a header, one line per frame, a summary (docs/OUTPUT.md).
 // Lines are composed by hand into a reused string so that writing a frame does not allocate.
-#include "hrcsense/sinks.hpp"
+#include "hrcsense/sinks/sinks.hpp"
+
+#include "hrcsense/safety.hpp"
 
 #include "hrcsense/camera.hpp"
 #include "hrcsense/robot_state.hpp"

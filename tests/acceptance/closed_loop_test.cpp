@@ -12,10 +12,10 @@
 
 #include "../support/scenes.hpp"
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/safety.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <gtest/gtest.h>
 

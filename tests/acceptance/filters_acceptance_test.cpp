@@ -11,7 +11,7 @@
 #include "common/assembly.hpp"
 #include "hrcsense/camera.hpp"
 #include "hrcsense/robot_state.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/pipeline.hpp"
 
 #include <gtest/gtest.h>

@@ -13,10 +13,10 @@
 
 #include "../support/decide.hpp"
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/filters.hpp"
 #include "hrcsense/pipeline.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <gtest/gtest.h>
 

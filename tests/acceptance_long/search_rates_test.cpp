@@ -7,7 +7,7 @@
 // only, under the ctest label `long`.
 
 #include "../support/run_cli.hpp"
-#include "hrcsense/person_cloud.hpp"
+#include "hrcsense/sim/person_cloud.hpp"
 
 #include <gtest/gtest.h>
 

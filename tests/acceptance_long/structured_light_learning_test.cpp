@@ -14,8 +14,8 @@
 
 #include "../support/scenes.hpp"
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

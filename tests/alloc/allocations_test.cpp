@@ -9,7 +9,7 @@
 // tests: a replacement in a family binary would count (and could disturb) all of them.
 #include "../support/scenes.hpp"
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/safety.hpp"

@@ -5,7 +5,7 @@
 #include "../support/child_process.hpp"
 #include "../support/cli_folder.hpp"
 #include "../support/sanitized.hpp"
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -6,7 +6,7 @@
 // from frame 0 to frame 20.
 #include "../support/cli_folder.hpp"
 
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -5,7 +5,7 @@
 // spells the same name again, so that it reloads as the same choice with the same hash.
 #include "config_test_util.hpp"
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // Helpers for the config tests: a temporary folder and ConfigError expectations.
 #pragma once
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 // names, and sim.* keys given beside it overriding the preset's values.
 #include "config_test_util.hpp"
 
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <gtest/gtest.h>
 

@@ -4,7 +4,7 @@
 // in both with the same message; what is read interpolates as worked out by hand below.
 #include "config_test_util.hpp"
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/robot.hpp"
 
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The source.ros2.* and publish.* keys: defaults as docs/CONFIG.md says, bounds, ROS 2 names,
 // and topics overridden one by one (make_source's mapping, through a source that cannot start).
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 
 #include <gtest/gtest.h>
 

@@ -10,8 +10,8 @@
 #include "dds_test_util.hpp"
 
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 
 #include <gtest/gtest.h>
 

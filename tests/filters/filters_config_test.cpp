@@ -2,7 +2,7 @@
 // The filter keys of the configuration (filters.preset, filters.order, filters.<block>.<option>)
 // with the SDK's ranges, and the chain's per-block timings in Pipeline::process.
 #include "../support/decide.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "preset_expectations.hpp"

@@ -5,7 +5,7 @@
 // the file lists for it. A golden value changed on purpose must be found where it was changed,
 // and `hrcsense verify-filters` must still print its lines and exit codes as before.
 #include "hrcsense/eval/goldens.hpp"
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

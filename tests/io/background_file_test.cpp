@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 namespace hrcsense {
 namespace {

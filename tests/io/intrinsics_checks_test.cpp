@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 namespace hrcsense {
 namespace {

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "hrcsense/camera.hpp"
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 namespace hrcsense {
 namespace {

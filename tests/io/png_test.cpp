@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 namespace hrcsense {
 namespace {

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "../support/no_block.hpp"
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 namespace hrcsense {
 namespace {

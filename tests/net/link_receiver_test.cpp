@@ -4,7 +4,7 @@
 // version 2 table (with a CRC-32 computed bit by bit here, not by the library); then the example
 // program, and a kill -9 and restart of the real `hrcsense run` on loopback (127.0.0.1,
 // ephemeral ports, every wait bounded).
-#include "hrcsense/link_receiver.hpp"
+#include "hrcsense/net/link_receiver.hpp"
 
 #include "../support/child_process.hpp"
 #include "../support/loopback.hpp"

@@ -12,7 +12,7 @@
 
 #include "../pipeline/fake_scene.hpp"
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/proximity.hpp"
 
 #include <gtest/gtest.h>

@@ -5,8 +5,8 @@
 #include "rtde_rig.hpp"
 
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
-#include "hrcsense/rtde.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/net/rtde.hpp"
 
 #include <gtest/gtest.h>
 

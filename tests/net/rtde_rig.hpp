@@ -5,7 +5,7 @@
 
 #include "fake_rtde_controller.hpp"
 
-#include "hrcsense/rtde.hpp"
+#include "hrcsense/net/rtde.hpp"
 
 #include <atomic>
 #include <chrono>

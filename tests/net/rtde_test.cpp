@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // RTDE protocol functions against the worked bytes of ../shared/specs/ur-rtde.md and against
 // packages built here by hand, byte by byte.
-#include "hrcsense/rtde.hpp"
+#include "src/net/rtde_protocol.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,11 +14,11 @@ namespace {
 
 using Bytes = std::vector<uint8_t>;
 
-Frame only_frame(const Bytes& bytes) {
-  const FrameSplit split = split_frame(bytes.data(), bytes.size());
-  EXPECT_EQ(split.status, SplitStatus::frame) << split.error;
+Package only_package(const Bytes& bytes) {
+  const PackageSplit split = split_package(bytes.data(), bytes.size());
+  EXPECT_EQ(split.status, SplitStatus::package) << split.error;
   EXPECT_EQ(split.consumed, bytes.size());
-  return split.frame;
+  return split.package;
 }
 
 // Big-endian IEEE-754, written out here for the hand-built packages.
@@ -50,16 +50,16 @@ TEST(RtdeEncode, SetupOutputsHasFrequencyThenNames) {
 TEST(RtdeParse, SpecRepliesAccepted) {
   bool accepted = false;
   std::string error;
-  EXPECT_TRUE(parse_accepted(only_frame({0x00, 0x04, 0x56, 0x01}), PackageType::request_protocol_version, accepted,
+  EXPECT_TRUE(parse_accepted(only_package({0x00, 0x04, 0x56, 0x01}), PackageType::request_protocol_version, accepted,
                              error));
   EXPECT_TRUE(accepted);
   accepted = false;
-  EXPECT_TRUE(parse_accepted(only_frame({0x00, 0x04, 0x53, 0x01}), PackageType::start, accepted, error));
+  EXPECT_TRUE(parse_accepted(only_package({0x00, 0x04, 0x53, 0x01}), PackageType::start, accepted, error));
   EXPECT_TRUE(accepted);
   accepted = false;
-  EXPECT_TRUE(parse_accepted(only_frame({0x00, 0x04, 0x50, 0x01}), PackageType::pause, accepted, error));
+  EXPECT_TRUE(parse_accepted(only_package({0x00, 0x04, 0x50, 0x01}), PackageType::pause, accepted, error));
   EXPECT_TRUE(accepted);
-  EXPECT_TRUE(parse_accepted(only_frame({0x00, 0x04, 0x56, 0x00}), PackageType::request_protocol_version, accepted,
+  EXPECT_TRUE(parse_accepted(only_package({0x00, 0x04, 0x56, 0x00}), PackageType::request_protocol_version, accepted,
                              error));
   EXPECT_FALSE(accepted);
 }
@@ -68,7 +68,7 @@ TEST(RtdeParse, SpecControllerVersion) {
   ControllerVersion v;
   std::string error;
   ASSERT_TRUE(parse_controller_version(
-      only_frame({0x00, 0x13, 0x76, 0, 0, 0, 5, 0, 0, 0, 8, 0, 0, 0, 0, 0, 0, 0, 0}), v, error))
+      only_package({0x00, 0x13, 0x76, 0, 0, 0, 5, 0, 0, 0, 8, 0, 0, 0, 0, 0, 0, 0, 0}), v, error))
       << error;
   EXPECT_EQ(v.major, 5U);
   EXPECT_EQ(v.minor, 8U);
@@ -79,7 +79,7 @@ TEST(RtdeParse, SpecControllerVersion) {
 TEST(RtdeParse, SpecInputSetupReply) {
   SetupReply reply;
   std::string error;
-  ASSERT_TRUE(parse_setup_reply(only_frame({0x00, 0x11, 0x49, 0x01, 0x55, 0x49, 0x4E, 0x54, 0x33, 0x32, 0x2C, 0x44,
+  ASSERT_TRUE(parse_setup_reply(only_package({0x00, 0x11, 0x49, 0x01, 0x55, 0x49, 0x4E, 0x54, 0x33, 0x32, 0x2C, 0x44,
                                             0x4F, 0x55, 0x42, 0x4C, 0x45}),
                                 PackageType::setup_inputs, reply, error))
       << error;
@@ -97,7 +97,7 @@ TEST(RtdeParse, SpecDataPackage) {
   std::string error;
   ASSERT_TRUE(make_output_recipe(reply, "timestamp,target_speed_fraction", recipe, error)) << error;
   DataSample sample;
-  ASSERT_TRUE(parse_data_package(only_frame({0x00, 0x14, 0x55, 0x01, 0x40, 0xD0, 0x07, 0x0D, 0x2F, 0x1A, 0x9F, 0xBE,
+  ASSERT_TRUE(parse_data_package(only_package({0x00, 0x14, 0x55, 0x01, 0x40, 0xD0, 0x07, 0x0D, 0x2F, 0x1A, 0x9F, 0xBE,
                                              0x3F, 0xF0, 0, 0, 0, 0, 0, 0}),
                                  recipe, sample, error))
       << error;
@@ -127,7 +127,7 @@ TEST(RtdeParse, OwnRecipeDataPackage) {
   b[0] = static_cast<uint8_t>(b.size() >> 8);
   b[1] = static_cast<uint8_t>(b.size() & 0xFF);
   DataSample s;
-  ASSERT_TRUE(parse_data_package(only_frame(b), recipe, s, error)) << error;
+  ASSERT_TRUE(parse_data_package(only_package(b), recipe, s, error)) << error;
   EXPECT_EQ(s.timestamp_s, 12.5);
   for (int j = 0; j < 6; ++j) {
     EXPECT_EQ(s.q[j], 0.25 * j - 1.0);
@@ -142,12 +142,12 @@ TEST(RtdeParse, OwnRecipeDataPackage) {
   // Another recipe id, or 8 bytes the recipe does not explain: rejected, naming the package.
   Bytes wrong_id = b;
   wrong_id[3] = 7;
-  EXPECT_FALSE(parse_data_package(only_frame(wrong_id), recipe, s, error));
+  EXPECT_FALSE(parse_data_package(only_package(wrong_id), recipe, s, error));
   EXPECT_NE(error.find("DATA_PACKAGE: recipe id 7, expected 4"), std::string::npos) << error;
   Bytes oversized = b;
   oversized.insert(oversized.end(), 8, 0);
   oversized[1] = static_cast<uint8_t>(oversized[1] + 8);
-  EXPECT_FALSE(parse_data_package(only_frame(oversized), recipe, s, error));
+  EXPECT_FALSE(parse_data_package(only_package(oversized), recipe, s, error));
   EXPECT_NE(error.find("DATA_PACKAGE: payload of 185 bytes, expected 177"), std::string::npos) << error;
 }
 
@@ -168,18 +168,18 @@ TEST(RtdeParse, RecipeProblemsNameTheVariable) {
 
 TEST(RtdeSplit, TruncatedWaitsShortSizeIsMalformedUnknownIsSkippedBySize) {
   const Bytes two{0x00, 0x04, 0x56, 0x01, 0x00, 0x08, 0x58, 1, 2, 3, 4, 5};  // V, then type 'X' (unknown)
-  FrameSplit split = split_frame(two.data(), two.size());
-  ASSERT_EQ(split.status, SplitStatus::frame);
+  PackageSplit split = split_package(two.data(), two.size());
+  ASSERT_EQ(split.status, SplitStatus::package);
   EXPECT_EQ(split.consumed, 4U);
-  split = split_frame(two.data() + 4, two.size() - 4);
-  ASSERT_EQ(split.status, SplitStatus::frame);
-  EXPECT_EQ(split.frame.type, 0x58);
-  EXPECT_EQ(split.frame.payload_size, 5U);
-  EXPECT_STREQ(package_type_name(split.frame.type), "unknown package type");
-  EXPECT_EQ(split_frame(two.data(), 2).status, SplitStatus::need_more);         // less than a header
-  EXPECT_EQ(split_frame(two.data() + 4, 7).status, SplitStatus::need_more);     // 7 of 8 bytes
+  split = split_package(two.data() + 4, two.size() - 4);
+  ASSERT_EQ(split.status, SplitStatus::package);
+  EXPECT_EQ(split.package.type, 0x58);
+  EXPECT_EQ(split.package.payload_size, 5U);
+  EXPECT_STREQ(package_type_name(split.package.type), "unknown package type");
+  EXPECT_EQ(split_package(two.data(), 2).status, SplitStatus::need_more);         // less than a header
+  EXPECT_EQ(split_package(two.data() + 4, 7).status, SplitStatus::need_more);     // 7 of 8 bytes
   const Bytes short_size{0x00, 0x02, 0x55};
-  split = split_frame(short_size.data(), short_size.size());
+  split = split_package(short_size.data(), short_size.size());
   EXPECT_EQ(split.status, SplitStatus::malformed);
   EXPECT_NE(split.error.find("package size 2"), std::string::npos) << split.error;
 }
@@ -189,23 +189,23 @@ TEST(RtdeParse, PayloadsTheTypeDoesNotExplainAreErrorsNamingThePackage) {
   ControllerVersion v;
   TextMessage text;
   std::string error;
-  EXPECT_FALSE(parse_accepted(only_frame({0x00, 0x05, 0x56, 0x01, 0x00}), PackageType::request_protocol_version,
+  EXPECT_FALSE(parse_accepted(only_package({0x00, 0x05, 0x56, 0x01, 0x00}), PackageType::request_protocol_version,
                               accepted, error));
   EXPECT_NE(error.find("REQUEST_PROTOCOL_VERSION: payload of 2 bytes, expected 1"), std::string::npos) << error;
-  EXPECT_FALSE(parse_accepted(only_frame({0x00, 0x04, 0x53, 0x01}), PackageType::pause, accepted, error));
+  EXPECT_FALSE(parse_accepted(only_package({0x00, 0x04, 0x53, 0x01}), PackageType::pause, accepted, error));
   EXPECT_NE(error.find("CONTROL_PACKAGE_PAUSE: got a CONTROL_PACKAGE_START"), std::string::npos) << error;
-  EXPECT_FALSE(parse_controller_version(only_frame({0x00, 0x07, 0x76, 0, 0, 0, 5}), v, error));
+  EXPECT_FALSE(parse_controller_version(only_package({0x00, 0x07, 0x76, 0, 0, 0, 5}), v, error));
   EXPECT_NE(error.find("GET_URCONTROL_VERSION: payload of 4 bytes, expected 16"), std::string::npos) << error;
   // Text: message "abc", source "fake", level 3 (info); then a message length past the end.
-  ASSERT_TRUE(parse_text_message(only_frame({0x00, 0x0D, 0x4D, 3, 'a', 'b', 'c', 4, 'f', 'a', 'k', 'e', 3}), text,
+  ASSERT_TRUE(parse_text_message(only_package({0x00, 0x0D, 0x4D, 3, 'a', 'b', 'c', 4, 'f', 'a', 'k', 'e', 3}), text,
                                  error))
       << error;
   EXPECT_EQ(text.message, "abc");
   EXPECT_EQ(text.source, "fake");
   EXPECT_EQ(text.level, 3);
-  EXPECT_FALSE(parse_text_message(only_frame({0x00, 0x06, 0x4D, 9, 'a', 'b'}), text, error));
+  EXPECT_FALSE(parse_text_message(only_package({0x00, 0x06, 0x4D, 9, 'a', 'b'}), text, error));
   EXPECT_NE(error.find("TEXT_MESSAGE: message runs past"), std::string::npos) << error;
-  EXPECT_FALSE(parse_text_message(only_frame({0x00, 0x08, 0x4D, 1, 'a', 0, 3, 9}), text, error));
+  EXPECT_FALSE(parse_text_message(only_package({0x00, 0x08, 0x4D, 1, 'a', 0, 3, 9}), text, error));
   EXPECT_NE(error.find("TEXT_MESSAGE: payload of 5 bytes, expected 4"), std::string::npos) << error;
 }
 

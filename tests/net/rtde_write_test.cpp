@@ -8,7 +8,7 @@
 #include "fake_rtde_controller.hpp"
 
 #include "hrcsense/clock.hpp"
-#include "hrcsense/rtde.hpp"
+#include "src/net/rtde_protocol.hpp"
 
 #include <gtest/gtest.h>
 
@@ -91,11 +91,11 @@ TEST(RtdeWriteEncode, InputSetupRepliesAreCheckedNamingTheInput) {
   // The spec's worked reply: recipe 1, "UINT32,DOUBLE".
   const std::vector<uint8_t> bytes = {0x00, 0x11, 0x49, 0x01, 0x55, 0x49, 0x4E, 0x54, 0x33,
                                       0x32, 0x2C, 0x44, 0x4F, 0x55, 0x42, 0x4C, 0x45};
-  const rtde::FrameSplit split = rtde::split_frame(bytes.data(), bytes.size());
-  ASSERT_EQ(split.status, rtde::SplitStatus::frame);
+  const rtde::PackageSplit split = rtde::split_package(bytes.data(), bytes.size());
+  ASSERT_EQ(split.status, rtde::SplitStatus::package);
   rtde::SetupReply reply;
   std::string error;
-  ASSERT_TRUE(rtde::parse_setup_reply(split.frame, rtde::PackageType::setup_inputs, reply, error)) << error;
+  ASSERT_TRUE(rtde::parse_setup_reply(split.package, rtde::PackageType::setup_inputs, reply, error)) << error;
   const std::string slider = "speed_slider_mask,speed_slider_fraction";
   EXPECT_TRUE(rtde::check_input_setup(reply, slider, {"UINT32", "DOUBLE"}, error)) << error;
 

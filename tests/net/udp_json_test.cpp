@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // udp_json: the datagram parser (good and malformed datagrams, messages worked out by hand) and
 // the robot state source fed by a sender socket in this process over loopback, on a fake clock.
-#include "hrcsense/udp_json.hpp"
+#include "hrcsense/net/udp_json.hpp"
 
 #include "../support/loopback.hpp"
 #include "../support/units.hpp"
@@ -9,7 +9,7 @@
 
 #include "common/assembly.hpp"
 #include "hrcsense/clock.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>

@@ -4,12 +4,12 @@
 // against every kind of damage and against version 1, and UdpLinkSink against a receiver socket
 // in this process on 127.0.0.1 (ephemeral ports, every wait bounded), on a fake clock; then
 // `hrcsense run` with the link on.
-#include "hrcsense/link.hpp"
+#include "hrcsense/net/link.hpp"
 
 #include "hrcsense/clock.hpp"
 #include "hrcsense/safety.hpp"
 #include "hrcsense/session.hpp"
-#include "hrcsense/sinks.hpp"
+#include "hrcsense/sinks/sinks.hpp"
 
 #include "../support/loopback.hpp"
 #include "../support/units.hpp"

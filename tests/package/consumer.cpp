@@ -5,11 +5,11 @@
 // sqrt(1 + 0.09) - 0.1 = 0.944 from it. The closest contact is point 0 at 0.4 m.
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/proximity.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 #ifdef CONSUMER_WITH_APPS
-#include "hrcsense/config.hpp"
-#include "hrcsense/recordings.hpp"
-#include "hrcsense/sinks.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/recordings/recordings.hpp"
+#include "hrcsense/sinks/sinks.hpp"
 #endif
 
 #include <algorithm>

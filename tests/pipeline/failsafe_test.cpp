@@ -6,7 +6,7 @@
 #include "../support/decide.hpp"
 #include "fake_scene.hpp"
 
-#include "hrcsense/sinks.hpp"
+#include "hrcsense/sinks/sinks.hpp"
 #include "hrcsense/robot_state.hpp"
 
 #include <gtest/gtest.h>

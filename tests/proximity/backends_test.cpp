@@ -4,7 +4,7 @@
 
 #include "../support/decide.hpp"
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/proximity.hpp"

@@ -6,8 +6,8 @@
 // itself is the manual check of docs/CAMERAS.md.
 #include "realsense/realsense_plan.hpp"
 
-#include "hrcsense/bag_writer.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/recordings/bag_writer.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 
 #include <gtest/gtest.h>
 

@@ -5,7 +5,7 @@
 #include "recordings_test_util.hpp"
 #include "../support/run_cli.hpp"
 
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 #include "src/recordings/bag_reader.hpp"
 
 #include <gtest/gtest.h>

@@ -3,8 +3,8 @@
 // damaged (truncated, corrupted chunk, wrong magic, unknown compression).
 #include "recordings_test_util.hpp"
 
-#include "hrcsense/io.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/io/io.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 
 #include <gtest/gtest.h>
 

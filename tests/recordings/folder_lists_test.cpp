@@ -4,8 +4,8 @@
 // line holds; timestamps that are not plain seconds are malformed lines too.
 #include "recordings_test_util.hpp"
 
-#include "hrcsense/io.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/io/io.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 
 #include <gtest/gtest.h>
 

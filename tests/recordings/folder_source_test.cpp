@@ -2,9 +2,9 @@
 // FolderSource: the datasets' layout and TUM's, intrinsics conventions, damaged folders.
 #include "recordings_test_util.hpp"
 
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 #include "hrcsense/robot_state.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 
 #include <gtest/gtest.h>
 

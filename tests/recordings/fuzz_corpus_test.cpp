@@ -5,7 +5,7 @@
 #include "fuzz/fuzz_entries.hpp"
 #include "recordings_test_util.hpp"
 
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 #include <gtest/gtest.h>
 

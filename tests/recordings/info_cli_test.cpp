@@ -3,7 +3,7 @@
 #include "recordings_test_util.hpp"
 #include "../support/run_cli.hpp"
 
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 #include <gtest/gtest.h>
 

@@ -6,9 +6,9 @@
 // (ROS1: little-endian, uint32 length prefixes), independently of the writer. No ../shared data.
 #include "recordings_test_util.hpp"
 
-#include "hrcsense/bag_writer.hpp"
-#include "hrcsense/io.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/recordings/bag_writer.hpp"
+#include "hrcsense/io/io.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 #include "src/recordings/bag_messages.hpp"
 #include "src/recordings/bag_reader.hpp"
 

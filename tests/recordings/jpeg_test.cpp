@@ -3,8 +3,8 @@
 // how FolderSource finds each depth frame's colour image (frames.txt, rgb/, TUM rgb.txt).
 #include "recordings_test_util.hpp"
 
-#include "hrcsense/io.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/io/io.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 
 #include <gtest/gtest.h>
 

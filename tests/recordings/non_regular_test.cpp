@@ -6,8 +6,8 @@
 #include "../support/no_block.hpp"
 #include "../support/run_cli.hpp"
 
-#include "hrcsense/io.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/io/io.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 
 #include <gtest/gtest.h>
 

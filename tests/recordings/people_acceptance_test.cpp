@@ -6,10 +6,10 @@
 #include "recordings_test_util.hpp"
 
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/robot_state.hpp"
-#include "hrcsense/io.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/io/io.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 
 #include <gtest/gtest.h>
 

@@ -6,8 +6,8 @@
 #include "recordings_test_util.hpp"
 
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 #include "src/recordings/bag_messages.hpp"
 #include "src/recordings/bag_reader.hpp"
 

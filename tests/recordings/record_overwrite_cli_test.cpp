@@ -6,7 +6,7 @@
 #include "recordings_test_util.hpp"
 
 #include "../support/run_cli.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 
 #include <gtest/gtest.h>
 

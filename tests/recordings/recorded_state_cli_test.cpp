@@ -9,9 +9,9 @@
 #include "../support/scenes.hpp"
 #include "recordings_test_util.hpp"
 
-#include "hrcsense/bag_writer.hpp"
-#include "hrcsense/config.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/recordings/bag_writer.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/sim/sim.hpp"
 #include "src/recordings/bag_messages.hpp"
 #include "src/recordings/bag_reader.hpp"
 #include "../support/run_cli.hpp"

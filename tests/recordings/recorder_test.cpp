@@ -7,11 +7,11 @@
 #include "recordings_test_util.hpp"
 
 #include "common/assembly.hpp"
-#include "hrcsense/bag_writer.hpp"
-#include "hrcsense/config.hpp"
-#include "hrcsense/io.hpp"
-#include "hrcsense/recorder.hpp"
-#include "hrcsense/recordings.hpp"
+#include "hrcsense/recordings/bag_writer.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/io/io.hpp"
+#include "hrcsense/recordings/recorder.hpp"
+#include "hrcsense/recordings/recordings.hpp"
 #include "src/recordings/bag_reader.hpp"
 
 #include <gtest/gtest.h>

@@ -11,7 +11,7 @@
 #include "synthetic_frames.hpp"
 
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/pipeline.hpp"
 

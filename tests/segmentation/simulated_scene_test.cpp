@@ -2,7 +2,7 @@
 // Segmentation statistics on the simulator's noisy 848x480 frames against its ground truth.
 
 #include "hrcsense/segmentation.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <gtest/gtest.h>
 

@@ -17,10 +17,10 @@
 // what counts as motion is described in docs/ARCHITECTURE.md ("Background and foreground").
 #include "../support/decide.hpp"
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/pipeline.hpp"
 #include "hrcsense/robot_state.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <gtest/gtest.h>
 

@@ -7,8 +7,8 @@
 #include "common/assembly.hpp"
 #include "common/truth_labeller.hpp"
 #include "hrcsense/camera.hpp"
-#include "hrcsense/config.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // The synthetic person cloud (person_cloud.hpp) that the proximity benchmarks and Table 4.4 of
 // `hrcsense eval` use: the size asked for, the same cloud every time, depth-image order, and
 // every point on the camera-facing surface of a person standing 2 m in front of the camera.
-#include "hrcsense/person_cloud.hpp"
+#include "hrcsense/sim/person_cloud.hpp"
 #include "hrcsense/proximity.hpp"
 
 #include <gtest/gtest.h>

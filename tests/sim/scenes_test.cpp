@@ -3,9 +3,9 @@
 
 #include "../support/scenes.hpp"
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
-#include "hrcsense/io.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/io/io.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <gtest/gtest.h>
 

@@ -3,8 +3,8 @@
 // lands where projecting it with them says), flat per-object colours, determinism, config.
 
 #include "hrcsense/camera.hpp"
-#include "hrcsense/config.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <gtest/gtest.h>
 

@@ -8,7 +8,7 @@
 #include "src/sim/sim_geometry.hpp"
 #include "src/sim/sim_raycast.hpp"
 #include "hrcsense/camera.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <gtest/gtest.h>
 

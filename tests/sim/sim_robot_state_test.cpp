@@ -3,8 +3,8 @@
 // by the latency with a seeded jitter, stale beyond robot.state.max_age_s.
 #include "../support/scenes.hpp"
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <gtest/gtest.h>
 

@@ -6,7 +6,7 @@
 #include "sim_sensor_scenes.hpp"
 
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 
 #include <gtest/gtest.h>
 

@@ -4,7 +4,7 @@
 #pragma once
 
 #include "hrcsense/camera.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <cmath>
 #include <cstddef>

@@ -2,9 +2,9 @@
 // Tests of the simulated depth camera against hand-computed geometry and its noise model.
 
 #include "hrcsense/camera.hpp"
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/pipeline.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 // the one the link's datagrams carry, written unsigned right after config_hash; null when the
 // header was assembled without one.
 #include "hrcsense/session.hpp"
-#include "hrcsense/sinks.hpp"
+#include "hrcsense/sinks/sinks.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

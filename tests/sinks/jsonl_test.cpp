@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tests of JsonLinesSink: each line parses back (nlohmann) with every binding field.
-#include "hrcsense/sinks.hpp"
+#include "hrcsense/sinks/sinks.hpp"
+
+#include "hrcsense/safety.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // The tests, benchmarks and fuzz seed corpus write bags with the production writer
-// (hrcsense/bag_writer.hpp); its params make the deliberately odd ones (no index, no trailing
+// (hrcsense/recordings/bag_writer.hpp); its params make the deliberately odd ones (no index, no trailing
 // depth units, uncompressed chunks, only the reader's topics with sdk_metadata = false).
 #pragma once
 
-#include "hrcsense/bag_writer.hpp"
+#include "hrcsense/recordings/bag_writer.hpp"
 
 namespace hrcsense::test {
 

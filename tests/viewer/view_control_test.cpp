@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "hrcsense/io.hpp"
+#include "hrcsense/io/io.hpp"
 
 #include <cstdio>
 #include <filesystem>

@@ -8,7 +8,7 @@
 #include "viewer/view_model.hpp"
 #include "viewer/view_tap.hpp"
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 
 #include <gtest/gtest.h>
 

@@ -8,8 +8,8 @@
 #include "viewer/view_model.hpp"
 
 #include "common/assembly.hpp"
-#include "hrcsense/config.hpp"
-#include "hrcsense/io.hpp"
+#include "hrcsense/config/config.hpp"
+#include "hrcsense/io/io.hpp"
 #include "hrcsense/robot.hpp"
 
 #include <gtest/gtest.h>

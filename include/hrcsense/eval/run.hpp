@@ -5,7 +5,7 @@
 // by the samples (a few dozen bytes a frame).
 #pragma once
 
-#include "hrcsense/config.hpp"
+#include "hrcsense/config/config.hpp"
 #include "hrcsense/eval/metrics.hpp"
 
 #include <atomic>

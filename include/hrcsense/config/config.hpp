@@ -4,10 +4,10 @@
 // an unknown or ill-typed key is an error that names the key and the file.
 #pragma once
 
-#include "hrcsense/pipeline.hpp"
+#include "hrcsense/pipeline_params.hpp"
 #include "hrcsense/robot.hpp"
 #include "hrcsense/robot_state_history.hpp"
-#include "hrcsense/sim.hpp"
+#include "hrcsense/sim/sim.hpp"
 
 #include <optional>
 #include <stdexcept>

@@ -2,7 +2,8 @@
 // hrcsense — sinks: where results go. JSON Lines as docs/OUTPUT.md describes.
 #pragma once
 
-#include "hrcsense/pipeline.hpp"
+#include "hrcsense/sink.hpp"
+#include "hrcsense/types.hpp"
 
 #include <cstdint>
 #include <functional>

@@ -5,7 +5,7 @@
 // nothing was taken within its timeout.
 #pragma once
 
-#include "hrcsense/link.hpp"
+#include "hrcsense/net/link.hpp"
 #include "hrcsense/types.hpp"
 
 #include <array>

@@ -4,7 +4,7 @@
 // frames (counted), never a late frame in processing.
 #pragma once
 
-#include "hrcsense/bag_writer.hpp"
+#include "hrcsense/recordings/bag_writer.hpp"
 #include "hrcsense/clock.hpp"
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/source.hpp"

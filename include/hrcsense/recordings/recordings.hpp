@@ -2,7 +2,7 @@
 // hrcsense — recorded sources: a folder of 16-bit depth PNGs and RealSense .bag files (ROS bag 2.0).
 #pragma once
 
-#include "hrcsense/pipeline.hpp"
+#include "hrcsense/source.hpp"
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/types.hpp"
 
