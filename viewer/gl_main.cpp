@@ -101,28 +101,6 @@ void on_scroll(GLFWwindow* /*window*/, double /*dx*/, double dy) {
   if (!imgui_has(false)) g_wheel += static_cast<float>(dy);
 }
 
-std::set<int64_t> parse_frame_list(const std::string& text) {
-  std::set<int64_t> frames;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    if (item.empty()) continue;
-    size_t used = 0;
-    long long value = -1;
-    try {
-      value = std::stoll(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != item.size() || value < 0) {
-      throw ConfigError("--snapshot-at: '" + item + "' is not a source frame index (0, 1, ...)");
-    }
-    frames.insert(value);
-  }
-  if (frames.empty()) throw ConfigError("--snapshot-at: no frame index given (e.g. --snapshot-at 123,198)");
-  return frames;
-}
-
 int64_t steady_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
       .count();

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <utility>
 
@@ -107,6 +108,28 @@ void save_tuned_config(const Config& config, const std::string& path) {
       << config.canonical_yaml;
   out.flush();
   if (!out) throw IoError(path + ": write failed");
+}
+
+std::set<int64_t> parse_frame_list(const std::string& text) {
+  std::set<int64_t> frames;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (item.empty()) continue;
+    size_t used = 0;
+    long long value = -1;
+    try {
+      value = std::stoll(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != item.size() || value < 0) {
+      throw ConfigError("--snapshot-at: '" + item + "' is not a source frame index (0, 1, ...)");
+    }
+    frames.insert(value);
+  }
+  if (frames.empty()) throw ConfigError("--snapshot-at: no frame index given (e.g. --snapshot-at 123,198)");
+  return frames;
 }
 
 }  // namespace hrcsense::view

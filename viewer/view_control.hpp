@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -64,5 +65,10 @@ Config tuned_config(const std::string& config_path, const std::vector<std::strin
 /// Writes `config.canonical_yaml` to `path` under a comment saying where it came from: a
 /// configuration `hrcsense run --config path` accepts. Throws IoError when it cannot.
 void save_tuned_config(const Config& config, const std::string& path);
+
+/// `--snapshot-at`'s comma-separated source frame indices ("123,198"), sorted and without
+/// repeats; empty items are skipped. Throws ConfigError naming an item that is not a
+/// non-negative integer, or when no index is given.
+std::set<int64_t> parse_frame_list(const std::string& text);
 
 }  // namespace hrcsense::view

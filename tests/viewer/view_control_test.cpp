@@ -237,5 +237,22 @@ TEST(SaveTuned, AValueTheParserRefusesIsAConfigErrorNamingTheKey) {
   }
 }
 
+// --snapshot-at: indices sorted and once each; anything else is refused, naming the item.
+TEST(ParseFrameList, SortedUniqueIndicesAndNamedRefusals) {
+  EXPECT_EQ(parse_frame_list("198,123,,198"), (std::set<int64_t>{123, 198}));
+  EXPECT_EQ(parse_frame_list("0"), (std::set<int64_t>{0}));
+  EXPECT_EQ(parse_frame_list("123, 198"), (std::set<int64_t>{123, 198}));  // a space after the comma
+  for (const char* bad : {"12a", "-1", "1.5", "7 "}) {
+    try {
+      (void)parse_frame_list(bad);
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("'") + bad + "'"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW((void)parse_frame_list(""), ConfigError);
+  EXPECT_THROW((void)parse_frame_list(",,"), ConfigError);
+}
+
 }  // namespace
 }  // namespace hrcsense::view
