@@ -48,6 +48,43 @@ TEST(CellChecks, BlockedShareCountsNearPixelsInFrontOfAFartherBackground) {
   EXPECT_FLOAT_EQ(blocked_share(p, d, b), 5.0F / 16.0F);
 }
 
+// The edge of blocked_depth_m, worked by hand with the D435's 1 mm raw unit: 249 mm is nearer
+// than 0.25 m and 250 mm is not; the largest raw value counts when the limit lies beyond it,
+// and a limit of 0 blocks nothing.
+TEST(CellChecks, BlockedShareEdgesOfTheNearLimit) {
+  CellCheckParams p;  // blocked_depth_m 0.25
+  DepthImage d = image_4x4(2000);
+  const BackgroundModel b = background_4x4(2.0F);
+  d.pixels[0] = 249;
+  d.pixels[1] = 250;
+  d.pixels[2] = 251;
+  d.pixels[3] = 1;  // the nearest valid depth
+  EXPECT_FLOAT_EQ(blocked_share(p, d, b), 2.0F / 16.0F);
+  d.pixels[4] = 65535;  // 65.535 m
+  d.pixels[5] = 0;      // invalid: never near
+  p.blocked_depth_m = 100.0F;
+  const BackgroundModel unknown = background_4x4(0.0F);  // no background nearer than the limit
+  EXPECT_FLOAT_EQ(blocked_share(p, d, unknown), 15.0F / 16.0F);
+  p.blocked_depth_m = 0.0F;
+  EXPECT_FLOAT_EQ(blocked_share(p, d, unknown), 0.0F);
+}
+
+// Pixels are taken 8 at a time; a row of 9 has one left over, counted the same way.
+TEST(CellChecks, BlockedShareCountsThePixelsPastTheLastFullGroupOfEight) {
+  CellCheckParams p;  // blocked_depth_m 0.25
+  DepthImage d;
+  d.resize(9, 1);
+  d.depth_scale_m = 0.001F;
+  std::fill(d.pixels.begin(), d.pixels.end(), uint16_t{2000});
+  d.pixels[3] = 100;
+  d.pixels[8] = 100;  // the one left over
+  BackgroundModel b;
+  b.width = 9;
+  b.height = 1;
+  b.mean_m.assign(9, 2.0F);
+  EXPECT_FLOAT_EQ(blocked_share(p, d, b), 2.0F / 9.0F);
+}
+
 TEST(CellChecks, EnvelopeCountsInvalidPixelsWhereTheBackgroundWasValid) {
   DepthImage d = image_4x4(1500);
   const BackgroundModel b0 = background_4x4(2.0F);
