@@ -15,6 +15,8 @@
 #include <map>
 #include <string>
 
+#include <unistd.h>
+
 namespace hrcsense::test {
 
 // A noise-free cell: the UR5 of config/cell-ur5.yaml at its fixed pose, a floor, and a box that
@@ -48,14 +50,20 @@ safety: {slow_distance_m: 1.0, stop_distance_m: 0.5}
 inline const JointAngles kCliJoints{-0.941593, -1.5, 1.4, -1.7, -1.5708, 0.0};
 
 /// Writes kCliCell to a temporary file and returns its path.
+/// A file name in the test's temporary folder, with this process's id: two test runs on one
+/// machine (a developer's and a clean clone's) must not read each other's files.
+inline std::string temp_path(const std::string& stem, const std::string& extension) {
+  return std::string(::testing::TempDir()) + stem + "_" + std::to_string(::getpid()) + extension;
+}
+
 inline std::string write_cli_cell(const std::string& name) {
-  const std::string path = std::string(::testing::TempDir()) + "cli_cell_" + name + ".yaml";
+  const std::string path = temp_path("cli_cell_" + name, ".yaml");
   std::ofstream(path) << kCliCell;
   return path;
 }
 
 /// Where run_tool(…, name) writes its JSON Lines.
-inline std::string cli_out_path(const std::string& name) { return std::string(::testing::TempDir()) + "cli_" + name + ".jsonl"; }
+inline std::string cli_out_path(const std::string& name) { return temp_path("cli_" + name, ".jsonl"); }
 
 /// How many frame lines the run writing `path` has written so far (the sink flushes every
 /// line): lets a test's fake peer go silent at a point of the run, however late it started.
