@@ -2,17 +2,19 @@
 // hrcsense — unknown space near the robot (unknown_space.hpp).
 //
 // Speed (issue A4): most of a frame is measured background or needs no more than counting, so
-// pixels are classified 16 at a time into bit masks (unknown_space_blocks.hpp) and only the
-// foreground, reliable gaps and (where a gap follows) the envelope are visited. Most unknown
-// rays pass far from the robot, so a block's rays are tested together, then one by one,
-// against spheres around the whole robot and around each capsule, and the exact
-// segment-to-capsule distance is computed only where a sphere comes nearer than the smallest
-// distance found so far. The distance reported is the same, bit for bit: what is skipped
+// runs of 64 pixels are first tested for measured background as a whole, the rest classified
+// 16 at a time into bit masks (unknown_space_blocks.hpp), and only the foreground, reliable
+// gaps and (where a gap follows) the envelope are visited. Most unknown rays pass far from the
+// robot, so a block's rays are tested together, then one by one, against spheres around the
+// whole robot and around each capsule (four capsules at a time, unknown_space_spheres.hpp),
+// and the exact segment-to-capsule distance is computed only where a sphere comes nearer
+// than the smallest distance found so far. The distance reported is the same, bit for bit: what is skipped
 // cannot be smaller than what was found, and the minimum does not depend on the order.
 
 #include "hrcsense/unknown_space.hpp"
 
 #include "unknown_space_blocks.hpp"
+#include "unknown_space_spheres.hpp"
 
 #include <algorithm>
 #include <array>
@@ -27,7 +29,7 @@ namespace {
 constexpr float kSkipMargin_m = 1e-3F;
 // Capsules with a sphere of their own; a larger robot is bounded by its enclosing sphere only
 // and measured exactly against every capsule (no allocation on the hot path).
-constexpr size_t kMaxBoundedCapsules = 32;
+constexpr size_t kMaxBoundedCapsules = unknown_space_detail::kMaxSpheres;
 
 // Squared distance between segments [p0, p1] and [q0, q1]: the closest pair's parameters
 // clamped to [0, 1] (the usual two-step clamp), in double so that nearly parallel segments
@@ -83,8 +85,8 @@ struct RayBounds {
   float ppx = 0.0F, ppy = 0.0F, inv_fx = 1.0F, inv_fy = 1.0F;
   float column_x_norm = 1.0F;  ///< |linear·(1, 0, 0)|: how far rays part per unit of x
   Sphere robot;
-  std::array<Sphere, kMaxBoundedCapsules> capsules{};
-  bool per_capsule = false;  ///< capsules[] holds one sphere per capsule of the robot
+  unknown_space_detail::SphereLanes capsules;  ///< sphere c around capsule c
+  bool per_capsule = false;                    ///< capsules holds one sphere per capsule of the robot
 };
 
 RayBounds make_ray_bounds(const Intrinsics& intrinsics, const Pose& T_base_camera, const RobotModel& robot) {
@@ -110,7 +112,12 @@ RayBounds make_ray_bounds(const Intrinsics& intrinsics, const Pose& T_base_camer
   bounds.per_capsule = robot.capsules.size() <= kMaxBoundedCapsules;
   for (size_t i = 0; bounds.per_capsule && i < robot.capsules.size(); ++i) {
     const Capsule& c = robot.capsules[i];
-    bounds.capsules[i] = {0.5F * (c.a + c.b) - bounds.camera_base, 0.5F * (c.b - c.a).norm() + c.radius_m};
+    const Eigen::Vector3f centre_from_camera = 0.5F * (c.a + c.b) - bounds.camera_base;
+    bounds.capsules.x[i] = centre_from_camera.x();
+    bounds.capsules.y[i] = centre_from_camera.y();
+    bounds.capsules.z[i] = centre_from_camera.z();
+    bounds.capsules.radius_m[i] = 0.5F * (c.b - c.a).norm() + c.radius_m;
+    bounds.capsules.count = static_cast<int>(i) + 1;
   }
   return bounds;
 }
@@ -147,15 +154,17 @@ struct Envelope {
   float z_m = 0.0F;
 };
 
-// One unknown ray of a block's row: pixel column u, from depth z0 to z1 (m).
+// One unknown ray of a block's row: pixel column u, from depth z0 to z1 (m). Left
+// uninitialised in a RayGroup: only rays [0, count) are written and read, and zeroing 16 of
+// them for every visited block cost as much as the visit.
 struct Ray {
-  int u = 0;
-  float z0_m = 0.0F;
-  float z1_m = 0.0F;
+  int u;
+  float z0_m;
+  float z1_m;
 };
 
 struct RayGroup {
-  std::array<Ray, unknown_space_detail::kBlockPx> rays{};
+  std::array<Ray, unknown_space_detail::kBlockPx> rays;
   int count = 0;
 };
 
@@ -166,20 +175,26 @@ Eigen::Vector3f ray_direction(const RayBounds& b, float u, int v) {
   return b.linear * Eigen::Vector3f(x, y, 1.0F);
 }
 
+unknown_space_detail::RaySpan ray_span(const Eigen::Vector3f& direction, float z0_m, float z1_m) {
+  unknown_space_detail::RaySpan span;
+  span.dx = direction.x();
+  span.dy = direction.y();
+  span.dz = direction.z();
+  span.inv_direction_sq = 1.0F / direction.squaredNorm();
+  span.z0_m = z0_m;
+  span.z1_m = z1_m;
+  return span;
+}
+
 // Lowers best_m to the ray's distance to the capsules in `near` (bit c: capsule c), measuring
 // exactly (ray_segment, segment-to-capsule in double) those its own bound does not skip. A
 // skipped capsule is farther than best_m, so leaving it out of the minimum cannot change
 // min(best_m, the ray's distance to every capsule).
 void measure_ray(const PixelScan& scan, int v, const Ray& ray, uint32_t near, float& best_m) {
   const RayBounds& b = scan.bounds;
-  const Eigen::Vector3f direction = ray_direction(b, static_cast<float>(ray.u), v);
-  const float inv_direction_sq = 1.0F / direction.squaredNorm();
   const float reach_m = best_m + kSkipMargin_m;  // infinite until a ray was measured: no skips
-  uint32_t measured = 0;
-  for (; near != 0; near &= near - 1) {
-    const int c = __builtin_ctz(near);
-    if (!beyond(direction, inv_direction_sq, ray.z0_m, ray.z1_m, b.capsules[c], reach_m)) measured |= 1U << c;
-  }
+  const unknown_space_detail::RaySpan span = ray_span(ray_direction(b, static_cast<float>(ray.u), v), ray.z0_m, ray.z1_m);
+  uint32_t measured = unknown_space_detail::spheres_within(b.capsules, span, reach_m, near);
   if (measured == 0) return;
   const RaySegment s = ray_segment(*scan.intrinsics, *scan.T_base_camera, ray.u, v, ray.z0_m, ray.z1_m);
   const Eigen::Vector3d from = s.from_base.cast<double>(), to = s.to_base.cast<double>();
@@ -190,11 +205,10 @@ void measure_ray(const PixelScan& scan, int v, const Ray& ray, uint32_t near, fl
   best_m = std::min(best_m, static_cast<float>(ray_best));
 }
 
-// The rays of one block, tested together first: each lies within slack_m of the group's middle
-// ray at the same depth, so a sphere farther than reach + slack from the middle ray over all
-// their depths is farther than reach from every one of them.
+// The rays of one block (at least one), tested together first: each lies within slack_m of
+// the group's middle ray at the same depth, so a sphere farther than reach + slack from the
+// middle ray over all their depths is farther than reach from every one of them.
 void measure_rays(const PixelScan& scan, int v, const RayGroup& group, float& best_m) {
-  if (group.count == 0) return;
   const RayBounds& b = scan.bounds;
   int u_min = group.rays[0].u, u_max = u_min;
   float z0_m = group.rays[0].z0_m, z1_m = group.rays[0].z1_m;
@@ -218,19 +232,19 @@ void measure_rays(const PixelScan& scan, int v, const RayGroup& group, float& be
     }
     return;
   }
-  uint32_t near = 0;
-  for (size_t c = 0; c < scan.robot->capsules.size(); ++c) {
-    if (!beyond(middle, inv_middle_sq, z0_m, z1_m, b.capsules[c], reach_m)) near |= 1U << c;
-  }
+  const uint32_t near = unknown_space_detail::spheres_within(b.capsules, ray_span(middle, z0_m, z1_m), reach_m,
+                                                             unknown_space_detail::sphere_bits(b.capsules.count));
   for (int r = 0; near != 0 && r < group.count; ++r) measure_ray(scan, v, group.rays[r], near, best_m);
 }
 
 // Set bits; without a POPCNT instruction in the baseline x86-64 target __builtin_popcount is
-// a library call, and most masks here are 0.
+// a library call, and a loop per bit cost as much again on the shiny table, whose blocks are
+// mostly never-valid pixels. Sums of bit pairs, then nibbles, then the bytes by a multiply.
 size_t count_bits(uint32_t bits) {
-  size_t count = 0;
-  for (; bits != 0; bits &= bits - 1) ++count;
-  return count;
+  bits = bits - ((bits >> 1) & 0x55555555U);
+  bits = (bits & 0x33333333U) + ((bits >> 2) & 0x33333333U);
+  bits = (bits + (bits >> 4)) & 0x0F0F0F0FU;
+  return (bits * 0x01010101U) >> 24;
 }
 
 // A pixel without depth now over a reliable background (column u): the robot's stereo shadow,
@@ -292,23 +306,33 @@ void visit_block(const PixelScan& scan, const unknown_space_detail::BlockKinds& 
     const int u = first_u + __builtin_ctz(kinds.envelope);
     set_envelope(scan, row_start + static_cast<size_t>(u), u, envelope);
   }
-  measure_rays(scan, v, group, best_m);
+  if (group.count != 0) measure_rays(scan, v, group, best_m);
 }
 
+// Right to left, whole blocks from the row's end, then the columns left over at its start.
 void scan_row(const PixelScan& scan, int v, UnknownSpace& out, float& best_m) {
   using unknown_space_detail::kBlockPx;
   const int width = scan.depth->width;
   const size_t row_start = static_cast<size_t>(v) * static_cast<size_t>(width);
   Envelope envelope;
-  for (int last = width - 1; last >= 0; last -= kBlockPx) {
-    const int first = std::max(0, last + 1 - kBlockPx);
-    const size_t i = row_start + static_cast<size_t>(first);
-    const unknown_space_detail::BlockBits bits = last + 1 - first == kBlockPx
-                                                     ? unknown_space_detail::block_bits(scan.blocks, i)
-                                                     : unknown_space_detail::block_bits_plain(scan.blocks, i, last + 1 - first);
+  constexpr int kSpanPx = unknown_space_detail::kSpanBlocks * kBlockPx;
+  int first = width - kBlockPx;
+  for (; first >= 0; first -= kBlockPx) {
+    const int span_first = first + kBlockPx - kSpanPx;  // a span ending with this block
+    if (span_first >= 0 && (first + kBlockPx - width) % kSpanPx == 0 &&
+        unknown_space_detail::span_quiet(scan.blocks, row_start + static_cast<size_t>(span_first))) {
+      first = span_first;
+      continue;
+    }
+    const unknown_space_detail::BlockBits bits =
+        unknown_space_detail::block_bits(scan.blocks, row_start + static_cast<size_t>(first));
     if ((bits.no_depth | bits.envelope | bits.foreground) == 0) continue;  // measured background only
     visit_block(scan, unknown_space_detail::kinds_of(bits), row_start, first, v, envelope, out, best_m);
   }
+  const int rest = first + kBlockPx;  // columns [0, rest)
+  if (rest <= 0) return;
+  const unknown_space_detail::BlockBits bits = unknown_space_detail::block_bits_head(scan.blocks, row_start, rest, width);
+  visit_block(scan, unknown_space_detail::kinds_of(bits), row_start, 0, v, envelope, out, best_m);
 }
 
 }  // namespace

@@ -77,23 +77,26 @@ inline BlockBits block_bits_plain(const BlockInputs& in, size_t first, int count
 
 #if defined(__SSE2__)
 /// The same bits for a whole block with SSE2 (every x86-64 CPU): compares on 8 or 16 lanes,
-/// narrowed to bytes and gathered with movemask. The background is read only for a block with
-/// a pixel without depth outside the envelope.
+/// narrowed to bytes and gathered with movemask. Most blocks are measured background only
+/// (depth everywhere, no envelope, no foreground): one movemask tells, and they return at
+/// once with no bit set. The background is read only for a block with a pixel without depth
+/// outside the envelope.
 inline BlockBits block_bits_sse2(const BlockInputs& in, size_t first) {
-  const __m128i zero = _mm_setzero_si128();
+  const __m128i zero = _mm_setzero_si128(), ones = _mm_cmpeq_epi8(zero, zero);
   const auto load = [](const void* p) { return _mm_loadu_si128(static_cast<const __m128i*>(p)); };
   const auto zero_words = [&](const uint16_t* p) {  // 16 words → 16 bytes, 0xFF where 0
     return _mm_packs_epi16(_mm_cmpeq_epi16(load(p), zero), _mm_cmpeq_epi16(load(p + 8), zero));
   };
+  // Bytes 0xFF where: no depth; outside the envelope; not foreground.
+  const __m128i no_depth = zero_words(in.raw + first);
+  const __m128i outside = in.envelope_from_raw != nullptr ? zero_words(in.envelope_from_raw + first) : ones;
+  const __m128i background =
+      in.foreground_mask != nullptr ? _mm_cmpeq_epi8(load(in.foreground_mask + first), zero) : ones;
+  if (_mm_movemask_epi8(_mm_andnot_si128(no_depth, _mm_and_si128(outside, background))) == 0xFFFF) return {};
   BlockBits b;
-  b.no_depth = static_cast<uint32_t>(_mm_movemask_epi8(zero_words(in.raw + first)));
-  if (in.envelope_from_raw != nullptr) {
-    b.envelope = ~static_cast<uint32_t>(_mm_movemask_epi8(zero_words(in.envelope_from_raw + first))) & 0xFFFFU;
-  }
-  if (in.foreground_mask != nullptr) {
-    b.foreground = ~static_cast<uint32_t>(_mm_movemask_epi8(_mm_cmpeq_epi8(load(in.foreground_mask + first), zero))) &
-                   0xFFFFU;
-  }
+  b.no_depth = static_cast<uint32_t>(_mm_movemask_epi8(no_depth));
+  b.envelope = ~static_cast<uint32_t>(_mm_movemask_epi8(outside)) & 0xFFFFU;
+  b.foreground = ~static_cast<uint32_t>(_mm_movemask_epi8(background)) & 0xFFFFU;
   const uint32_t gaps = b.no_depth & ~b.envelope;
   if (in.valid_ratio == nullptr || gaps == 0) return b;
   const __m128 min_ratio = _mm_set1_ps(in.min_valid_ratio), no_depth_zero = _mm_setzero_ps();
@@ -111,6 +114,47 @@ inline BlockBits block_bits_sse2(const BlockInputs& in, size_t first) {
 }
 #endif
 
+/// Blocks whose quiet test is shared: a row's measured background comes in long runs, and one
+/// test of 64 pixels costs about what a block's own did.
+inline constexpr int kSpanBlocks = 4;
+
+/// True when pixels [first, first + kSpanBlocks·kBlockPx) are measured background only: depth
+/// everywhere, no envelope, no foreground (no bit set in any of their blocks).
+inline bool span_quiet_plain(const BlockInputs& in, size_t first) {
+  for (size_t i = first; i < first + kSpanBlocks * kBlockPx; ++i) {
+    if (in.raw[i] == 0 || (in.envelope_from_raw != nullptr && in.envelope_from_raw[i] != 0) ||
+        (in.foreground_mask != nullptr && in.foreground_mask[i] != 0)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+#if defined(__SSE2__)
+/// The same with SSE2: every test ORed into one register, nonzero where a pixel needs work.
+inline bool span_quiet_sse2(const BlockInputs& in, size_t first) {
+  const __m128i zero = _mm_setzero_si128();
+  const auto load = [](const void* p) { return _mm_loadu_si128(static_cast<const __m128i*>(p)); };
+  __m128i any = zero;
+  for (size_t k = 0; k < kSpanBlocks * kBlockPx; k += 8) {
+    any = _mm_or_si128(any, _mm_cmpeq_epi16(load(in.raw + first + k), zero));
+    if (in.envelope_from_raw != nullptr) any = _mm_or_si128(any, load(in.envelope_from_raw + first + k));
+  }
+  for (size_t k = 0; in.foreground_mask != nullptr && k < kSpanBlocks * kBlockPx; k += 16) {
+    any = _mm_or_si128(any, load(in.foreground_mask + first + k));
+  }
+  return _mm_movemask_epi8(_mm_cmpeq_epi8(any, zero)) == 0xFFFF;
+}
+#endif
+
+inline bool span_quiet(const BlockInputs& in, size_t first) {
+#if defined(__SSE2__)
+  return span_quiet_sse2(in, first);
+#else
+  return span_quiet_plain(in, first);
+#endif
+}
+
 /// A whole block's bits, with SSE2 where the compiler targets it.
 inline BlockBits block_bits(const BlockInputs& in, size_t first) {
 #if defined(__SSE2__)
@@ -118,6 +162,21 @@ inline BlockBits block_bits(const BlockInputs& in, size_t first) {
 #else
   return block_bits_plain(in, first, kBlockPx);
 #endif
+}
+
+/// The bits of the first `count` pixels of a row from `row_start` (count < kBlockPx), in a row
+/// `width` wide. A row of at least a block reads its first whole block and keeps the low bits:
+/// a width that is no multiple of 16 (424 after decimation) left a partial block per row, and
+/// testing it pixel by pixel cost a tenth of the stage.
+inline BlockBits block_bits_head(const BlockInputs& in, size_t row_start, int count, int width) {
+  if (width < kBlockPx) return block_bits_plain(in, row_start, count);
+  BlockBits b = block_bits(in, row_start);
+  const uint32_t keep = (1U << count) - 1U;
+  b.no_depth &= keep;
+  b.envelope &= keep;
+  b.foreground &= keep;
+  b.reliable &= keep;
+  return b;
 }
 
 }  // namespace hrcsense::unknown_space_detail

@@ -55,6 +55,69 @@ TEST(UnknownSpaceBlocks, Sse2BitsEqualThePlainOnes) {
 }
 #endif
 
+// A span of blocks is quiet exactly when none of its blocks has a bit set, in both variants;
+// one event (no depth, envelope or foreground) anywhere in 64 pixels makes it busy.
+TEST(UnknownSpaceBlocks, QuietSpanHasNoBitInAnyBlock) {
+  constexpr size_t kSpan = unknown_space_detail::kSpanBlocks * unknown_space_detail::kBlockPx;
+  constexpr size_t kPixels = kSpan * 48;
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> pick(0, 199);
+  std::vector<uint16_t> raw(kPixels), envelope(kPixels);
+  std::vector<uint8_t> mask(kPixels);
+  std::vector<float> background(kPixels, 2.0F), ratio(kPixels, 1.0F);
+  for (size_t i = 0; i < kPixels; ++i) {  // ~1 % each: about half the spans see an event
+    raw[i] = pick(rng) == 0 ? 0 : static_cast<uint16_t>(1000 + pick(rng));
+    envelope[i] = pick(rng) == 0 ? static_cast<uint16_t>(900 + pick(rng)) : 0;
+    mask[i] = pick(rng) == 0 ? 1 : 0;
+  }
+  BlockInputs full{raw.data(), mask.data(), envelope.data(), background.data(), ratio.data(), 0.95F};
+  BlockInputs bare{raw.data(), nullptr, nullptr, background.data(), nullptr, 0.95F};
+  int quiet = 0, busy = 0;
+  for (const BlockInputs& in : {full, bare}) {
+    for (size_t first = 0; first < kPixels; first += kSpan) {
+      bool expected = true;
+      for (size_t block = first; block < first + kSpan; block += 16) {
+        const BlockBits b = unknown_space_detail::block_bits_plain(in, block, 16);
+        expected = expected && (b.no_depth | b.envelope | b.foreground) == 0;
+      }
+      (expected ? quiet : busy)++;
+      EXPECT_EQ(unknown_space_detail::span_quiet_plain(in, first), expected) << first;
+#if defined(__SSE2__)
+      EXPECT_EQ(unknown_space_detail::span_quiet_sse2(in, first), expected) << first;
+#endif
+    }
+  }
+  EXPECT_GT(quiet, 5);
+  EXPECT_GT(busy, 5);
+}
+
+// The first pixels of a row left over by whole blocks: read as the row's first whole block with
+// its low bits kept, they are the plain per-pixel bits of those pixels.
+TEST(UnknownSpaceBlocks, HeadOfARowEqualsThePlainBits) {
+  constexpr size_t kPixels = 40;
+  std::vector<uint16_t> raw(kPixels, 1500), envelope(kPixels, 0);
+  std::vector<uint8_t> mask(kPixels, 0);
+  std::vector<float> background(kPixels, 2.0F), ratio(kPixels, 1.0F);
+  for (size_t i : {1U, 4U, 9U, 12U}) raw[i] = 0;  // 9 and 12 lie beyond a head of 8
+  envelope[4] = envelope[10] = 900;
+  mask[6] = mask[11] = 1;
+  ratio[1] = 0.5F;
+  const BlockInputs in{raw.data(), mask.data(), envelope.data(), background.data(), ratio.data(), 0.95F};
+  for (int count = 1; count < 16; ++count) {
+    const BlockBits plain = unknown_space_detail::block_bits_plain(in, 0, count);
+    const BlockBits head = unknown_space_detail::block_bits_head(in, 0, count, static_cast<int>(kPixels));
+    EXPECT_EQ(plain.no_depth, head.no_depth) << count;
+    EXPECT_EQ(plain.envelope, head.envelope) << count;
+    EXPECT_EQ(plain.foreground, head.foreground) << count;
+    EXPECT_EQ(plain.reliable, head.reliable) << count;
+  }
+  const BlockBits eight = unknown_space_detail::block_bits_head(in, 0, 8, static_cast<int>(kPixels));
+  EXPECT_EQ(eight.no_depth, 0b00010010U);  // 1 and 4
+  EXPECT_EQ(eight.envelope, 0b00010000U);
+  EXPECT_EQ(eight.foreground, 0b01000000U);
+  EXPECT_EQ(eight.reliable, 0U);  // 1 flickered while learning, 4 is the envelope
+}
+
 TEST(UnknownSpaceBlocks, KindsOfOneBlockByHand) {
   // Pixel 0 measured, 1 no depth over a reliable background, 2 no depth over an unknown one,
   // 3 foreground, 4 in the envelope without depth, 5 no depth over a flickering background.
