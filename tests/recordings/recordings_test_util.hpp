@@ -11,15 +11,18 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 namespace hrcsense::test {
 
-/// A fresh folder under the system temp dir, removed at the end of the test.
+/// A fresh folder under the system temp dir, removed at the end of the test; the process id in
+/// its name keeps two test runs on one machine out of each other's folders.
 struct ScratchDir {
   std::filesystem::path path;
   explicit ScratchDir(const std::string& name) {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     path = std::filesystem::temp_directory_path() /
-           ("hrcsense_" + name + "_" + info->test_suite_name() + "_" + info->name());
+           ("hrcsense_" + name + "_" + info->test_suite_name() + "_" + info->name() + "_" + std::to_string(::getpid()));
     std::filesystem::remove_all(path);
     std::filesystem::create_directories(path);
   }
