@@ -4,7 +4,6 @@
 // our numbers differ from the thesis's; the numbers themselves come from the run.
 #include "hrcsense/eval/studies.hpp"
 
-#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <ctime>
@@ -112,6 +111,7 @@ SweepRequest StudyContext::sweep(const std::string& study, const std::string& sc
   request.jobs = jobs;
   request.out_dir = (fs::path(out_dir) / study).string();
   request.label = study;
+  request.observer = observer;
   return request;
 }
 
@@ -140,7 +140,7 @@ std::vector<StudySection> run_studies(const std::string& name, const StudyContex
   std::vector<StudySection> sections;
   if (name == "thesis") {
     for (const char* each : {"table-4.1", "table-4.2", "table-4.3", "table-4.4", "moving-cell"}) {
-      spdlog::info("eval: study {}", each);
+      if (ctx.observer.note) ctx.observer.note(std::string("study ") + each);
       sections.push_back(studies_by_name().at(each)(ctx));
     }
   } else {

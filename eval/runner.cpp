@@ -9,15 +9,10 @@
 #include "hrcsense/eval/metrics.hpp"
 #include "hrcsense/number_text.hpp"
 
-#include <unistd.h>
-
-#include <spdlog/spdlog.h>
-
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -148,30 +143,13 @@ std::string row_line(const Row& row, const EvalRun& run, bool serial) {
   return line;
 }
 
-// What the progress bar shows, updated by the workers.
+// What the progress reports count, updated by the workers.
 struct Progress {
   std::atomic<int64_t> frames{0};
   std::atomic<int64_t> rows_done{0};
   int64_t rows_total = 0;
   int64_t frames_per_row = 0;  ///< for the estimate; 0: unknown
 };
-
-void draw(const Progress& p, double elapsed_s, const std::string& current) {
-  const int64_t done = p.rows_done.load();
-  const double fps = elapsed_s > 0.0 ? static_cast<double>(p.frames.load()) / elapsed_s : 0.0;
-  const double left_frames =
-      static_cast<double>(p.rows_total * p.frames_per_row) - static_cast<double>(p.frames.load());
-  constexpr int kWidth = 24;
-  const int filled = p.rows_total > 0 ? static_cast<int>(kWidth * done / p.rows_total) : kWidth;
-  std::string bar(static_cast<size_t>(filled), '#');
-  bar.resize(kWidth, '.');
-  std::fprintf(stderr, "\r[%s] %lld/%lld rows  %s  %.0f frames/s  %s left   ", bar.c_str(),
-               static_cast<long long>(done), static_cast<long long>(p.rows_total), current.c_str(), fps,
-               fps > 0.0 && p.frames_per_row > 0
-                   ? (std::to_string(static_cast<int64_t>(left_frames / fps)) + " s").c_str()
-                   : "?");
-  std::fflush(stderr);
-}
 
 // DIR/results.md: every row of results.csv in row order, with the columns a reader compares
 // (the rest are in the CSV).
@@ -320,26 +298,37 @@ void run_rows_worker(SweepWork& work) {
   }
 }
 
-// Runs the pending rows on `jobs` threads, drawing the progress bar every 200 ms when stderr is
-// a terminal; throws std::runtime_error naming the first row that failed.
+// The observer's report of `work` at `elapsed_s`; call with work.mutex held (current).
+SweepProgress progress_of(const SweepWork& work, double elapsed_s, bool finished) {
+  SweepProgress p;
+  p.rows_done = work.progress.rows_done.load();
+  p.rows_total = work.progress.rows_total;
+  p.frames_done = work.progress.frames.load();
+  p.frames_total = work.progress.rows_total * work.progress.frames_per_row;
+  p.elapsed_s = elapsed_s;
+  p.current = work.current;
+  p.finished = finished;
+  return p;
+}
+
+// Runs the pending rows on `jobs` threads, reporting progress to the observer every 200 ms
+// and once at the end; throws std::runtime_error naming the first row that failed.
 void run_pending_rows(SweepWork& work, int jobs) {
   const auto start = std::chrono::steady_clock::now();
+  const auto elapsed_s = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  const std::function<void(const SweepProgress&)>& report = work.request.observer.progress;
   std::vector<std::thread> threads;
   for (int j = 0; j < jobs; ++j) threads.emplace_back(run_rows_worker, std::ref(work));
-  const bool tty = ::isatty(STDERR_FILENO) != 0;
   while (work.progress.rows_done.load() < work.progress.rows_total) {
     {
       std::lock_guard<std::mutex> lock(work.mutex);
       if (!work.first_error.empty()) break;
-      if (tty) {
-        draw(work.progress, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-             work.current);
-      }
+      if (report) report(progress_of(work, elapsed_s(), false));
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
   }
   for (std::thread& t : threads) t.join();
-  if (tty) std::fprintf(stderr, "\n");
+  if (report) report(progress_of(work, elapsed_s(), true));
   if (!work.first_error.empty()) throw std::runtime_error("eval: " + work.first_error);
 }
 
@@ -392,9 +381,11 @@ ResultTable run_sweep(const SweepRequest& request) {
   const eval::ResumeState resumed = eval::resume_results(csv, header_line(), kKeyColumns);
   check_sweep_settings(request, csv, resumed.existed);
   const std::vector<size_t> pending = rows_not_done(rows, resumed);
-  if (resumed.existed) {
-    spdlog::info("eval: resuming {}: {} of {} rows already there{}", csv, rows.size() - pending.size(), rows.size(),
-                 resumed.dropped_partial ? " (a row cut off by the interruption was removed)" : "");
+  const std::function<void(const std::string&)>& note = request.observer.note;
+  if (resumed.existed && note) {
+    note("resuming " + csv + ": " + std::to_string(rows.size() - pending.size()) + " of " +
+         std::to_string(rows.size()) + " rows already there" +
+         (resumed.dropped_partial ? " (a row cut off by the interruption was removed)" : ""));
   }
 
   const int jobs = std::max(1, std::min<int>(request.jobs, static_cast<int>(pending.size())));
@@ -408,7 +399,10 @@ ResultTable run_sweep(const SweepRequest& request) {
   const std::string md = (std::filesystem::path(request.out_dir) / "results.md").string();
   ResultTable table = read_results(csv);  // read once: the rows resumed and the rows run now
   write_results_md(table, md);
-  spdlog::info("eval: {} rows in {} and {} ({} run now)", rows.size(), csv, md, pending.size());
+  if (note) {
+    note(std::to_string(rows.size()) + " rows in " + csv + " and " + md + " (" + std::to_string(pending.size()) +
+         " run now)");
+  }
   return table;
 }
 

@@ -10,8 +10,6 @@
 #include "hrcsense/eval/studies.hpp"
 #include "hrcsense/config/config.hpp"
 
-#include <spdlog/spdlog.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -2,7 +2,8 @@
 // hrcsense CLI — `hrcsense eval`: sweeps configuration keys over scenes and seeds (the sweep
 // runner, hrcsense/eval/runner.hpp), then draws the sweep's figures (eval/plots.hpp); `--study
 // NAME` runs one of the ready-made studies that replicate the thesis's tables (eval/studies.hpp).
-// The flags become requests to the evaluation library (hrcsense_eval); this file only logs.
+// The flags become requests to the evaluation library (hrcsense_eval), which writes nothing
+// to the terminal; this file logs its notes and draws its progress.
 #include "commands.hpp"
 #include "common/app_errors.hpp"
 #include "hrcsense/eval/plots.hpp"
@@ -11,6 +12,10 @@
 
 #include <spdlog/spdlog.h>
 
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
 #include <exception>
 #include <string>
 #include <vector>
@@ -35,6 +40,31 @@ std::string command_line(const EvalArgs& args) {
   return line;
 }
 
+// The progress bar on stderr, redrawn in place when stderr is a terminal (a log file gets
+// none); the library's notes go to the log.
+eval::SweepObserver terminal_observer() {
+  eval::SweepObserver observer;
+  observer.note = [](const std::string& note) { spdlog::info("eval: {}", note); };
+  if (::isatty(STDERR_FILENO) == 0) return observer;
+  observer.progress = [](const eval::SweepProgress& p) {
+    constexpr int kWidth = 24;
+    const int filled = p.rows_total > 0 ? static_cast<int>(kWidth * p.rows_done / p.rows_total) : kWidth;
+    std::string bar(static_cast<size_t>(filled), '#');
+    bar.resize(kWidth, '.');
+    const double fps = p.elapsed_s > 0.0 ? static_cast<double>(p.frames_done) / p.elapsed_s : 0.0;
+    const std::string left = fps > 0.0 && p.frames_total > 0
+                                 ? std::to_string(static_cast<int64_t>(
+                                       static_cast<double>(p.frames_total - p.frames_done) / fps)) + " s"
+                                 : "?";
+    std::fprintf(stderr, "\r[%s] %lld/%lld rows  %s  %.0f frames/s  %s left   ", bar.c_str(),
+                 static_cast<long long>(p.rows_done), static_cast<long long>(p.rows_total), p.current.c_str(), fps,
+                 left.c_str());
+    if (p.finished) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  };
+  return observer;
+}
+
 }  // namespace
 
 int eval_study_command(const EvalArgs& args) {
@@ -44,6 +74,7 @@ int eval_study_command(const EvalArgs& args) {
   ctx.jobs = args.jobs;
   ctx.frames = args.frames;
   ctx.sets = args.sets;
+  ctx.observer = terminal_observer();
   if (!eval::is_study(args.study)) {
     return report_error("eval: --study '" + args.study +
                             "' is no study; expected table-4.1, table-4.2, table-4.3, table-4.4, moving-cell or thesis",
@@ -78,6 +109,7 @@ int eval_command(const EvalArgs& args) {
     request.frames = args.frames;
     request.jobs = args.jobs;
     request.out_dir = args.out;
+    request.observer = terminal_observer();
     const ResultTable table = eval::run_sweep(request);
     const std::vector<std::string> plots = eval::sweep_plots(table, axes, args.out);
     if (!plots.empty()) spdlog::info("eval: {} figures in {}", plots.size(), args.out);

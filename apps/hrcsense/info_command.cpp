@@ -191,6 +191,20 @@ void print_background(const Config& config, int64_t max_frames) {
   print_share(what);
 }
 
+// A live camera's identity and stream, as it reports them.
+void print_live_source(SourceType type, const SourceInfo& info) {
+  if (type == SourceType::realsense) {
+    std::printf("source: realsense, %s (serial %s, firmware %s)\n", info.camera_name.c_str(),
+                info.camera_serial.c_str(), info.camera_firmware.c_str());
+  } else {
+    std::printf("source: %s, %s\n", source_type_name(type), info.description.c_str());
+  }
+  std::printf("resolution: %dx%d at %.3g frames/s\n", info.intrinsics.width, info.intrinsics.height,
+              info.nominal_fps);
+  std::printf("intrinsics: fx %.3f fy %.3f ppx %.3f ppy %.3f\n", info.intrinsics.fx, info.intrinsics.fy,
+              info.intrinsics.ppx, info.intrinsics.ppy);
+}
+
 }  // namespace
 
 int info_command(const CommandArgs& args) {
@@ -213,17 +227,11 @@ int info_command(const CommandArgs& args) {
     if (status == 0) print_background(config, args.frames);
     return status;
   }
-  if (config.source.type == SourceType::realsense) {
-    // Without the SDK: the ConfigError saying so. With it: what the camera (or .bag) reports.
-    const SourceInfo info = make_source(config)->info();
-    std::printf("source: realsense, %s (serial %s, firmware %s)\n", info.camera_name.c_str(),
-                info.camera_serial.c_str(), info.camera_firmware.c_str());
-    std::printf("resolution: %dx%d at %.3g frames/s\n", info.intrinsics.width, info.intrinsics.height,
-                info.nominal_fps);
+  if (config.source.type == SourceType::realsense || config.source.type == SourceType::ros2) {
+    // Without the SDK or DDS: the ConfigError saying so. With it: what the camera reports (a
+    // ros2 camera once its first depth CameraInfo has come).
+    print_live_source(config.source.type, make_source(config)->info());
     return 0;
-  }
-  if (config.source.type != SourceType::sim) {
-    make_source(config);  // ros2 in a build without DDS: throws "not built into this hrcsense"
   }
   const int status = print_sim(config);
   std::fflush(stdout);

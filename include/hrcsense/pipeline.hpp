@@ -18,6 +18,7 @@
 #include "hrcsense/sink.hpp"
 #include "hrcsense/source.hpp"
 #include "hrcsense/types.hpp"
+#include "hrcsense/unknown_space.hpp"
 
 #include <atomic>
 #include <cstdint>
@@ -133,6 +134,11 @@ class Pipeline {
   std::vector<RobotModel> link_models_;  ///< robot_ split by link (buffers reused)
 
   std::vector<uint8_t> no_depth_frames_;  ///< per filtered pixel: frames in a row without depth
+  // The background in use changes with each learning frame, a relearn and set_background();
+  // reliable_ is unknown space's view of it, prepared again when the two counts differ.
+  int64_t background_changes_ = 0;
+  int64_t reliable_prepared_at_ = -1;
+  ReliableBackground reliable_;
   std::vector<uint32_t> moved_reference_;  ///< moved_reference_pixels of the background in use
   bool moved_reference_ready_ = false;
 
@@ -206,10 +212,11 @@ int64_t robot_state_lookup_offset_ns(RobotStateOrigin origin, double camera_late
 
 /// Runs capture and processing on two threads of their own and output on the caller's, joined
 /// by mailboxes. Processing measures (Pipeline::process); the output thread decides each
-/// measurement with one SafetyMonitor immediately before the sinks write it. Unpaced runs
-/// (options.pace false, live cameras included) process every frame the source delivers (the
-/// source waits for processing); paced runs drop and count, and a dropped measurement's verdict
-/// is carried into the next (carry_replaced).
+/// measurement with one SafetyMonitor immediately before the sinks write it. Unpaced runs of
+/// files and the simulator (options.pace false) process every frame the source delivers (the
+/// source waits for processing); paced runs and live sources (SourceInfo::live) keep the latest
+/// frame, drop and count the rest (frames_dropped), and a dropped measurement's verdict is
+/// carried into the next (carry_replaced).
 /// Each frame gets the robot state `robot_states` has at the frame's host time minus
 /// robot_state_lookup_offset_ns (camera_latency_s). The host time is the source's own (a live
 /// camera's capture time) when it sets Frame::host_time_ns; else the source timestamp with a

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace hrcsense {
@@ -35,9 +36,13 @@ struct ForegroundParams;  // segmentation.hpp: the foreground test the margin fo
 
 /// Which raw depths of each pixel are the robot's: [from_raw[i], to_raw[i]] (both inclusive);
 /// from_raw[i] = 0 where the robot is not in the pixel. Row-major, the rendered frame's size.
+/// from_raw is also 0 outside columns [u0, u1) × rows [v0, v1), so that a reader can skip the
+/// rest of the image (the default: the whole image, whatever its size).
 struct RobotPixels {
   const uint16_t* from_raw = nullptr;
   const uint16_t* to_raw = nullptr;
+  int u0 = 0, v0 = 0;
+  int u1 = std::numeric_limits<int>::max(), v1 = std::numeric_limits<int>::max();
   bool contains(size_t i, uint16_t raw) const {
     return from_raw[i] != 0 && raw >= from_raw[i] && raw <= to_raw[i];
   }
@@ -66,7 +71,9 @@ class SelfFilter {
   /// never undercuts `foreground`'s own noise test.
   void render(const Frame& frame, const Pose& T_base_camera, const ForegroundParams& foreground);
   /// The robot's raw depths per pixel of the last render (valid until the next render).
-  RobotPixels robot_pixels() const { return {from_raw_.data(), to_raw_.data()}; }
+  RobotPixels robot_pixels() const {
+    return {from_raw_.data(), to_raw_.data(), dirty_.u0, dirty_.v0, dirty_.u1, dirty_.v1};
+  }
   /// The padded body's nearest depth per pixel in metres, dilated (+inf where no robot); for
   /// tests and the viewer.
   const std::vector<float>& surface_depth_m() const { return entry_m_; }

@@ -56,7 +56,7 @@ struct TimestampCounts {
 struct RunSummary {
   int64_t frames_in = 0;          ///< frames read from the source
   int64_t frames_processed = 0;   ///< frames that went through processing
-  int64_t frames_dropped = 0;     ///< dropped by mailboxes (paced runs only; unpaced ones wait)
+  int64_t frames_dropped = 0;     ///< dropped by mailboxes (paced runs and live sources; unpaced files and the simulator wait)
   int64_t frames_dropped_camera = 0;  ///< lost before the source delivered them (Source::frames_dropped_camera)
   int64_t frames_valid = 0;
   int64_t verdict_run = 0, verdict_slow = 0, verdict_stop = 0;

@@ -61,6 +61,18 @@ struct UnknownSpaceParams {
   int min_no_depth_frames = 3;
 };
 
+/// The pixels of a background that unknown_space() calls reliable — known (mean > 0) and with
+/// depth in at least min_valid_ratio of its learning frames (NaN is neither) — one bit each,
+/// prepared once per background. The model's two float arrays are 8 bytes a pixel, read where a
+/// pixel has no depth; the stages before unknown space push them out of the cache, so that each
+/// frame paid two cache misses per block with a gap. These bits are 1/64 of that.
+struct ReliableBackground {
+  std::vector<uint8_t> bits;  ///< pixel i: bit i % 8 of bits[i / 8]; two bytes of padding after
+  size_t pixels = 0;          ///< the model's pixel count
+  float min_valid_ratio = 0.95F;
+};
+ReliableBackground reliable_background(const BackgroundModel& background, float min_valid_ratio);
+
 /// Counts, per pixel, the frames in a row without depth up to and including `depth` (saturating
 /// at 255); resized (and zeroed) when the image size changes.
 void count_no_depth_frames(const DepthImage& depth, std::vector<uint8_t>& no_depth_frames);
@@ -74,5 +86,14 @@ UnknownSpace unknown_space(const DepthImage& depth, const Intrinsics& intrinsics
                            const std::vector<uint8_t>& foreground_mask, const RobotPixels* robot_pixels,
                            const Pose& T_base_camera, const RobotModel& robot, float stereo_baseline_m,
                            const std::vector<uint8_t>& no_depth_frames, const UnknownSpaceParams& params = {});
+
+/// The same with the background's reliable pixels prepared (reliable_background(background,
+/// params.min_valid_ratio)): what a stream of frames against one background calls. Nothing is
+/// reliable when `reliable` was prepared for another size.
+UnknownSpace unknown_space(const DepthImage& depth, const Intrinsics& intrinsics, const BackgroundModel& background,
+                           const ReliableBackground& reliable, const std::vector<uint8_t>& foreground_mask,
+                           const RobotPixels* robot_pixels, const Pose& T_base_camera, const RobotModel& robot,
+                           float stereo_baseline_m, const std::vector<uint8_t>& no_depth_frames,
+                           const UnknownSpaceParams& params = {});
 
 }  // namespace hrcsense

@@ -197,6 +197,7 @@ void Pipeline::retune(const LiveTuning& tuning) {
 }
 
 void Pipeline::relearn_background() {
+  ++background_changes_;
   moved_reference_ready_ = false;
   not_empty_ = false;  // the reference stays: the new background is compared with it too
   learner_ = BackgroundLearner{};
@@ -219,6 +220,7 @@ std::optional<RobotPixels> Pipeline::render_robot(const Frame& frame, Measuremen
 }
 
 void Pipeline::set_background(BackgroundModel model, std::string origin) {
+  ++background_changes_;
   preset_model_ = std::move(model);
   preset_origin_ = std::move(origin);
   preset_background_ = true;
@@ -281,6 +283,7 @@ const Frame* Pipeline::filter(const Frame& source_frame, Measurement& m) {
 // With a reference, the batch that completes is compared with it at once (in the same timing),
 // and refused when someone stands in it.
 void Pipeline::learn(const Frame& frame, const RobotState& robot_state, Measurement& m) {
+  ++background_changes_;
   const bool placed = robot_state.valid && all_finite(robot_state.q_rad);
   if (learner_.frames_seen() == 0) {  // this frame starts a batch
     learning_poses_.capsules.clear();
@@ -348,9 +351,14 @@ void Pipeline::search_links(Measurement& m) {
 }
 
 void Pipeline::find_unknown_space(const Frame& frame, const RobotPixels* robot_pixels, Measurement& m) {
-  const UnknownSpace unknown = unknown_space(frame.depth, frame.intrinsics, background(), foreground_.mask,
+  const UnknownSpaceParams params;
+  if (reliable_prepared_at_ != background_changes_) {  // once per background, in this stage's timing
+    reliable_ = reliable_background(background(), params.min_valid_ratio);
+    reliable_prepared_at_ = background_changes_;
+  }
+  const UnknownSpace unknown = unknown_space(frame.depth, frame.intrinsics, background(), reliable_, foreground_.mask,
                                              robot_pixels, params_.T_base_camera, robot_,
-                                             frame.stereo_baseline_mm * 1e-3F, no_depth_frames_);
+                                             frame.stereo_baseline_mm * 1e-3F, no_depth_frames_, params);
   m.unknown_distance_m = unknown.distance_m;
 }
 

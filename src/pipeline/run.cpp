@@ -143,9 +143,12 @@ void stamp_delivery(Captured& slot, int64_t captured_ns, bool host_time_is_sourc
 }
 
 // Reads the source until it ends, fails, or the run is stopped; then closes `frames`. Paced
-// waits are the clock's sleep_until, which a stop request (SIGINT, SIGTERM) ends.
+// waits are the clock's sleep_until, which a stop request (SIGINT, SIGTERM) ends. With
+// `latest_wins` (paced or live) a frame processing has not yet taken is replaced and counted;
+// else the source waits for processing.
 void capture_loop(Source& source, const RunOptions& options, RunClock& clock, double max_frame_age_s,
-                  bool host_time_is_source_time, Mailbox<Captured>& frames, CaptureOutcome& outcome) {
+                  bool host_time_is_source_time, bool latest_wins, Mailbox<Captured>& frames,
+                  CaptureOutcome& outcome) {
   const double nominal_fps = source.info().nominal_fps;
   const int64_t max_frame_age_ns = seconds_to_ns(max_frame_age_s);
   Captured slot;
@@ -186,9 +189,10 @@ void capture_loop(Source& source, const RunOptions& options, RunClock& clock, do
       clock.sleep_until(due_ns, options.stop_requested);
     }
     stamp_delivery(slot, clock.now_ns(), host_time_is_source_time);
-    // Paced: latest wins, a frame not yet taken is dropped and counted. Unpaced: wait for
-    // processing. Either fails once processing is gone.
-    if (!(options.pace ? frames.put(slot) : frames.put_wait(slot))) break;
+    // Paced or live: latest wins, a frame not yet taken is dropped and counted (a live camera
+    // does not wait, and a frame held back would only grow older). Unpaced files and the
+    // simulator: wait for processing. Either fails once processing is gone.
+    if (!(latest_wins ? frames.put(slot) : frames.put_wait(slot))) break;
   }
   frames.close();
 }
@@ -210,12 +214,12 @@ void say_why_no_robot_state(const RobotStateSource& robot_states, Measurement& m
 }
 
 // Measures every frame it takes and hands the measurement to the output, where the monitor
-// decides it. A paced run's measurement that replaces one not yet taken carries that one's
-// verdict (carry_replaced), so a stop is never dropped unseen. Closes `results` when `frames`
-// is closed and drained.
+// decides it. With `latest_wins`, a measurement that replaces one not yet taken carries that
+// one's verdict (carry_replaced), so a stop is never dropped unseen. Closes `results` when
+// `frames` is closed and drained.
 void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const RunOptions& options,
-                     const RunClock& clock, const SafetyMonitor& monitor, Mailbox<Captured>& frames,
-                     Mailbox<FrameResult>& results, ProcessingStats& stats) {
+                     bool latest_wins, const RunClock& clock, const SafetyMonitor& monitor,
+                     Mailbox<Captured>& frames, Mailbox<FrameResult>& results, ProcessingStats& stats) {
   const int64_t camera_latency_ns = robot_state_lookup_offset_ns(robot_states.origin(), options.camera_latency_s);
   const auto carry = [&](const FrameResult& replaced, FrameResult& next) {
     carry_replaced(monitor, replaced, clock.now_ns(), next);
@@ -240,7 +244,7 @@ void processing_loop(Pipeline& pipeline, RobotStateSource& robot_states, const R
       if (options.before_process) previous = result;  // put() swaps `result` with an older buffer
       ++stats.processed;
       stats.latencies.add(result.latency_us);
-      if (!(options.pace ? results.put(result, carry) : results.put_wait(result))) break;  // the output ended
+      if (!(latest_wins ? results.put(result, carry) : results.put_wait(result))) break;  // the output ended
     }
   } catch (const std::exception& e) {
     stats.error = "processing error at frame " + std::to_string(in.frame.index) + ": " + e.what();
@@ -419,10 +423,14 @@ RunSummary run_pipeline(Source& source, RobotStateSource& robot_states, Pipeline
 
   sink.header(header);
   const bool source_time = host_time_is_source_time(robot_states.origin(), options.pace);
-  std::thread capture([&] { capture_loop(source, options, clock, max_frame_age_s, source_time, frames, outcome); });
-  // The watchdog counts nominal periods for sources that deliver at a rate (live or paced).
-  SafetyMonitor monitor(pipeline.params().safety, source.info().nominal_fps, source.info().live || options.pace);
-  std::thread processing([&] { processing_loop(pipeline, robot_states, options, clock, monitor, frames, results, stats); });
+  // Sources that deliver at a rate (live or paced) drop what processing cannot take, and the
+  // watchdog counts their nominal periods.
+  const bool at_a_rate = source.info().live || options.pace;
+  std::thread capture(
+      [&] { capture_loop(source, options, clock, max_frame_age_s, source_time, at_a_rate, frames, outcome); });
+  SafetyMonitor monitor(pipeline.params().safety, source.info().nominal_fps, at_a_rate);
+  std::thread processing(
+      [&] { processing_loop(pipeline, robot_states, options, at_a_rate, clock, monitor, frames, results, stats); });
   const FrameResult last = output_loop(sink, source, clock, monitor, results, summary, output_error);
   processing.join();
   capture.join();

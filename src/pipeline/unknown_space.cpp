@@ -4,7 +4,8 @@
 // Speed (issue A4): most of a frame is measured background or needs no more than counting, so
 // runs of 64 pixels are first tested for measured background as a whole, the rest classified
 // 16 at a time into bit masks (unknown_space_blocks.hpp), and only the foreground, reliable
-// gaps and (where a gap follows) the envelope are visited. Most unknown rays pass far from the
+// gaps and (where a gap follows) the envelope are visited. The envelope buffer is read only
+// inside the self-filter's rectangle (RobotPixels' bounds), the one place it can be nonzero. Most unknown rays pass far from the
 // robot, so a block's rays are tested together, then one by one, against spheres around the
 // whole robot and around each capsule (four capsules at a time, unknown_space_spheres.hpp),
 // and the exact segment-to-capsule distance is computed only where a sphere comes nearer
@@ -135,6 +136,9 @@ bool beyond(const Eigen::Vector3f& direction, float inv_direction_sq, float z0_m
 // One frame's inputs to the pixel loop.
 struct PixelScan {
   unknown_space_detail::BlockInputs blocks;
+  unknown_space_detail::BlockInputs blocks_without_envelope;  ///< the same, envelope_from_raw null
+  // Where the envelope can be (RobotPixels' bounds): columns [u0, u1), rows [v0, v1).
+  int envelope_u0 = 0, envelope_u1 = 0, envelope_v0 = 0, envelope_v1 = 0;
   const DepthImage* depth = nullptr;
   const uint8_t* no_depth_frames = nullptr;  ///< null: every gap counts at once
   double fx_b = 0.0;                         ///< px·m: shadow width = fx·B·(1/z_fg − 1/z_bg)
@@ -298,8 +302,9 @@ void visit_block(const PixelScan& scan, const unknown_space_detail::BlockKinds& 
     }
     const float z0_m = (kinds.hidden & bit) != 0 ? static_cast<float>(scan.blocks.raw[i]) * scan.depth->depth_scale_m
                                                  : gap_ray_start(scan, i, u, envelope, out);
+    if (std::isnan(z0_m)) continue;  // no ray
     const float bg = scan.blocks.background_m[i];
-    if (!(bg > z0_m)) continue;  // no ray (NaN), or nothing hidden behind it
+    if (!(bg > z0_m)) continue;  // nothing hidden behind it
     group.rays[static_cast<size_t>(group.count++)] = Ray{u, z0_m, bg};
   }
   if (kinds.envelope != 0 && kinds.gap == 0) {
@@ -309,29 +314,49 @@ void visit_block(const PixelScan& scan, const unknown_space_detail::BlockKinds& 
   if (group.count != 0) measure_rays(scan, v, group, best_m);
 }
 
-// Right to left, whole blocks from the row's end, then the columns left over at its start.
+// The row's inputs for pixels [first, first + count): without the envelope where they lie
+// outside its columns [u0, u1) (RobotPixels: nothing of the robot there), so that most of the
+// envelope buffer is never read.
+const unknown_space_detail::BlockInputs& inputs_for(const PixelScan& scan, const unknown_space_detail::BlockInputs& row,
+                                                    int first, int count) {
+  const bool outside = first >= scan.envelope_u1 || first + count <= scan.envelope_u0;
+  return outside ? scan.blocks_without_envelope : row;
+}
+
+// The block of pixels from column first, if it has any pixel to visit.
+void scan_block(const PixelScan& scan, const unknown_space_detail::BlockInputs& row, size_t row_start, int first, int v,
+                Envelope& envelope, UnknownSpace& out, float& best_m) {
+  const unknown_space_detail::BlockBits bits = unknown_space_detail::block_bits(
+      inputs_for(scan, row, first, unknown_space_detail::kBlockPx), row_start + static_cast<size_t>(first));
+  if ((bits.no_depth | bits.envelope | bits.foreground) == 0) return;  // measured background only
+  visit_block(scan, unknown_space_detail::kinds_of(bits), row_start, first, v, envelope, out, best_m);
+}
+
+// Right to left: runs of kSpanBlocks blocks from the row's end (a quiet run skipped at once),
+// the whole blocks left over, then the columns left over at the row's start.
 void scan_row(const PixelScan& scan, int v, UnknownSpace& out, float& best_m) {
   using unknown_space_detail::kBlockPx;
+  constexpr int kSpanPx = unknown_space_detail::kSpanBlocks * kBlockPx;
   const int width = scan.depth->width;
   const size_t row_start = static_cast<size_t>(v) * static_cast<size_t>(width);
+  const bool envelope_row = v >= scan.envelope_v0 && v < scan.envelope_v1;
+  const unknown_space_detail::BlockInputs& row = envelope_row ? scan.blocks : scan.blocks_without_envelope;
   Envelope envelope;
-  constexpr int kSpanPx = unknown_space_detail::kSpanBlocks * kBlockPx;
-  int first = width - kBlockPx;
-  for (; first >= 0; first -= kBlockPx) {
-    const int span_first = first + kBlockPx - kSpanPx;  // a span ending with this block
-    if (span_first >= 0 && (first + kBlockPx - width) % kSpanPx == 0 &&
-        unknown_space_detail::span_quiet(scan.blocks, row_start + static_cast<size_t>(span_first))) {
-      first = span_first;
+  int end = width;  // columns [0, end) are left
+  for (; end >= kSpanPx; end -= kSpanPx) {
+    const int span_first = end - kSpanPx;
+    if (unknown_space_detail::span_quiet(inputs_for(scan, row, span_first, kSpanPx),
+                                         row_start + static_cast<size_t>(span_first))) {
       continue;
     }
-    const unknown_space_detail::BlockBits bits =
-        unknown_space_detail::block_bits(scan.blocks, row_start + static_cast<size_t>(first));
-    if ((bits.no_depth | bits.envelope | bits.foreground) == 0) continue;  // measured background only
-    visit_block(scan, unknown_space_detail::kinds_of(bits), row_start, first, v, envelope, out, best_m);
+    for (int first = end - kBlockPx; first >= span_first; first -= kBlockPx) {
+      scan_block(scan, row, row_start, first, v, envelope, out, best_m);
+    }
   }
-  const int rest = first + kBlockPx;  // columns [0, rest)
-  if (rest <= 0) return;
-  const unknown_space_detail::BlockBits bits = unknown_space_detail::block_bits_head(scan.blocks, row_start, rest, width);
+  for (; end >= kBlockPx; end -= kBlockPx) scan_block(scan, row, row_start, end - kBlockPx, v, envelope, out, best_m);
+  if (end <= 0) return;
+  const unknown_space_detail::BlockBits bits =
+      unknown_space_detail::block_bits_head(inputs_for(scan, row, 0, std::min(width, kBlockPx)), row_start, end, width);
   visit_block(scan, unknown_space_detail::kinds_of(bits), row_start, 0, v, envelope, out, best_m);
 }
 
@@ -368,10 +393,33 @@ void count_no_depth_frames(const DepthImage& depth, std::vector<uint8_t>& no_dep
 }
 
 
+ReliableBackground reliable_background(const BackgroundModel& background, float min_valid_ratio) {
+  ReliableBackground out;
+  out.pixels = background.mean_m.size();
+  out.min_valid_ratio = min_valid_ratio;
+  out.bits.assign((out.pixels + 7) / 8 + 2, 0);  // reliable_bits16 reads three bytes from any pixel's
+  if (background.valid_ratio.size() != out.pixels) return out;
+  for (size_t i = 0; i < out.pixels; ++i) {
+    // Ordered compares: NaN is neither known nor reliable.
+    const bool reliable = background.mean_m[i] > 0.0F && background.valid_ratio[i] >= min_valid_ratio;
+    out.bits[i / 8] = static_cast<uint8_t>(out.bits[i / 8] | (reliable ? 1U << (i % 8) : 0U));
+  }
+  return out;
+}
+
 UnknownSpace unknown_space(const DepthImage& depth, const Intrinsics& intrinsics, const BackgroundModel& background,
                            const std::vector<uint8_t>& foreground_mask, const RobotPixels* robot_pixels,
                            const Pose& T_base_camera, const RobotModel& robot, float stereo_baseline_m,
                            const std::vector<uint8_t>& no_depth_frames, const UnknownSpaceParams& params) {
+  return unknown_space(depth, intrinsics, background, reliable_background(background, params.min_valid_ratio),
+                       foreground_mask, robot_pixels, T_base_camera, robot, stereo_baseline_m, no_depth_frames, params);
+}
+
+UnknownSpace unknown_space(const DepthImage& depth, const Intrinsics& intrinsics, const BackgroundModel& background,
+                           const ReliableBackground& reliable, const std::vector<uint8_t>& foreground_mask,
+                           const RobotPixels* robot_pixels, const Pose& T_base_camera, const RobotModel& robot,
+                           float stereo_baseline_m, const std::vector<uint8_t>& no_depth_frames,
+                           const UnknownSpaceParams& params) {
   UnknownSpace out;
   const size_t n = depth.pixels.size();
   if (background.mean_m.size() != n || depth.width <= 0 || robot.capsules.empty()) return out;
@@ -380,8 +428,16 @@ UnknownSpace unknown_space(const DepthImage& depth, const Intrinsics& intrinsics
   scan.blocks.foreground_mask = foreground_mask.size() == n ? foreground_mask.data() : nullptr;
   scan.blocks.envelope_from_raw = robot_pixels != nullptr ? robot_pixels->from_raw : nullptr;
   scan.blocks.background_m = background.mean_m.data();
-  scan.blocks.valid_ratio = background.valid_ratio.size() == n ? background.valid_ratio.data() : nullptr;
-  scan.blocks.min_valid_ratio = params.min_valid_ratio;
+  const bool reliable_fits = reliable.pixels == n && reliable.bits.size() >= (n + 7) / 8 + 2;
+  scan.blocks.reliable_bits = reliable_fits ? reliable.bits.data() : nullptr;
+  scan.blocks_without_envelope = scan.blocks;
+  scan.blocks_without_envelope.envelope_from_raw = nullptr;
+  if (robot_pixels != nullptr) {
+    scan.envelope_u0 = robot_pixels->u0;
+    scan.envelope_u1 = robot_pixels->u1;
+    scan.envelope_v0 = robot_pixels->v0;
+    scan.envelope_v1 = robot_pixels->v1;
+  }
   scan.depth = &depth;
   scan.no_depth_frames = no_depth_frames.size() == n ? no_depth_frames.data() : nullptr;
   scan.fx_b = static_cast<double>(intrinsics.fx) * stereo_baseline_m;

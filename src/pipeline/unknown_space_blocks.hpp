@@ -26,16 +26,25 @@ struct BlockInputs {
   const uint8_t* foreground_mask = nullptr;     ///< 1 = foreground (optional)
   const uint16_t* envelope_from_raw = nullptr;  ///< the robot's envelope: nonzero inside (optional)
   const float* background_m = nullptr;          ///< background mean, m (> 0: known)
-  const float* valid_ratio = nullptr;           ///< share of learning frames with depth (optional)
-  float min_valid_ratio = 0.95F;
+  /// ReliableBackground::bits: pixel i reliable when bit i % 8 of byte i / 8 is set (optional:
+  /// none is).
+  const uint8_t* reliable_bits = nullptr;
 };
+
+/// The reliable bits of pixels [first, first + 16) (bit k: pixel first + k); ReliableBackground
+/// pads its bytes so that the three bytes read here exist for every pixel.
+inline uint32_t reliable_bits16(const uint8_t* bits, size_t first) {
+  const uint8_t* b = bits + first / 8;
+  const uint32_t word = uint32_t{b[0]} | (uint32_t{b[1]} << 8) | (uint32_t{b[2]} << 16);
+  return (word >> (first % 8)) & 0xFFFFU;
+}
 
 /// The raw tests of a block, one bit per pixel.
 struct BlockBits {
   uint32_t no_depth = 0;    ///< raw == 0
   uint32_t envelope = 0;    ///< in the robot's envelope
   uint32_t foreground = 0;  ///< in the foreground mask
-  /// Background > 0 and valid_ratio ≥ min; only where no_depth outside the envelope, else 0.
+  /// A reliable background (reliable_bits); only where no_depth outside the envelope, else 0.
   uint32_t reliable = 0;
 };
 
@@ -66,11 +75,8 @@ inline BlockBits block_bits_plain(const BlockInputs& in, size_t first, int count
     const bool envelope = in.envelope_from_raw != nullptr && in.envelope_from_raw[i] != 0;
     if (envelope) b.envelope |= bit;
     if (in.foreground_mask != nullptr && in.foreground_mask[i] != 0) b.foreground |= bit;
-    // Written as the per-pixel test was: NaN is neither known nor reliable.
-    if (in.raw[i] == 0 && !envelope && in.background_m[i] > 0.0F && in.valid_ratio != nullptr &&
-        in.valid_ratio[i] >= in.min_valid_ratio) {
-      b.reliable |= bit;
-    }
+    const bool reliable = in.reliable_bits != nullptr && ((in.reliable_bits[i / 8] >> (i % 8)) & 1U) != 0;
+    if (in.raw[i] == 0 && !envelope && reliable) b.reliable |= bit;
   }
   return b;
 }
@@ -79,7 +85,7 @@ inline BlockBits block_bits_plain(const BlockInputs& in, size_t first, int count
 /// The same bits for a whole block with SSE2 (every x86-64 CPU): compares on 8 or 16 lanes,
 /// narrowed to bytes and gathered with movemask. Most blocks are measured background only
 /// (depth everywhere, no envelope, no foreground): one movemask tells, and they return at
-/// once with no bit set. The background is read only for a block with a pixel without depth
+/// once with no bit set. The reliable bits are read only for a block with a pixel without depth
 /// outside the envelope.
 inline BlockBits block_bits_sse2(const BlockInputs& in, size_t first) {
   const __m128i zero = _mm_setzero_si128(), ones = _mm_cmpeq_epi8(zero, zero);
@@ -98,18 +104,7 @@ inline BlockBits block_bits_sse2(const BlockInputs& in, size_t first) {
   b.envelope = ~static_cast<uint32_t>(_mm_movemask_epi8(outside)) & 0xFFFFU;
   b.foreground = ~static_cast<uint32_t>(_mm_movemask_epi8(background)) & 0xFFFFU;
   const uint32_t gaps = b.no_depth & ~b.envelope;
-  if (in.valid_ratio == nullptr || gaps == 0) return b;
-  const __m128 min_ratio = _mm_set1_ps(in.min_valid_ratio), no_depth_zero = _mm_setzero_ps();
-  __m128i reliable[4];
-  for (int q = 0; q < 4; ++q) {
-    // Ordered compares: false for NaN, as the per-pixel test.
-    const __m128 known = _mm_cmpgt_ps(_mm_loadu_ps(in.background_m + first + 4 * q), no_depth_zero);
-    const __m128 steady = _mm_cmpge_ps(_mm_loadu_ps(in.valid_ratio + first + 4 * q), min_ratio);
-    reliable[q] = _mm_castps_si128(_mm_and_ps(known, steady));
-  }
-  const __m128i bytes = _mm_packs_epi16(_mm_packs_epi32(reliable[0], reliable[1]),
-                                        _mm_packs_epi32(reliable[2], reliable[3]));
-  b.reliable = static_cast<uint32_t>(_mm_movemask_epi8(bytes)) & gaps;
+  if (in.reliable_bits != nullptr && gaps != 0) b.reliable = reliable_bits16(in.reliable_bits, first) & gaps;
   return b;
 }
 #endif

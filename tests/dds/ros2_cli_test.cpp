@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <thread>
 #include <vector>
@@ -26,11 +27,18 @@ namespace {
 using nlohmann::json;
 using namespace std::chrono_literals;
 
-pid_t spawn(std::vector<std::string> args) {
+// Runs the CLI with `args`, its stderr discarded and its stdout into `stdout_path` (empty:
+// inherited).
+pid_t spawn(std::vector<std::string> args, const std::string& stdout_path = {}) {
   const pid_t pid = ::fork();
   if (pid == 0) {
     const int null = ::open("/dev/null", O_WRONLY);
     ::dup2(null, STDERR_FILENO);
+    if (!stdout_path.empty()) {
+      const int out = ::open(stdout_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (out < 0) ::_exit(126);
+      ::dup2(out, STDOUT_FILENO);
+    }
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
@@ -136,6 +144,32 @@ TEST(Ros2Cli, SilentCameraStopsTheCellAndTheRunResumesWhenItIsBack) {
       EXPECT_EQ(lines[i]["verdict"], "stop");
     }
   }
+}
+
+// `hrcsense info` with a ros2 source describes the camera that answers (its topic, domain and
+// stream), not the simulator's settings of the same file.
+TEST(Ros2Cli, InfoDescribesTheCameraThatAnswers) {
+  if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
+  const std::string domain = std::to_string(test::test_domain());
+  const std::string out = std::string(::testing::TempDir()) + "ros2_cli_info_" + std::to_string(::getpid()) + ".txt";
+  const pid_t publisher = spawn(publisher_args(domain, 200));
+  ASSERT_GT(publisher, 0);
+  const pid_t info = spawn({HRCSENSE_CLI, "info", "--config", kWalk, "--set", "source.type=ros2", "--set",
+                            "source.ros2.namespace=/cli/camera", "--set", "source.ros2.domain_id=" + domain, "--set",
+                            "source.ros2.startup_timeout_s=30"},
+                           out);
+  ASSERT_GT(info, 0);
+  const int info_exit = wait_exit(info, 40s);
+  ::kill(publisher, SIGTERM);
+  wait_exit(publisher, 10s);
+  ASSERT_EQ(info_exit, 0);
+  std::ifstream in(out);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("source: ros2, ROS 2 /cli/camera/depth/image_rect_raw (domain " + domain + ")"),
+            std::string::npos) << text;
+  EXPECT_NE(text.find("resolution: 424x240 at 30 frames/s"), std::string::npos) << text;
+  EXPECT_EQ(text.find("sim"), std::string::npos) << "the simulator's settings printed:\n" << text;
+  std::remove(out.c_str());
 }
 
 // A run whose ROS 2 camera never answers still writes what every run writes (issue 31, defect

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -232,7 +233,16 @@ TEST(RunPipeline, WatchdogStopsALiveSourceAfterTwoFramePeriods) {
   test::WatchedClock clock;
   LiveFakeSource source(after_learning({{1.5F}, {1.5F}, {1.5F}}));
   CollectingSink sink;
-  source.before_step = stall_before_frame_4(clock, sink, 70'000'000);
+  // A live source's frames are not waited for: each one comes once the last is written, so
+  // that none is replaced before processing takes it.
+  const std::function<bool(size_t)> stall = stall_before_frame_4(clock, sink, 70'000'000);
+  source.before_step = [&](size_t step) {
+    const bool written = sink.wait_until([&](const std::vector<FrameResult>& results) {
+      return static_cast<size_t>(std::count_if(results.begin(), results.end(),
+                                               [](const FrameResult& r) { return r.source_frame; })) >= step;
+    });
+    return written && stall(step);
+  };
   RunOptions options;
   options.clock = &clock;
   run(source, sink, fake_params(0.5), options);
@@ -242,6 +252,60 @@ TEST(RunPipeline, WatchdogStopsALiveSourceAfterTwoFramePeriods) {
   EXPECT_EQ(watchdog.verdict.code, ReasonCode::no_frame);
   EXPECT_EQ(watchdog.verdict.reason, "no frame for 0.070 s (max_frame_gap_periods 2 at 30 frames/s)");
   EXPECT_FALSE(watchdog.source_frame);
+}
+
+// A live camera does not wait for processing: while processing is held at frame 3, the
+// camera delivers frames 4 to 8 and each replaces the one before it. Processing then takes
+// frame 8, the newest; frames 4 to 7 were never processed and are counted as dropped.
+class EndingLiveSource : public LiveFakeSource {
+ public:
+  using LiveFakeSource::LiveFakeSource;
+  Status next(Frame& out) override {
+    const Status status = LiveFakeSource::next(out);
+    if (status == Status::end) {
+      std::lock_guard<std::mutex> lock(mutex);
+      ended = true;
+      changed.notify_all();
+    }
+    return status;
+  }
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool ended = false;
+};
+
+TEST(RunPipeline, LiveSourceKeepsTheNewestFrameAndCountsTheRest) {
+  EndingLiveSource source(after_learning({{1.5F}, {1.5F}, {1.5F}, {1.5F}, {1.5F}, {1.5F}}));
+  CollectingSink sink;
+  // Frames 0-3 come one at a time (each once the last is written or, for 3, held); frames
+  // 4-8 as fast as the source can.
+  bool held = false;
+  source.before_step = [&](size_t step) {
+    if (step != 4) return step > 4 || has_results(sink, step);
+    std::unique_lock<std::mutex> lock(source.mutex);
+    return source.changed.wait_for(lock, std::chrono::seconds(10), [&] { return held; });
+  };
+  RunOptions options;
+  int calls = 0;
+  bool waited = false;
+  options.before_process = [&](Pipeline&, const FrameResult&) {
+    if (calls++ != 3) return;
+    std::unique_lock<std::mutex> lock(source.mutex);
+    held = true;
+    source.changed.notify_all();
+    waited = source.changed.wait_for(lock, std::chrono::seconds(10), [&] { return source.ended; });
+  };
+  const RunSummary summary = run(source, sink, fake_params(0.5), options);
+
+  EXPECT_TRUE(waited);
+  EXPECT_EQ(summary.frames_in, 9);
+  EXPECT_EQ(summary.frames_processed, 5);  // 0-3 and 8
+  EXPECT_GE(summary.frames_dropped, 4);    // 4-7 in capture; the output may drop 3 as well
+  const std::vector<FrameResult> frames = sink.frame_results();
+  EXPECT_EQ(static_cast<int64_t>(frames.size()) + summary.frames_dropped, summary.frames_in);
+  ASSERT_FALSE(frames.empty());
+  EXPECT_EQ(frames.back().frame, 8);
+  for (const FrameResult& r : frames) EXPECT_TRUE(r.frame < 4 || r.frame == 8) << r.frame;
 }
 
 // The same stall of 70 ms from a source that delivers on demand (a recording, unpaced): only

@@ -22,6 +22,15 @@ using unknown_space_detail::BlockInputs;
 
 using test::capsule;
 
+// The reliable bits of a background of `background` means and `ratio` valid ratios, prepared
+// as the pipeline prepares them.
+ReliableBackground reliable_of(const std::vector<float>& background, const std::vector<float>& ratio) {
+  BackgroundModel model;
+  model.mean_m = background;
+  model.valid_ratio = ratio;
+  return reliable_background(model, 0.95F);
+}
+
 #if defined(__SSE2__)
 TEST(UnknownSpaceBlocks, Sse2BitsEqualThePlainOnes) {
   constexpr size_t kPixels = 16 * 64;
@@ -40,8 +49,9 @@ TEST(UnknownSpaceBlocks, Sse2BitsEqualThePlainOnes) {
     const int r = pick(rng);
     ratio[i] = r == 0 ? nan : r < 4 ? 0.94F : r == 4 ? 0.95F : 1.0F;
   }
-  BlockInputs full{raw.data(), mask.data(), envelope.data(), background.data(), ratio.data(), 0.95F};
-  BlockInputs bare{raw.data(), nullptr, nullptr, background.data(), nullptr, 0.95F};
+  const ReliableBackground reliable = reliable_of(background, ratio);
+  BlockInputs full{raw.data(), mask.data(), envelope.data(), background.data(), reliable.bits.data()};
+  BlockInputs bare{raw.data(), nullptr, nullptr, background.data(), nullptr};
   for (const BlockInputs& in : {full, bare}) {
     for (size_t first = 0; first < kPixels; first += 16) {
       const BlockBits plain = unknown_space_detail::block_bits_plain(in, first, 16);
@@ -54,6 +64,52 @@ TEST(UnknownSpaceBlocks, Sse2BitsEqualThePlainOnes) {
   }
 }
 #endif
+
+// The reliable bits are the rule written out per pixel: known (mean > 0) and valid in at least
+// 0.95 of the learning frames; NaN is neither. Read 16 at a time from any pixel, they are the
+// same bits, the last pixels included (the padding).
+TEST(UnknownSpaceBlocks, ReliableBitsFollowTheRuleFromAnyPixel) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<float> mean = {2.0F, 0.0F, nan, -0.0F, 2.0F, 2.0F, 2.0F, 1.0F, 3.0F, 2.0F, 2.0F};
+  const std::vector<float> ratio = {1.0F, 1.0F, 1.0F, 1.0F, 0.95F, 0.9499F, nan, 0.96F, 1.0F, 0.0F, 1.0F};
+  const std::vector<bool> expected = {true, false, false, false, true, false, false, true, true, false, true};
+  const ReliableBackground reliable = reliable_of(mean, ratio);
+  ASSERT_EQ(reliable.pixels, mean.size());
+  for (size_t i = 0; i < mean.size(); ++i) {
+    EXPECT_EQ(((reliable.bits[i / 8] >> (i % 8)) & 1U) != 0, expected[i]) << i;
+    const uint32_t word = unknown_space_detail::reliable_bits16(reliable.bits.data(), i);
+    for (size_t k = 0; k < 16; ++k) {
+      const bool bit = ((word >> k) & 1U) != 0;
+      EXPECT_EQ(bit, i + k < mean.size() && expected[i + k]) << i << " + " << k;
+    }
+  }
+  // Without valid ratios nothing is reliable.
+  BackgroundModel no_ratios;
+  no_ratios.mean_m = mean;
+  const ReliableBackground none = reliable_background(no_ratios, 0.95F);
+  for (uint8_t byte : none.bits) EXPECT_EQ(byte, 0);
+}
+
+// The envelope's rectangle (RobotPixels' bounds): unknown space reads the envelope only in the
+// runs and blocks that meet it. A row of 70 is scanned as a run of 64 (columns 6-69), then its
+// first 6 columns; the envelope lies at 2-3. The rectangle of the whole row and that of just
+// those columns give the same counts; one at columns 40-69 leaves the first block unread, so
+// that 2 and 3 count as unknown, which shows the envelope there was not read.
+TEST(UnknownSpaceBlocks, TheEnvelopeIsReadOnlyWhereItsRectangleMeetsTheScan) {
+  test::UnknownSpaceRow<70> row(5);
+  for (size_t u : {2U, 3U}) row.from[u] = 1000, row.to[u] = 1100;
+  for (size_t u : {2U, 3U, 30U, 40U, 69U}) row.depth.pixels[u] = 0;
+  const auto run = [&](int u0, int u1) {
+    RobotPixels envelope{row.from.data(), row.to.data(), u0, 0, u1, 1};
+    return unknown_space(row.depth, row.in, row.background, row.mask, &envelope, Pose::Identity(), row.robot, 0.0F,
+                         row.no_depth_frames);
+  };
+  const UnknownSpace whole = run(0, 70), tight = run(2, 4), elsewhere = run(40, 70);
+  EXPECT_EQ(whole.no_depth_pixels, 3U);  // 30, 40 and 69: 2 and 3 are the envelope
+  EXPECT_EQ(tight.no_depth_pixels, whole.no_depth_pixels);
+  EXPECT_EQ(tight.distance_m, whole.distance_m);
+  EXPECT_EQ(elsewhere.no_depth_pixels, 5U);
+}
 
 // A span of blocks is quiet exactly when none of its blocks has a bit set, in both variants;
 // one event (no depth, envelope or foreground) anywhere in 64 pixels makes it busy.
@@ -70,8 +126,9 @@ TEST(UnknownSpaceBlocks, QuietSpanHasNoBitInAnyBlock) {
     envelope[i] = pick(rng) == 0 ? static_cast<uint16_t>(900 + pick(rng)) : 0;
     mask[i] = pick(rng) == 0 ? 1 : 0;
   }
-  BlockInputs full{raw.data(), mask.data(), envelope.data(), background.data(), ratio.data(), 0.95F};
-  BlockInputs bare{raw.data(), nullptr, nullptr, background.data(), nullptr, 0.95F};
+  const ReliableBackground reliable = reliable_of(background, ratio);
+  BlockInputs full{raw.data(), mask.data(), envelope.data(), background.data(), reliable.bits.data()};
+  BlockInputs bare{raw.data(), nullptr, nullptr, background.data(), nullptr};
   int quiet = 0, busy = 0;
   for (const BlockInputs& in : {full, bare}) {
     for (size_t first = 0; first < kPixels; first += kSpan) {
@@ -102,7 +159,8 @@ TEST(UnknownSpaceBlocks, HeadOfARowEqualsThePlainBits) {
   envelope[4] = envelope[10] = 900;
   mask[6] = mask[11] = 1;
   ratio[1] = 0.5F;
-  const BlockInputs in{raw.data(), mask.data(), envelope.data(), background.data(), ratio.data(), 0.95F};
+  const ReliableBackground reliable = reliable_of(background, ratio);
+  const BlockInputs in{raw.data(), mask.data(), envelope.data(), background.data(), reliable.bits.data()};
   for (int count = 1; count < 16; ++count) {
     const BlockBits plain = unknown_space_detail::block_bits_plain(in, 0, count);
     const BlockBits head = unknown_space_detail::block_bits_head(in, 0, count, static_cast<int>(kPixels));
@@ -124,7 +182,8 @@ TEST(UnknownSpaceBlocks, KindsOfOneBlockByHand) {
   std::vector<uint16_t> raw{1500, 0, 0, 1200, 0, 0}, envelope{0, 0, 0, 0, 800, 0};
   std::vector<uint8_t> mask{0, 0, 0, 1, 0, 0};
   std::vector<float> background{2, 2, 0, 2, 2, 2}, ratio{1, 1, 1, 1, 1, 0.5F};
-  const BlockInputs in{raw.data(), mask.data(), envelope.data(), background.data(), ratio.data(), 0.95F};
+  const ReliableBackground reliable = reliable_of(background, ratio);
+  const BlockInputs in{raw.data(), mask.data(), envelope.data(), background.data(), reliable.bits.data()};
   const auto kinds = unknown_space_detail::kinds_of(unknown_space_detail::block_bits_plain(in, 0, 6));
   EXPECT_EQ(kinds.gap, 0b000010U);
   EXPECT_EQ(kinds.never_valid, 0b100100U);

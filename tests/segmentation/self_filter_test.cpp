@@ -159,6 +159,33 @@ TEST(SelfFilter, ARenderForgetsTheLastOnesPixels) {
   EXPECT_NE(filter.robot_pixels().from_raw[index(50, 35)], 0);
 }
 
+// RobotPixels' rectangle holds every pixel of the robot (a reader may skip the rest) and stays
+// near the bar: at z ≈ 2 m, x within ±0.3 m and y 0.2-0.4 m project to columns 50 ± 16 and
+// rows 60-70 (f = 100 px), grown here by at most the dilation, a pixel of slack and the
+// nearer surface's larger scale. Without a pose it is empty.
+TEST(SelfFilter, TheRectangleHoldsEveryRobotPixel) {
+  SelfFilter filter = filter_with(2);
+  filter.render(camera_frame(), Pose::Identity(), ForegroundParams{});
+  RobotPixels robot = filter.robot_pixels();
+  EXPECT_TRUE(robot.u0 >= robot.u1 || robot.v0 >= robot.v1) << "no pose, yet a rectangle";
+  filter.add_pose(bar_at(2.0F, 0.3F));
+  filter.render(camera_frame(), Pose::Identity(), ForegroundParams{});
+  robot = filter.robot_pixels();
+  int inside = 0;
+  for (int v = 0; v < kSize; ++v) {
+    for (int u = 0; u < kSize; ++u) {
+      if (robot.from_raw[index(u, v)] == 0) continue;
+      ++inside;
+      EXPECT_TRUE(u >= robot.u0 && u < robot.u1 && v >= robot.v0 && v < robot.v1) << u << ", " << v;
+    }
+  }
+  EXPECT_GT(inside, 100);
+  EXPECT_GE(robot.u0, 28);
+  EXPECT_LE(robot.u1, 73);
+  EXPECT_GE(robot.v0, 54);
+  EXPECT_LE(robot.v1, 77);
+}
+
 TEST(SelfFilter, CameraPoseMovesTheArmIntoTheCameraFrame) {
   // The bar given in a base frame whose origin is 1 m behind the camera along its axis.
   SelfFilter filter = filter_with(0);

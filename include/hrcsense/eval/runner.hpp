@@ -8,12 +8,33 @@
 #include "hrcsense/eval/sweep.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 namespace hrcsense::eval {
 
 /// One sweep to run.
+/// How far a sweep has got, for a progress display.
+struct SweepProgress {
+  int64_t rows_done = 0;
+  int64_t rows_total = 0;    ///< rows to run now (those already in results.csv not counted)
+  int64_t frames_done = 0;   ///< source frames processed so far, over every row run now
+  int64_t frames_total = 0;  ///< the same when every row is done; 0: unknown
+  double elapsed_s = 0.0;    ///< since the first row started (steady clock)
+  std::string current;       ///< the row being run: "<label>: <point> <scene file>"
+  bool finished = false;     ///< the last report of the sweep
+};
+
+/// What a sweep tells its caller while it runs; either may be empty. The library itself writes
+/// nothing to the terminal: `hrcsense eval` draws the progress bar and logs the notes.
+struct SweepObserver {
+  /// Every 200 ms while rows run, then once with finished set (on the calling thread).
+  std::function<void(const SweepProgress&)> progress;
+  /// A sentence for the log: resuming a results.csv, the files written, the study begun.
+  std::function<void(const std::string&)> note;
+};
+
 struct SweepRequest {
   std::vector<std::string> scenes;          ///< configuration files, one run per point each
   std::vector<std::string> sets;            ///< `--set` text for every row, before the point's
@@ -23,6 +44,7 @@ struct SweepRequest {
   int jobs = 1;                             ///< rows at once; rates are marked `parallel` above 1
   std::string out_dir;                      ///< results.csv and results.md go here
   std::string label;                        ///< shown before the progress bar (a study's name)
+  SweepObserver observer;                   ///< progress and notes (none by default)
 };
 
 /// results.csv read back: its columns and its rows in row order.
@@ -38,7 +60,7 @@ struct ResultTable {
   double number(size_t row, const std::string& name) const;
 };
 
-/// Runs every row of `request` not already in out_dir/results.csv (logging that it resumes),
+/// Runs every row of `request` not already in out_dir/results.csv (noting that it resumes),
 /// then writes results.md and returns the whole table. Every row's configuration is loaded
 /// before the first one runs, so that a misspelt key fails at once. Throws (ConfigError for a
 /// bad key or value, std::runtime_error naming the scene and settings of a row whose run

@@ -28,6 +28,7 @@ struct StudyContext {
   int jobs = 1;                      ///< rows at once (rates are quotable only at 1)
   int64_t frames = -1;               ///< source frames per row; -1: the study's own
   std::vector<std::string> sets;     ///< --set KEY=VALUE for every row of every study
+  SweepObserver observer;            ///< every study's sweep reports to it; notes the study begun
 
   /// The scene `file` in config_dir; throws std::runtime_error naming it when it is absent.
   std::string scene(const std::string& file) const;
@@ -51,7 +52,7 @@ StudySection study_moving_cell(const StudyContext& ctx);  ///< the moving UR5 ce
 /// Whether `name` is a study: table-4.1, table-4.2, table-4.3, table-4.4, moving-cell, or thesis (all of them).
 bool is_study(const std::string& name);
 
-/// Runs study `name`, or for `thesis` every study in the report's order (logging each); returns
+/// Runs study `name`, or for `thesis` every study in the report's order (noting each); returns
 /// their sections. Throws std::invalid_argument when `name` is no study, and what a study throws.
 std::vector<StudySection> run_studies(const std::string& name, const StudyContext& ctx);
 
