@@ -298,7 +298,8 @@ void run_rows_worker(SweepWork& work) {
   }
 }
 
-// The observer's report of `work` at `elapsed_s`; call with work.mutex held (current).
+// The observer's report of `work` at `elapsed_s`. work.current is the workers': read it under
+// work.mutex while they run.
 SweepProgress progress_of(const SweepWork& work, double elapsed_s, bool finished) {
   SweepProgress p;
   p.rows_done = work.progress.rows_done.load();

@@ -69,7 +69,6 @@ struct UnknownSpaceParams {
 struct ReliableBackground {
   std::vector<uint8_t> bits;  ///< pixel i: bit i % 8 of bits[i / 8]; two bytes of padding after
   size_t pixels = 0;          ///< the model's pixel count
-  float min_valid_ratio = 0.95F;
 };
 ReliableBackground reliable_background(const BackgroundModel& background, float min_valid_ratio);
 
@@ -88,8 +87,9 @@ UnknownSpace unknown_space(const DepthImage& depth, const Intrinsics& intrinsics
                            const std::vector<uint8_t>& no_depth_frames, const UnknownSpaceParams& params = {});
 
 /// The same with the background's reliable pixels prepared (reliable_background(background,
-/// params.min_valid_ratio)): what a stream of frames against one background calls. Nothing is
-/// reliable when `reliable` was prepared for another size.
+/// params.min_valid_ratio)): what a stream of frames against one background calls. The ratio
+/// is the one `reliable` was prepared with (params.min_valid_ratio is not read again); nothing
+/// is reliable when `reliable` was prepared for another size.
 UnknownSpace unknown_space(const DepthImage& depth, const Intrinsics& intrinsics, const BackgroundModel& background,
                            const ReliableBackground& reliable, const std::vector<uint8_t>& foreground_mask,
                            const RobotPixels* robot_pixels, const Pose& T_base_camera, const RobotModel& robot,

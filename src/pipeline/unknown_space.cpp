@@ -5,12 +5,15 @@
 // runs of 64 pixels are first tested for measured background as a whole, the rest classified
 // 16 at a time into bit masks (unknown_space_blocks.hpp), and only the foreground, reliable
 // gaps and (where a gap follows) the envelope are visited. The envelope buffer is read only
-// inside the self-filter's rectangle (RobotPixels' bounds), the one place it can be nonzero. Most unknown rays pass far from the
-// robot, so a block's rays are tested together, then one by one, against spheres around the
-// whole robot and around each capsule (four capsules at a time, unknown_space_spheres.hpp),
-// and the exact segment-to-capsule distance is computed only where a sphere comes nearer
-// than the smallest distance found so far. The distance reported is the same, bit for bit: what is skipped
-// cannot be smaller than what was found, and the minimum does not depend on the order.
+// inside the self-filter's rectangle (RobotPixels' bounds), the one place it can be nonzero,
+// and the background's reliability as one bit per pixel (ReliableBackground), prepared once
+// per background: read as floats, it cost two cache misses at every block with a gap.
+// Most unknown rays pass far from the robot, so a block's rays are tested together, then one
+// by one, against spheres around the whole robot and around each capsule (four capsules at a
+// time, unknown_space_spheres.hpp), and the exact segment-to-capsule distance is computed only
+// where a sphere comes nearer than the smallest distance found so far. The distance reported
+// is the same, bit for bit: what is skipped cannot be smaller than what was found, and the
+// minimum does not depend on the order.
 
 #include "hrcsense/unknown_space.hpp"
 
@@ -396,7 +399,6 @@ void count_no_depth_frames(const DepthImage& depth, std::vector<uint8_t>& no_dep
 ReliableBackground reliable_background(const BackgroundModel& background, float min_valid_ratio) {
   ReliableBackground out;
   out.pixels = background.mean_m.size();
-  out.min_valid_ratio = min_valid_ratio;
   out.bits.assign((out.pixels + 7) / 8 + 2, 0);  // reliable_bits16 reads three bytes from any pixel's
   if (background.valid_ratio.size() != out.pixels) return out;
   for (size_t i = 0; i < out.pixels; ++i) {
