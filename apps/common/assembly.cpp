@@ -342,6 +342,9 @@ RunHeader make_run_header(const Config& config, const SourceInfo& info) {
   header.session = process_session();  // the link's datagrams carry the same (UdpLinkParams::session 0)
   header.source = info;
   header.robot_state = robot_state_origin_name(config.robot_state.source);
+  if (config.pipeline.safety.mode == SafetyParams::Mode::ssm) {
+    header.stopping_data = stopping_data_name(config.pipeline.safety.ssm.stopping_data);
+  }
   if (config.robot_state.source == RobotStateOrigin::rtde) {
     header.robot_state_reports.push_back("robot_status");
     if (config.pipeline.robot.arm) header.robot_state_reports.push_back("tcp_pose_check");

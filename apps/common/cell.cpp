@@ -119,6 +119,7 @@ std::unique_ptr<Cell> assemble_cell(const Config& config, const CellOptions& opt
   cell->header = make_run_header(config, info);
   cell->header.unknown_background_share = cell->pipeline->unknown_background_share();  // a loaded background's
   if (!cell->header.filters.note.empty()) spdlog::warn("filters: {}", cell->header.filters.note);
+  for (const std::string& warning : config.warnings) spdlog::warn("config: {}", warning);
   cell->run_options = run_options(config, options, *cell, paced);
   return cell;
 }

@@ -35,8 +35,10 @@ struct SafetyParams {
   /// `safety.min_hold_s`: a stricter state is held at least this long after the last frame
   /// that asked for it. s, ≥ 0.
   double min_hold_s = 0.0;
-  /// `safety.unknown_policy`: report (unknown_distance_m only) or stop_within_m.
-  enum class UnknownPolicy { report, stop_within_m } unknown_policy = UnknownPolicy::report;
+  /// `safety.unknown_policy`: report (unknown_distance_m and unknown_margin_m only),
+  /// stop_within_m (unknown space within unknown_stop_within_m of the robot) or
+  /// stop_within_protective (unknown space nearer the robot than the governing S_p).
+  enum class UnknownPolicy { report, stop_within_m, stop_within_protective } unknown_policy = UnknownPolicy::report;
   float unknown_stop_within_m = 0.1F;  ///< `safety.unknown_stop_within_m`, m from the padded capsules
   /// `safety.max_frame_gap_periods`: no frame for this many nominal frame periods is a stop
   /// (`no_frame`); safety.max_frame_age_s stays the absolute ceiling.
@@ -64,7 +66,13 @@ struct VerdictInput {
   /// programmed speed, v_r / robot_speed_scaling.
   double robot_speed_scaling = 1.0;
   double frame_age_s = 0.0;      ///< the frame's age at the verdict: host time to now
+  /// The robot state's age beyond what extrapolation covered, s (robot_state_gap_s).
+  double robot_state_gap_s = 0.0;
 };
+
+/// How much older the robot state of `m` is than its frame beyond what extrapolation with the
+/// joint velocities covered, s, ≥ 0 (SsmInput::robot_state_gap_s).
+double robot_state_gap_s(const Measurement& m);
 
 /// The share of its programmed speed the robot runs at for measurement `m`: its state's
 /// speed_fraction when that is a reading in 0..1, else `scale_sent` (the speed scale hrcsense
@@ -84,6 +92,9 @@ struct Decision {
   int governing_link = -1;  ///< Capsule::link of the governing link; -1 without a contact
   float distance_uncertainty_m = std::numeric_limits<float>::quiet_NaN();  ///< the governing link's Z_d
   float robot_speed_towards_mps = std::numeric_limits<float>::quiet_NaN(); ///< the governing link's v_r
+  /// unknown_distance_m less the governing S_p (ssm) or safety.stop_distance_m (zones); NaN
+  /// without unknown space.
+  float unknown_margin_m = std::numeric_limits<float>::quiet_NaN();
 };
 
 /// The verdict of a valid frame in `params.mode`: zones (verdict_for_contact) or ssm (stop
@@ -92,8 +103,13 @@ struct Decision {
 /// off the contact's distance (the hysteresis test of VerdictHold).
 Decision decide_verdict(const SafetyParams& params, const VerdictInput& input, float distance_margin_m = 0.0F);
 
+/// The unknown distance less the protective distance of `verdict` (ssm mode: the governing
+/// link's S_p; zones mode: safety.stop_distance_m); NaN without unknown space.
+float unknown_margin_m(const SafetyParams& params, float unknown_distance_m, const Verdict& verdict);
+
 /// `safety.unknown_policy`: stop_within_m turns `verdict` into a stop (`unknown_space`) when
-/// unknown space lies within safety.unknown_stop_within_m (+ the margin) of the robot.
+/// unknown space lies within safety.unknown_stop_within_m (+ the margin) of the robot,
+/// stop_within_protective when the unknown margin (unknown_margin_m) is below the margin.
 void apply_unknown_policy(const SafetyParams& params, float unknown_distance_m, float distance_margin_m,
                           Verdict& verdict);
 
@@ -150,11 +166,12 @@ class SafetyMonitor {
  public:
   /// `nominal_fps` and `frames_at_a_rate` (a live or paced source) set the no-frame watchdog:
   /// safety.max_frame_age_s, or safety.max_frame_gap_periods nominal periods when shorter.
+  /// `nominal_fps` > 0 also puts one nominal frame period into T_r (SsmParams::frame_period_s).
   explicit SafetyMonitor(SafetyParams params, double nominal_fps = 0.0, bool frames_at_a_rate = false);
   const SafetyParams& params() const { return params_; }
-  /// Decides `result` at run-clock time `now_ns`: a stop (`stale_frame`) when it was
-  /// delivered more than watchdog_after_ns() before (a frame older than the no-frame limit is
-  /// no fresher than no frame); T_r from its seen time
+  /// Decides `result` at run-clock time `now_ns`: a stop (`stale_frame`) when it was seen
+  /// (captured, for a live camera; else delivered) more than watchdog_after_ns() before (a
+  /// frame older than the no-frame limit is no fresher than no frame); T_r from its seen time
   /// (Measurement::seen_ns; an age of 0 when not clocked); merged with the strictest of the
   /// measurements it replaced (FrameResult::replaced); then held (VerdictHold) on the frame's
   /// host time. Fills verdict, ssm, governing_link, the governing Z_d and v_r, frame_age_s.
@@ -201,6 +218,9 @@ const char* reason_code_name(ReasonCode code);
 
 /// 0 run, 1 slow, 2 stop: a larger number is the stricter state.
 int verdict_strictness(VerdictState state);
+
+/// `safety.unknown_policy`'s names: "report", "stop_within_m", "stop_within_protective".
+const char* unknown_policy_name(SafetyParams::UnknownPolicy policy);
 
 /// Name used in the output: "run", "slow", "stop".
 const char* verdict_name(VerdictState state);

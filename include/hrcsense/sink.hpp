@@ -26,6 +26,9 @@ struct RunHeader {
   uint32_t session = 0;
   SourceInfo source;
   std::string robot_state;  ///< `robot.state.source` (fixed, sim, rtde, udp_json); empty: not written
+  /// `safety.mode: ssm`: where S_s comes from, stopping_data_name() ("default", "table",
+  /// "limits"); empty (null): zones mode.
+  std::string stopping_data;
   /// What the robot state source delivers beyond time-stamped joints: "robot_status" (frames
   /// carry the controller's robot_status) and "tcp_pose_check" (its actual_TCP_pose is checked
   /// against the forward kinematics); empty: nothing more (or not written: robot_state empty).

@@ -7,8 +7,26 @@
 #pragma once
 
 #include <limits>
+#include <vector>
 
 namespace hrcsense {
+
+/// One row of `safety.stopping_table`: from `speed_mps` (towards the person, at the point that
+/// moves fastest) the robot stops within `distance_m` and `time_s` (its stopping data for the
+/// stop category it is stopped with, at the cell's payload and extension).
+struct StoppingRow {
+  float speed_mps = 0.0F;
+  float distance_m = 0.0F;
+  double time_s = 0.0;
+};
+
+/// Where S_s and T_s come from (the header's `stopping_data`).
+enum class StoppingData {
+  default_time,  ///< "default": the closed form of robot_stop_time_s and robot_decel_mps2
+  table,         ///< "table": safety.stopping_table
+  limits,        ///< "limits": safety.stopping_limits, the robot's configured stopping limits
+};
+const char* stopping_data_name(StoppingData data);  ///< "default", "table", "limits"
 
 /// `safety.*` of the `ssm` mode. Defaults and their sources: docs/SAFETY.md.
 struct SsmParams {
@@ -28,6 +46,33 @@ struct SsmParams {
   /// 0: not stated. A statement for the integrator; S_p does not use it.
   float detection_range_m = 0.0F;
   float robot_uncertainty_m = 0.01F;  ///< Z_r, the robot's position uncertainty
+  /// `safety.stopping_table`: rows in increasing speed; when not empty it gives S_s and T_s
+  /// (robot_stop_time_s and robot_decel_mps2 are then not used). Linear between rows; below
+  /// the first row the distance falls linearly to 0 at rest and the time stays the first
+  /// row's; beyond the last row a constant deceleration: distance × (v/v_last)², time × v/v_last.
+  std::vector<StoppingRow> stopping_table;
+  /// `safety.stopping_limits`: the robot's own stopping distance and time limits (its safety
+  /// configuration), which it keeps at any speed; used when > 0 and there is no table.
+  float stopping_limit_distance_m = 0.0F;
+  double stopping_limit_time_s = 0.0;
+  StoppingData stopping_data = StoppingData::default_time;  ///< which of the above S_s comes from
+  /// `safety.stopping_data_confirmed`: the integrator has checked the closed form against the
+  /// robot; a live cell then starts without a table or limits.
+  bool stopping_data_confirmed = false;
+  /// T_r's parts beside the frame's age and controller_latency_s:
+  /// one nominal frame period (an intrusion can begin just after a capture), set from the
+  /// source's nominal rate by the SafetyMonitor; 0: not known.
+  double frame_period_s = 0.0;
+  /// `source.latency_s`: how long before its stamp the camera saw the scene (exposure,
+  /// readout); default per source type (docs/SAFETY.md).
+  double source_latency_s = 0.0;
+  /// `safety.receiver_timeout_s`: how long the receiver of the verdict keeps the last one in
+  /// force after the link goes silent (a `run` stays a `run` until then).
+  double receiver_timeout_s = 0.2;
+  /// `safety.robot_max_speed_mps`: the fastest any point of the arm can move (its safety
+  /// configuration's TCP and elbow speed limits); Z_r grows by it over the robot state's age
+  /// that extrapolation did not cover.
+  float robot_max_speed_mps = 3.0F;
 };
 
 /// What one frame gives the formula.
@@ -38,7 +83,19 @@ struct SsmInput {
   /// it moves away or stands still, which then counts as 0.
   float robot_speed_mps = 0.0F;
   float distance_uncertainty_m = 0.0F;  ///< Z_d of the contact, ≥ 0
+  /// How much older the robot state is than the frame beyond what extrapolation with its
+  /// joint velocities covered, s (≥ 0): the arm may have moved by robot_max_speed_mps × this.
+  double robot_state_gap_s = 0.0;
 };
+
+/// How the robot stops from one speed: its stopping distance and time.
+struct StopProfile {
+  double distance_m = 0.0;  ///< S_s
+  double time_s = 0.0;      ///< T_s
+};
+
+/// The robot's stop from `speed_mps` (≥ 0) by params' stopping data (stopping_data).
+StopProfile robot_stop(const SsmParams& params, double speed_mps);
 
 /// The protective separation distance S_p = S_h + S_r + S_s + C + Z_d + Z_r and its terms
 /// (`ssm` in the output), for the robot at the speed given.
@@ -48,9 +105,16 @@ struct SsmTerms {
   float s_s_m = 0.0F;  ///< the robot's stopping distance
   float c_m = 0.0F;    ///< intrusion distance of the detection capability
   float z_d_m = 0.0F;  ///< measurement uncertainty of the contact
-  float z_r_m = 0.0F;  ///< robot position uncertainty
+  float z_r_m = 0.0F;  ///< robot position uncertainty: robot_uncertainty_m + z_r_state_m
+  float z_r_state_m = 0.0F;  ///< of Z_r, the arm's possible travel over the robot state's uncovered age
   float protective_distance_m = 0.0F;  ///< their sum
-  double reaction_time_s = 0.0;        ///< T_r: frame age + controller latency
+  /// T_r = frame_age_s + frame_period_s + source_latency_s + controller_latency_s + receiver_timeout_s.
+  double reaction_time_s = 0.0;
+  double frame_age_s = 0.0;            ///< T_r's parts, s
+  double frame_period_s = 0.0;
+  double source_latency_s = 0.0;
+  double controller_latency_s = 0.0;
+  double receiver_timeout_s = 0.0;
   double stop_time_s = 0.0;            ///< T_s at this speed
 };
 
@@ -58,15 +122,27 @@ struct SsmTerms {
 /// 0). NaN in, NaN out: the caller's verdict turns it into a stop.
 SsmTerms protective_distance(const SsmParams& params, const SsmInput& input, float robot_speed_mps);
 
-/// The highest robot speed (m/s, towards the person) at which input.distance_m is still at
-/// least S_p: the root of S_p(v) = distance (linear without a deceleration, quadratic with
-/// one). Negative when even a standing robot is too close; NaN for NaN input.
+/// The highest robot speed v_a (m/s, towards the person) the robot may be given, or −1 when
+/// none: the robot keeps its present speed v_r = input.robot_speed_mps for T_r, then brakes
+/// to v_a and must still be able to stop from there. Braking to v_a and stopping from it is one
+/// braking on the robot's stopping profile, which is never shorter than a stop from v_r, so
+/// some v_a ≥ 0 fits only when distance ≥ S_p(v_r) (docs/SAFETY.md, "S_r at the present
+/// speed"); then v_a is the largest v with S_p(v) ≤ distance, which is ≥ v_r. NaN for NaN input.
 double allowed_robot_speed_mps(const SsmParams& params, const SsmInput& input);
 
+/// The speed the scale aims at: the largest v ≤ allowed_robot_speed_mps at which the next
+/// frame, one frame_period_s later, would still find the separation at S_p(v) with the person
+/// v_h·period and the robot v·period nearer: S_p(v) + (v_h + v)·period ≤ distance. It slows
+/// the robot before the separation reaches S_p at its present speed (which is a stop), so that
+/// a robot following the scale is slowed rather than stopped. Not a safety term: the stop rule
+/// is allowed_robot_speed_mps's. 0 when even v = 0 does not fit; allowed_robot_speed_mps itself
+/// without a frame period or when that is negative or NaN.
+double planned_robot_speed_mps(const SsmParams& params, const SsmInput& input);
+
 /// The fraction of the robot's present speed towards the person (taken as its programmed
-/// speed) that keeps the separation at or above S_p, in [0, 1]: 1 when the present speed
-/// already does; for a robot that stands still or moves away, 1 when the separation is at
-/// least S_p at zero speed, else 0. 0 for NaN input.
+/// speed) that takes it to planned_robot_speed_mps, in [0, 1]: 1 when the present speed is
+/// already within it, 0 when no speed keeps S_p (allowed_robot_speed_mps < 0). A robot that
+/// stands still or moves away gets 1, or 0 when even rest does not fit. 0 for NaN input.
 float ssm_speed_scale(const SsmParams& params, const SsmInput& input);
 
 /// What Z_d of one contact is made of (contact_uncertainty_m).

@@ -208,6 +208,10 @@ struct RobotState {
   /// frame's robot_state_age_ms is measured from it. 0 for a state that ages not (`fixed`); a
   /// state that is invalid with a sample time is stale rather than missing.
   int64_t sample_time_ns = 0;
+  /// Of the time from sample_time_ns to host_time_ns, how much the joints were moved on with
+  /// their velocities (RobotStateHistory::at past the newest sample), ns; the rest of the
+  /// state's age is time the arm may have moved unseen (Z_r, docs/SAFETY.md).
+  int64_t extrapolated_ns = 0;
   JointAngles q_rad{};        ///< joint angles
   JointAngles qd_rad_s{};     ///< joint velocities
   bool valid = false;         ///< false: no state (never measured, lost, rejected); the frame is a stop
@@ -247,7 +251,7 @@ enum class ReasonCode : uint16_t {
   no_robot_state = 12,      ///< stop: no valid robot state for the frame (an arm needs its joints)
   robot_state_stale = 13,   ///< stop: the newest robot state is older than robot.state.max_age_s
   foreground_failed = 14,   ///< stop: the foreground test could not run
-  stale_frame = 15,         ///< stop: when decided, delivered longer ago than the no-frame limit (no_frame's)
+  stale_frame = 15,         ///< stop: when decided, seen longer ago than the no-frame limit (no_frame's)
   no_frame = 16,            ///< stop: the watchdog saw no frame for safety.max_frame_age_s (or max_frame_gap_periods)
   source_ended = 17,        ///< stop: end of the run, the source ended
   frame_limit_reached = 18, ///< stop: end of the run, --frames reached
@@ -328,8 +332,8 @@ struct Measurement {
   /// Frame host time minus robot_state.sample_time_ns, ≥ 0; 0 for a state that ages not.
   double robot_state_age_ms = 0.0;
   /// Run-clock times of the frame, set by run_pipeline (`clocked`): when the source delivered
-  /// it (the stale limit counts from here) and when it was seen (its host time when the source
-  /// set one, else the delivery; T_r counts from here). Not clocked (a caller of
+  /// it and when it was seen (its capture on the host clock when the source set one, a live
+  /// camera's, else the delivery; T_r and the stale limit count from here). Not clocked (a caller of
   /// Pipeline::process alone): the decision takes an age of 0 and never calls it stale.
   bool clocked = false;
   int64_t delivered_ns = 0;
@@ -370,6 +374,9 @@ struct FrameResult : Measurement {
   float distance_uncertainty_m = std::numeric_limits<float>::quiet_NaN();
   /// v_r of the governing link towards its contact, m/s (negative: away); NaN when not computed.
   float robot_speed_towards_mps = std::numeric_limits<float>::quiet_NaN();
+  /// unknown_distance_m less the governing S_p (ssm) or safety.stop_distance_m (zones), m;
+  /// NaN without unknown space (`unknown_margin_m`).
+  float unknown_margin_m = std::numeric_limits<float>::quiet_NaN();
   /// Per link with a contact (`links`): its S_p at its own present speed, m; same order as
   /// Measurement::links.
   std::vector<float> link_protective_distance_m;

@@ -132,6 +132,15 @@ void read_camera_source(KeyReader& r, SourceConfig& source);
 /// error naming the key and the range.
 void read_filters(KeyReader& r, Config& config);
 
+/// Reads the robot's stopping data (`safety.stopping_table`, `safety.stopping_limits`,
+/// `safety.stopping_data_confirmed`) into config.pipeline.safety.ssm (src/config/safety_config.cpp).
+void read_stopping_data(KeyReader& r, Config& config);
+
+/// In `safety.mode: ssm`, after every key is read: the bounds that keep each watchdog on
+/// (docs/CONFIG.md, "Limits in ssm mode"), the refusal to start a live cell without stopping
+/// data unless confirmed, and config.warnings.
+void check_ssm_mode(KeyReader& r, Config& config);
+
 /// Reads `scene.objects` (a list of objects, see docs/CONFIG.md) into a Scene.
 /// `key` is the list's key, used to name items in errors ("scene.objects[1].shapes[0]").
 Scene read_scene_objects(const YAML::Node& objects, const std::string& where, const std::string& key);

@@ -52,6 +52,9 @@ void read_source_and_sim(KeyReader& r, Config& c) {
   constexpr SourceType kSourceTypes[] = {SourceType::sim, SourceType::folder, SourceType::bag, SourceType::realsense,
                                          SourceType::ros2};
   r.choice("source.type", c.source.type, kSourceTypes, source_type_name);
+  // The simulator renders at its stamp; a camera saw the scene up to an exposure earlier.
+  c.source.latency_s = c.source.type == SourceType::sim ? 0.0 : kCameraLatencyS;
+  r.number_in("source.latency_s", c.source.latency_s, 0.0, 1.0, " s");
   r.text("source.path", c.source.path);
   r.flag("source.pace", c.source.pace);
   r.flag("source.loop", c.source.loop);
@@ -201,6 +204,10 @@ void read_ssm_terms(KeyReader& r, Config& c) {
   // configuration, not a term of S_p; 0 (the default) leaves it unstated.
   r.number("safety.detection_range_m", ssm.detection_range_m, Bound::non_negative, kMaxCoordinateM);
   r.number("safety.robot_uncertainty_m", ssm.robot_uncertainty_m, Bound::non_negative, 1.0F);
+  r.number("safety.robot_max_speed_mps", ssm.robot_max_speed_mps, Bound::positive, 20.0F);
+  r.number_in("safety.receiver_timeout_s", ssm.receiver_timeout_s, 0.0, 10.0, " s");
+  ssm.source_latency_s = c.source.latency_s;
+  config_detail::read_stopping_data(r, c);  // src/config/safety_config.cpp
   // The system cannot detect what it removes as speckle (foreground.min_object_mm), and a test
   // piece of d measures less than d: the mean depth of a sphere's visible cap is nearer than its
   // outline, and edge pixels drop out (35-45 mm for 40 mm on the simulated D435, docs/SAFETY.md,
@@ -233,10 +240,10 @@ void read_safety_behaviour(KeyReader& r, Config& c) {
   }
   r.number("safety.hysteresis_m", safety.hysteresis_m, Bound::non_negative, 10.0F);
   r.number_in("safety.min_hold_s", safety.min_hold_s, 0.0, 60.0, " s");
-  std::string policy = safety.unknown_policy == SafetyParams::UnknownPolicy::stop_within_m ? "stop_within_m" : "report";
-  r.choice("safety.unknown_policy", policy, {"report", "stop_within_m"});
-  safety.unknown_policy =
-      policy == "stop_within_m" ? SafetyParams::UnknownPolicy::stop_within_m : SafetyParams::UnknownPolicy::report;
+  constexpr SafetyParams::UnknownPolicy kPolicies[] = {SafetyParams::UnknownPolicy::report,
+                                                      SafetyParams::UnknownPolicy::stop_within_m,
+                                                      SafetyParams::UnknownPolicy::stop_within_protective};
+  r.choice("safety.unknown_policy", safety.unknown_policy, kPolicies, unknown_policy_name);
   r.number("safety.unknown_stop_within_m", safety.unknown_stop_within_m, Bound::non_negative, 10.0F);
   CellCheckParams& checks = c.pipeline.checks;
   // None of the image watchdogs can be switched off by a value: 0 m would never block, a
@@ -338,6 +345,7 @@ void read_all(KeyReader& r, Config& c) {
   read_link(r, c);
   read_record(r, c);
   read_ros2(r, c);
+  config_detail::check_ssm_mode(r, c);  // after every key: it weighs keys of several sections
 }
 
 // Every key the reader knows, found by reading an empty tree (all reads are unconditional).

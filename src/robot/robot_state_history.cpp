@@ -104,6 +104,7 @@ RobotStateLookup RobotStateHistory::at(int64_t host_time_ns) const {
     state.speed_fraction = last.speed_fraction;
     for (size_t j = 0; j < kJointCount; ++j) state.q_rad[j] += last.qd_rad_s[j] * dt_s;
     out.extrapolated = dt_s > 0.0;
+    state.extrapolated_ns = std::min(age_ns, period_ns);
   } else if (host_time_ns <= sample(0).host_time_ns) {
     state.q_rad = sample(0).q_rad;
     state.qd_rad_s = sample(0).qd_rad_s;

@@ -21,9 +21,11 @@ bool stricter(VerdictState state_a, float scale_a, VerdictState state_b, float s
   return a != b ? a > b : scale_a < scale_b;
 }
 
-// A measurement delivered more than `stale_after_ns` before `now_ns` is stale.
+// A measurement seen more than `stale_after_ns` before `now_ns` is stale: from its capture
+// where the source put that on the host clock (live cameras), else from its delivery
+// (recordings and the simulator, whose stamps are not host time).
 bool is_stale(int64_t stale_after_ns, const Measurement& m, int64_t now_ns) {
-  return m.clocked && now_ns - m.delivered_ns > stale_after_ns;
+  return m.clocked && now_ns - m.seen_ns > stale_after_ns;
 }
 
 double age_s(const Measurement& m, int64_t now_ns) {
@@ -66,6 +68,7 @@ void decide_measurement(const SafetyParams& params, const Measurement& m, double
   out.governing_link = -1;
   out.distance_uncertainty_m = std::numeric_limits<float>::quiet_NaN();
   out.robot_speed_towards_mps = std::numeric_limits<float>::quiet_NaN();
+  out.unknown_margin_m = std::numeric_limits<float>::quiet_NaN();
   Verdict& verdict = out.verdict;
   if (!m.valid) {
     verdict.state = VerdictState::stop;
@@ -85,6 +88,7 @@ void decide_measurement(const SafetyParams& params, const Measurement& m, double
     const Decision d = decide_verdict(params, verdict_input(m, nullptr, frame_age_s, scale_sent), distance_margin_m);
     assign_verdict(verdict, d.verdict);
     out.ssm = d.ssm;
+    out.unknown_margin_m = d.unknown_margin_m;
     return;
   }
   float governing_slack_m = 0.0F;
@@ -108,11 +112,14 @@ void decide_measurement(const SafetyParams& params, const Measurement& m, double
       governing_slack_m = slack_m;
     }
   }
+  out.unknown_margin_m = unknown_margin_m(params, m.unknown_distance_m, verdict);
   apply_unknown_policy(params, m.unknown_distance_m, distance_margin_m, verdict);
 }
 
 SafetyMonitor::SafetyMonitor(SafetyParams params, double nominal_fps, bool frames_at_a_rate)
     : params_(std::move(params)) {
+  // T_r counts one nominal frame period: an intrusion can begin just after a capture.
+  if (nominal_fps > 0.0) params_.ssm.frame_period_s = 1.0 / nominal_fps;
   watchdog_after_ns_ = seconds_to_ns(params_.max_frame_age_s);
   std::snprintf(watchdog_rule_, sizeof watchdog_rule_, "max_frame_age_s %.3f", params_.max_frame_age_s);
   if (frames_at_a_rate && nominal_fps > 0.0) {
@@ -150,6 +157,7 @@ void SafetyMonitor::decide(FrameResult& result, int64_t now_ns) {
   result.governing_link = decision.governing_link;
   result.distance_uncertainty_m = decision.distance_uncertainty_m;
   result.robot_speed_towards_mps = decision.robot_speed_towards_mps;
+  result.unknown_margin_m = decision.unknown_margin_m;
   result.robot_speed_fraction = robot_speed_fraction(result, scale_sent);
   scale_sent_.store(result.verdict.speed_scale, std::memory_order_relaxed);  // what every link sends now
 }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace hrcsense {
 namespace {
@@ -24,72 +25,144 @@ double human_speed(const SsmParams& params, double distance_m) {
   return distance_m <= params.human_near_m ? params.human_speed_near_mps : params.human_speed_mps;
 }
 
-// S_p(v) = a + b·v + c·v²: the part that does not depend on the robot's speed, and the
-// coefficients of the part that does.
-struct Quadratic {
-  double a = 0.0, b = 0.0, c = 0.0;
-};
-
-Quadratic protective_polynomial(const SsmParams& params, const SsmInput& input) {
-  const double v_h = human_speed(params, input.distance_m);
-  const double t_r = non_negative(input.frame_age_s) + params.controller_latency_s;
-  const double t_0 = params.robot_stop_time_s;
-  const double c_m = intrusion_distance_m(params);
-  Quadratic q;
-  q.a = v_h * (t_r + t_0) + c_m + non_negative(input.distance_uncertainty_m) + params.robot_uncertainty_m;
-  if (params.robot_decel_mps2 > 0.0F) {
-    // Braking starts after t_0 and lasts v / decel: T_s = t_0 + v/decel, S_s = v·t_0 + v²/(2·decel).
-    const double decel = params.robot_decel_mps2;
-    q.b = t_r + t_0 + v_h / decel;
-    q.c = 0.5 / decel;
-  } else {
-    // Constant deceleration over the stopping time: S_s = v·t_0 / 2.
-    q.b = t_r + 0.5 * t_0;
+// The stopping table at `v` (rows in increasing speed, checked by the configuration).
+StopProfile table_stop(const std::vector<StoppingRow>& table, double v) {
+  const StoppingRow& first = table.front();
+  const StoppingRow& last = table.back();
+  if (v <= first.speed_mps) {
+    // Towards rest the distance falls to 0; the time stays the first row's (the person keeps
+    // walking while even a slow robot stops).
+    const double share = first.speed_mps > 0.0F ? v / first.speed_mps : 0.0;
+    return {first.distance_m * share, first.time_s};
   }
-  return q;
+  if (v >= last.speed_mps) {
+    // Beyond the data: braking at the last row's deceleration, never a shorter stop.
+    const double ratio = v / last.speed_mps;
+    return {last.distance_m * ratio * ratio, last.time_s * ratio};
+  }
+  size_t hi = 1;
+  while (table[hi].speed_mps < v) ++hi;
+  const StoppingRow& a = table[hi - 1];
+  const StoppingRow& b = table[hi];
+  const double w = (v - a.speed_mps) / (b.speed_mps - a.speed_mps);
+  return {a.distance_m + w * (b.distance_m - a.distance_m), a.time_s + w * (b.time_s - a.time_s)};
+}
+
+// T_r and its parts (everything the verdict waits for before the robot begins to react).
+void reaction_time(const SsmParams& params, const SsmInput& input, SsmTerms& t) {
+  t.frame_age_s = non_negative(input.frame_age_s);
+  t.frame_period_s = params.frame_period_s;
+  t.source_latency_s = params.source_latency_s;
+  t.controller_latency_s = params.controller_latency_s;
+  t.receiver_timeout_s = params.receiver_timeout_s;
+  t.reaction_time_s =
+      t.frame_age_s + t.frame_period_s + t.source_latency_s + t.controller_latency_s + t.receiver_timeout_s;
+}
+
+// S_p with the robot at `v` (≥ 0) before it reacts and stopping from there, without the terms'
+// breakdown: what the allowed speed is solved for.
+double protective_at(const SsmParams& params, const SsmInput& input, const SsmTerms& fixed, double v) {
+  const StopProfile stop = robot_stop(params, v);
+  const double v_h = human_speed(params, input.distance_m);
+  return v_h * (fixed.reaction_time_s + stop.time_s) + v * fixed.reaction_time_s + stop.distance_m + fixed.c_m +
+         fixed.z_d_m + fixed.z_r_m;
 }
 
 }  // namespace
+
+const char* stopping_data_name(StoppingData data) {
+  switch (data) {
+    case StoppingData::default_time: return "default";
+    case StoppingData::table: return "table";
+    case StoppingData::limits: return "limits";
+  }
+  return "default";
+}
+
+StopProfile robot_stop(const SsmParams& params, double speed_mps) {
+  const double v = non_negative(speed_mps);
+  if (std::isnan(v)) return {v, v};
+  if (!params.stopping_table.empty()) return table_stop(params.stopping_table, v);
+  if (params.stopping_limit_distance_m > 0.0F) {
+    // The robot's safety system stops it within these whatever its speed.
+    return {params.stopping_limit_distance_m, params.stopping_limit_time_s};
+  }
+  const double t_0 = params.robot_stop_time_s;
+  if (params.robot_decel_mps2 > 0.0F) {
+    // Braking starts after t_0 and lasts v / decel.
+    const double decel = params.robot_decel_mps2;
+    return {v * t_0 + v * v / (2.0 * decel), t_0 + v / decel};
+  }
+  // Constant deceleration over the stopping time.
+  return {0.5 * v * t_0, t_0};
+}
 
 SsmTerms protective_distance(const SsmParams& params, const SsmInput& input, float robot_speed_mps) {
   const double v_r = non_negative(robot_speed_mps);
   const double v_h = human_speed(params, input.distance_m);
   SsmTerms t;
-  t.reaction_time_s = non_negative(input.frame_age_s) + params.controller_latency_s;
-  const double t_0 = params.robot_stop_time_s;
-  double s_s = 0.0;
-  if (params.robot_decel_mps2 > 0.0F) {
-    t.stop_time_s = t_0 + v_r / params.robot_decel_mps2;
-    s_s = v_r * t_0 + v_r * v_r / (2.0 * params.robot_decel_mps2);
-  } else {
-    t.stop_time_s = t_0;
-    s_s = 0.5 * v_r * t_0;
-  }
+  reaction_time(params, input, t);
+  const StopProfile stop = robot_stop(params, v_r);
+  t.stop_time_s = stop.time_s;
   t.s_h_m = static_cast<float>(v_h * (t.reaction_time_s + t.stop_time_s));
   t.s_r_m = static_cast<float>(v_r * t.reaction_time_s);
-  t.s_s_m = static_cast<float>(s_s);
+  t.s_s_m = static_cast<float>(stop.distance_m);
   t.c_m = static_cast<float>(intrusion_distance_m(params));
   t.z_d_m = static_cast<float>(non_negative(input.distance_uncertainty_m));
-  t.z_r_m = params.robot_uncertainty_m;
+  t.z_r_state_m = static_cast<float>(params.robot_max_speed_mps * non_negative(input.robot_state_gap_s));
+  t.z_r_m = params.robot_uncertainty_m + t.z_r_state_m;
   t.protective_distance_m = t.s_h_m + t.s_r_m + t.s_s_m + t.c_m + t.z_d_m + t.z_r_m;
   return t;
 }
 
 double allowed_robot_speed_mps(const SsmParams& params, const SsmInput& input) {
-  const Quadratic q = protective_polynomial(params, input);
-  const double room = static_cast<double>(input.distance_m) - q.a;  // what is left for the robot's own terms
-  if (!(room >= 0.0)) return std::isnan(room) ? room : room / q.b;  // too close even at rest: negative
-  if (q.c == 0.0) return room / q.b;
-  // c·v² + b·v − room = 0, the positive root, written to avoid cancellation.
-  return 2.0 * room / (q.b + std::sqrt(q.b * q.b + 4.0 * q.c * room));
+  const double d = input.distance_m;
+  const double v_r = non_negative(input.robot_speed_mps);
+  const SsmTerms at_present = protective_distance(params, input, static_cast<float>(v_r));
+  if (std::isnan(d) || std::isnan(at_present.protective_distance_m)) return std::numeric_limits<double>::quiet_NaN();
+  // Braking from v_r to any v_a and stopping from v_a is one braking on the robot's profile,
+  // never shorter than the stop from v_r itself: below S_p(v_r) no speed helps.
+  if (!(d >= at_present.protective_distance_m)) return -1.0;
+  // The largest v with S_p(v) ≤ d; S_p grows with v (the stopping data grow with speed), so
+  // bisection between v_r, which fits, and a speed that does not.
+  double lo = v_r;
+  double hi = std::max(1.0, 2.0 * v_r);
+  for (int k = 0; k < 16 && protective_at(params, input, at_present, hi) <= d; ++k) hi *= 2.0;
+  if (protective_at(params, input, at_present, hi) <= d) return hi;  // beyond any arm's speed
+  for (int k = 0; k < 100 && hi - lo > 1e-12 * hi; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (protective_at(params, input, at_present, mid) <= d ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+double planned_robot_speed_mps(const SsmParams& params, const SsmInput& input) {
+  const double allowed = allowed_robot_speed_mps(params, input);
+  const double period_s = params.frame_period_s;
+  if (!(allowed >= 0.0) || !(period_s > 0.0)) return allowed;
+  // The next frame must find the robot at v clear of S_p(v) after the person came v_h·period
+  // nearer and the robot v·period: S_p(v) + (v_h + v)·period ≤ d, which grows with v.
+  const SsmTerms fixed = protective_distance(params, input, 0.0F);
+  const double v_h = human_speed(params, input.distance_m);
+  const double d = input.distance_m;
+  const auto fits = [&](double v) { return protective_at(params, input, fixed, v) + (v_h + v) * period_s <= d; };
+  if (!fits(0.0)) return 0.0;
+  if (fits(allowed)) return allowed;
+  double lo = 0.0;
+  double hi = allowed;
+  for (int k = 0; k < 100 && hi - lo > 1e-12 * hi; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (fits(mid) ? lo : hi) = mid;
+  }
+  return lo;
 }
 
 float ssm_speed_scale(const SsmParams& params, const SsmInput& input) {
-  const double allowed = allowed_robot_speed_mps(params, input);
-  if (!(allowed >= 0.0)) return 0.0F;  // too close at rest, or NaN
+  const double allowed = planned_robot_speed_mps(params, input);
+  if (!(allowed >= 0.0)) return 0.0F;  // no speed keeps S_p, or NaN
   const double v_r = input.robot_speed_mps;
   if (std::isnan(v_r)) return 0.0F;  // an unknown speed is no proof of a slow robot
-  if (!(v_r > 0.0)) return 1.0F;     // standing still or moving away, and far enough at rest
+  if (!(v_r > 0.0)) return 1.0F;     // standing still or moving away, and far enough
   return static_cast<float>(std::min(1.0, allowed / v_r));
 }
 

@@ -73,25 +73,32 @@ Verdict ssm_verdict(const SafetyParams& params, const VerdictInput& input, float
   ssm.frame_age_s = input.frame_age_s;
   ssm.robot_speed_mps = input.robot_speed_towards_mps;
   ssm.distance_uncertainty_m = input.distance_uncertainty_m;
+  ssm.robot_state_gap_s = input.robot_state_gap_s;
   terms = protective_distance(params.ssm, ssm, input.robot_speed_towards_mps);
-  const float at_rest_m = protective_distance(params.ssm, ssm, 0.0F).protective_distance_m;
-  // NaN anywhere (an unknown speed or uncertainty) fails these comparisons: a stop.
-  if (!std::isfinite(terms->protective_distance_m) || !std::isfinite(input.robot_speed_towards_mps) ||
-      !(distance_m >= at_rest_m)) {
-    const bool bad = !std::isfinite(terms->protective_distance_m) || !std::isfinite(input.robot_speed_towards_mps);
+  // NaN anywhere (an unknown speed or uncertainty) is a stop.
+  if (!std::isfinite(terms->protective_distance_m) || !std::isfinite(input.robot_speed_towards_mps)) {
+    return make_verdict(VerdictState::stop, 0.0F, terms->protective_distance_m, ReasonCode::non_finite_input,
+                        "invalid ssm input");
+  }
+  // Below S_p at the present speed no speed helps: the robot has not reacted yet, and braking
+  // to any lower speed is never shorter than stopping (docs/SAFETY.md).
+  const double allowed = allowed_robot_speed_mps(params.ssm, ssm);
+  if (!(allowed >= 0.0)) {
     return make_verdict(VerdictState::stop, 0.0F, terms->protective_distance_m,
-                        bad ? ReasonCode::non_finite_input : ReasonCode::below_protective_distance,
-                        bad ? "invalid ssm input" : "below S_p");
+                        ReasonCode::below_protective_distance, "below S_p");
   }
   float scale = ssm_speed_scale(params.ssm, ssm);
+  const double planned = planned_robot_speed_mps(params.ssm, ssm);  // ≤ allowed: slows before a stop
   // The scale is of the programmed speed: the robot runs at robot_speed_scaling of it now (the
-  // slider we set earlier times the controller's own reduction). Below 1 % the present speed
-  // says too little about the programmed one, and the present speed counts as programmed.
+  // slider we set earlier times the controller's own reduction). Below 1 % (a robot we stopped,
+  // or one paused) the present speed says nothing of the programmed one, and the arm's fastest,
+  // robot_max_speed_mps, counts: told 1, it could resume at any speed.
   const double running = input.robot_speed_scaling;
   if (running > 0.01 && running < 1.0 && input.robot_speed_towards_mps > 0.0F) {
-    const double allowed = allowed_robot_speed_mps(params.ssm, ssm);
     const double programmed_mps = input.robot_speed_towards_mps / running;
-    scale = static_cast<float>(std::clamp(allowed / programmed_mps, 0.0, 1.0));
+    scale = static_cast<float>(std::clamp(planned / programmed_mps, 0.0, 1.0));
+  } else if (!(running > 0.01)) {
+    scale = static_cast<float>(std::clamp(planned / params.ssm.robot_max_speed_mps, 0.0, 1.0));
   }
   if (scale >= 1.0F) {
     return make_verdict(VerdictState::run, 1.0F, terms->protective_distance_m, ReasonCode::clear, "clear");
@@ -126,7 +133,13 @@ VerdictInput verdict_input(const Measurement& m, const LinkContact* link, double
   input.unknown_distance_m = m.unknown_distance_m;
   input.frame_age_s = frame_age_s;
   input.robot_speed_scaling = robot_speed_fraction(m, scale_sent);
+  input.robot_state_gap_s = robot_state_gap_s(m);
   return input;
+}
+
+double robot_state_gap_s(const Measurement& m) {
+  const double gap_s = m.robot_state_age_ms * 1e-3 - static_cast<double>(m.robot_state.extrapolated_ns) * 1e-9;
+  return gap_s > 0.0 ? gap_s : 0.0;
 }
 
 Decision decide_verdict(const SafetyParams& params, const VerdictInput& input, float distance_margin_m) {
@@ -147,16 +160,31 @@ Decision decide_verdict(const SafetyParams& params, const VerdictInput& input, f
     SsmInput far;
     far.distance_m = std::numeric_limits<float>::infinity();
     far.frame_age_s = input.frame_age_s;
+    far.robot_state_gap_s = input.robot_state_gap_s;
     decision.verdict.protective_distance_m = protective_distance(params.ssm, far, 0.0F).protective_distance_m;
   }
+  decision.unknown_margin_m = unknown_margin_m(params, input.unknown_distance_m, decision.verdict);
   apply_unknown_policy(params, input.unknown_distance_m, distance_margin_m, decision.verdict);
   return decision;
 }
 
+float unknown_margin_m(const SafetyParams& params, float unknown_distance_m, const Verdict& verdict) {
+  const float protective_m =
+      params.mode == SafetyParams::Mode::ssm ? verdict.protective_distance_m : params.stop_distance_m;
+  return unknown_distance_m - protective_m;  // NaN without unknown space
+}
+
 void apply_unknown_policy(const SafetyParams& params, float unknown_distance_m, float distance_margin_m,
                           Verdict& verdict) {
-  if (params.unknown_policy == SafetyParams::UnknownPolicy::stop_within_m &&
-      unknown_distance_m <= params.unknown_stop_within_m + distance_margin_m && verdict.state != VerdictState::stop) {
+  if (verdict.state == VerdictState::stop) return;
+  bool stop = false;
+  if (params.unknown_policy == SafetyParams::UnknownPolicy::stop_within_m) {
+    stop = unknown_distance_m <= params.unknown_stop_within_m + distance_margin_m;
+  } else if (params.unknown_policy == SafetyParams::UnknownPolicy::stop_within_protective) {
+    // NaN (no unknown space) fails the comparison: nothing hidden, no stop.
+    stop = unknown_margin_m(params, unknown_distance_m, verdict) < distance_margin_m;
+  }
+  if (stop) {
     verdict = make_verdict(VerdictState::stop, 0.0F, verdict.protective_distance_m, ReasonCode::unknown_space,
                            "unknown space");
   }
@@ -259,6 +287,15 @@ int verdict_strictness(VerdictState state) {
     case VerdictState::stop: return 2;
   }
   return 2;
+}
+
+const char* unknown_policy_name(SafetyParams::UnknownPolicy policy) {
+  switch (policy) {
+    case SafetyParams::UnknownPolicy::report: return "report";
+    case SafetyParams::UnknownPolicy::stop_within_m: return "stop_within_m";
+    case SafetyParams::UnknownPolicy::stop_within_protective: return "stop_within_protective";
+  }
+  return "report";
 }
 
 const char* verdict_name(VerdictState state) {

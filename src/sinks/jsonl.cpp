@@ -124,7 +124,16 @@ void put_ssm(Members& m, const std::optional<SsmTerms>& ssm) {
   m.number("c_m", ssm->c_m);
   m.number("z_d_m", ssm->z_d_m);
   m.number("z_r_m", ssm->z_r_m);
+  m.number("z_r_state_m", ssm->z_r_state_m);
   m.number("reaction_time_s", ssm->reaction_time_s);
+  // T_r's parts, which add up to reaction_time_s (docs/SAFETY.md, "T_r: every latency").
+  m.open("reaction_time_parts");
+  m.number("frame_age_s", ssm->frame_age_s);
+  m.number("frame_period_s", ssm->frame_period_s);
+  m.number("source_latency_s", ssm->source_latency_s);
+  m.number("controller_latency_s", ssm->controller_latency_s);
+  m.number("receiver_timeout_s", ssm->receiver_timeout_s);
+  m.close();
   m.number("stop_time_s", ssm->stop_time_s);
   m.close();
 }
@@ -259,6 +268,7 @@ void JsonLinesSink::header(const RunHeader& header) {
     m.text("robot_state", header.robot_state);
     m.texts("robot_state_reports", header.robot_state_reports);
   }
+  m.text_or_null("stopping_data", header.stopping_data);
   robot_status_announced_ = std::find(header.robot_state_reports.begin(), header.robot_state_reports.end(),
                                       "robot_status") != header.robot_state_reports.end();
   m.number_or_null("unknown_background_share", header.unknown_background_share >= 0.0,
@@ -295,6 +305,7 @@ void JsonLinesSink::frame(const FrameResult& result) {
   // that stand for no frame).
   m.number_or_null("robot_speed_fraction", std::isfinite(result.robot_speed_fraction), result.robot_speed_fraction);
   m.number_or_null("unknown_distance_m", std::isfinite(result.unknown_distance_m), result.unknown_distance_m);
+  m.number_or_null("unknown_margin_m", std::isfinite(result.unknown_margin_m), result.unknown_margin_m);
   put_links(m, result);
   put_contact(m, contact);
   // The backend that searched (auto's pick), else the configured one.

@@ -185,12 +185,13 @@ TEST_F(BackgroundReference, TheEmptyCellIsAcceptedAtOnce) {
 }
 
 // How near the robot a blob refuses the background: the slow distance in zones mode, S_p at
-// rest in ssm mode (walking speed, frame age 0, Z_d 0: 1.6 · (0.05 + 0.5) + 0.208 + 0.01).
+// rest in ssm mode (walking speed, frame age 0, Z_d 0, the receiver's 0.2 s timeout in T_r:
+// 1.6 · (0.05 + 0.2 + 0.5) + 0.208 + 0.01).
 TEST(BackgroundReferenceLimit, ZonesSlowDistanceOrProtectiveDistanceAtRest) {
   const Config zones = load_config("", {"safety.slow_distance_m=1.3"});
   EXPECT_FLOAT_EQ(Pipeline(zones.pipeline).reference_distance_m(), 1.3F);
   const Config ssm = load_config("", {"safety.mode=ssm"});
-  EXPECT_NEAR(Pipeline(ssm.pipeline).reference_distance_m(), 1.6 * 0.55 + 0.208 + 0.01, 1e-5);
+  EXPECT_NEAR(Pipeline(ssm.pipeline).reference_distance_m(), 1.6 * 0.75 + 0.208 + 0.01, 1e-5);
 }
 
 // Reason code 31, its name, and a datagram that carries it is one the reference decoder takes.

@@ -31,17 +31,22 @@ namespace {
 
 using test::scene_path;
 
-// The moving UR5 cell with the person standing 2.25 m to the side of the base from frame 100
+// The moving UR5 cell with the person standing 2.4 m to the side of the base from frame 100
 // on, where the wrist's swing comes towards them at up to ≈ 1 m/s, and the arm following the
 // link. `hold` false: safety.min_hold_s and hysteresis_m 0, so that each frame's scale reaches
 // the arm at once (the hold would hide a wrong scale for up to min_hold_s).
 Config closed_loop_cell(bool hold) {
-  std::vector<std::string> overrides{"robot.trajectory.follow_link=true"};
+  // Without the receiver's silence timeout, so that T_r is the controller's latency and one
+  // frame period (a 0.2 s timeout widens S_p at rest by 0.32 m, and the person would stop the
+  // arm throughout: docs/SAFETY.md's availability table). Before S2 (T_r without the frame
+  // period, no look-ahead in the scale) the person stood at 2.25 m; there the frame period and
+  // the look-ahead leave the wrist no room to move.
+  std::vector<std::string> overrides{"robot.trajectory.follow_link=true", "safety.receiver_timeout_s=0"};
   if (!hold) overrides.insert(overrides.end(), {"safety.min_hold_s=0", "safety.hysteresis_m=0"});
   Config config = load_config(scene_path("cell-ur5-moving.yaml"), overrides);
   for (SceneObject& object : config.scene.objects) {
     if (object.name != "person") continue;
-    object.path = {{0.0, Eigen::Vector3f(0.0F, -2.25F, -0.75F)}};
+    object.path = {{0.0, Eigen::Vector3f(0.0F, -2.4F, -0.75F)}};
     object.last_frame = -1;
   }
   return config;
@@ -79,7 +84,7 @@ LoopCounts run_closed_loop(const Config& config, int64_t closed_from, int64_t fr
   Simulator sim = make_simulator(config, clock);
   const std::unique_ptr<RobotStateSource> states = make_robot_state_source(config, nullptr, clock);
   Pipeline pipeline(config.pipeline);
-  SafetyMonitor monitor(config.pipeline.safety);
+  SafetyMonitor monitor(config.pipeline.safety, config.sim.fps);  // T_r and the scale count a frame period
   const SsmParams& ssm = config.pipeline.safety.ssm;
   const double period_s = 1.0 / config.sim.fps;
   // In process every frame is decided at an age of 0: T_r is the controller latency alone.

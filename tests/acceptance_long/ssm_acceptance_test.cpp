@@ -125,16 +125,18 @@ TEST(SsmAcceptance, MovingCellNeverLaxerThanTheTruthAllows) {
   EXPECT_EQ(count.too_lax, 0);
 }
 
-// The person standing still 1.7 m to the side of the base (offset [0, -1.7]) from frame 100 on,
-// beside the wrist's swing: the single closest pair was often a slow part of the arm while the
-// fast wrist was inside its own S_p (19 of 61 `run` frames before S1). Safe per link, and
-// still available: `run` frames remain where the person is beyond every link's S_p.
+// The person standing still to the side of the base from frame 100 on, beside the wrist's
+// swing: the single closest pair was often a slow part of the arm while the fast wrist was
+// inside its own S_p (at 1.7 m, 19 of 61 `run` frames before S1). Safe per link, and still
+// available: `run` frames remain where the person is beyond every link's S_p. Since S2's T_r
+// (the receiver's 0.2 s timeout, a frame period) S_p at rest is 0.37 m wider and the wrist at
+// its present speed is a stop, so the person stands at 2.4 m (1.7 m leaves no `run`).
 TEST(SsmAcceptance, PersonStandingBesideTheFastWristNeverLaxerThanTheTruth) {
   Config config = load_config(scene_path("cell-ur5-moving.yaml"), {});
   bool moved = false;
   for (SceneObject& object : config.scene.objects) {
     if (object.name != "person") continue;
-    object.path = {{0.0, Eigen::Vector3f(0.0F, -1.7F, -0.75F)}};
+    object.path = {{0.0, Eigen::Vector3f(0.0F, -2.4F, -0.75F)}};
     object.last_frame = -1;
     moved = true;
   }

@@ -17,8 +17,9 @@ namespace {
 using test::expect_config_error;
 using test::TempDir;
 
+// The closed-form stopping data confirmed: a live cell is refused without (safety_config_test.cpp).
 constexpr const char* kSliderInSsm = R"(robot: {state: {host: 127.0.0.1}}
-safety: {mode: ssm}
+safety: {mode: ssm, stopping_data_confirmed: true}
 link: {rtde: {write: speed_slider}}
 )";
 
@@ -51,7 +52,7 @@ TEST(RtdeSliderConfig, AcknowledgedSliderInSsmModeLoads) {
 TEST(RtdeSliderConfig, DefaultIsFalseAndOtherCombinationsNeedNoAcknowledgement) {
   EXPECT_FALSE(LinkConfig{}.rtde_slider_unguarded_ok);
   EXPECT_FALSE(load_config("", {}).link.rtde_slider_unguarded_ok);
-  const std::vector<std::string> host = {"robot.state.host=127.0.0.1"};
+  const std::vector<std::string> host = {"robot.state.host=127.0.0.1", "safety.stopping_data_confirmed=true"};
   const auto with = [&](std::vector<std::string> extra) {
     extra.insert(extra.begin(), host.begin(), host.end());
     return load_config("", extra);

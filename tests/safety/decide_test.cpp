@@ -18,10 +18,12 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 // deceleration; C = 8·(40 − 14) mm = 0.208 m; Z_r 0.01 m), no hold. Each frame is 0.05 s old
 // (T_r = 0.1 s) with Z_d 0.02 m. S_p at rest, farther than 0.5 m:
 // 1.6·(0.1 + 0.5) + 0.208 + 0.02 + 0.01 = 1.198 m. A robot moving towards the person at v
-// adds v·T_r + v·T_s/2 = 0.35·v.
+// adds v·T_r + v·T_s/2 = 0.35·v. The receiver's timeout, a part of T_r of its own, is 0 here
+// (its table test is in ssm_test.cpp).
 SafetyParams ssm_params() {
   SafetyParams p;
   p.mode = SafetyParams::Mode::ssm;
+  p.ssm.receiver_timeout_s = 0.0;
   return p;
 }
 
@@ -61,12 +63,13 @@ TEST(DecideVerdict, SsmStopsBelowTheProtectiveDistanceAtRest) {
   EXPECT_NEAR(near.ssm->protective_distance_m, 1.438, 1e-5);
 }
 
-TEST(DecideVerdict, SsmMovingRobotSlowsToTheScaleThatKeepsTheDistance) {
-  // At 1.373 m the robot may approach at (1.373 − 1.198) / 0.35 = 0.5 m/s: half its 1 m/s.
+TEST(DecideVerdict, SsmMovingRobotStopsBelowTheProtectiveDistanceAtItsPresentSpeed) {
+  // At 1.373 m a robot at 1 m/s towards the person: S_p(1) = 1.198 + 0.35 = 1.548 m. The old
+  // rule slowed it to (1.373 − 1.198) / 0.35 = 0.5 m/s; but it keeps 1 m/s for T_r, and braking
+  // to 0.5 m/s then stopping is no shorter than stopping from 1 m/s: a stop.
   const Decision d = decide_verdict(ssm_params(), frame(1.373F, 1.0F));
-  EXPECT_EQ(d.verdict.state, VerdictState::slow);
-  EXPECT_EQ(d.verdict.code, ReasonCode::speed_limited);
-  EXPECT_NEAR(d.verdict.speed_scale, 0.5, 1e-4);
+  EXPECT_EQ(d.verdict.state, VerdictState::stop);
+  EXPECT_EQ(d.verdict.code, ReasonCode::below_protective_distance);
   // The terms are at the present speed: S_r = 1·0.1, S_s = 1·0.5/2; S_p = 1.548 m.
   EXPECT_NEAR(d.ssm->s_r_m, 0.1, 1e-6);
   EXPECT_NEAR(d.ssm->s_s_m, 0.25, 1e-6);
@@ -78,18 +81,22 @@ TEST(DecideVerdict, SsmMovingRobotSlowsToTheScaleThatKeepsTheDistance) {
 }
 
 TEST(DecideVerdict, SsmScaleIsOfTheProgrammedSpeed) {
-  // At 1.373 m the robot may approach at 0.5 m/s. It moves at 0.5 m/s now, but at half its
-  // programmed speed (speed_scaling 0.5: a slider set earlier): programmed 1 m/s, so the scale
-  // is 0.5 of the programmed speed, not the 1.0 the present speed alone would give.
-  VerdictInput in = frame(1.373F, 0.5F);
+  // At 1.3765 m the robot may approach at up to (1.3765 − 1.198) / 0.35 = 0.51 m/s. It moves at
+  // 0.5 m/s now (S_p(0.5) = 1.373 m: it may go on), but at half its programmed speed
+  // (speed_scaling 0.5: a slider set earlier): programmed 1 m/s, so the scale is 0.51 of the
+  // programmed speed, not the 1.0 the present speed alone would give.
+  VerdictInput in = frame(1.3765F, 0.5F);
   EXPECT_EQ(decide_verdict(ssm_params(), in).verdict.state, VerdictState::run);  // scaling unknown
   in.robot_speed_scaling = 0.5;
   const Decision d = decide_verdict(ssm_params(), in);
   EXPECT_EQ(d.verdict.state, VerdictState::slow);
-  EXPECT_NEAR(d.verdict.speed_scale, 0.5, 1e-4);
+  EXPECT_NEAR(d.verdict.speed_scale, 0.51, 1e-4);
   // Far enough for the programmed speed too (1.198 + 0.35·1.0 = 1.548 m): run.
   in.contact.distance_m = 1.56F;
   EXPECT_EQ(decide_verdict(ssm_params(), in).verdict.state, VerdictState::run);
+  // Nearer than S_p at the present speed (1.373 m): no scale helps, a stop.
+  in.contact.distance_m = 1.37F;
+  EXPECT_EQ(decide_verdict(ssm_params(), in).verdict.code, ReasonCode::below_protective_distance);
 }
 
 TEST(DecideVerdict, SsmUnknownSpeedOrUncertaintyStops) {
@@ -137,6 +144,61 @@ TEST(DecideVerdict, UnknownSpaceStopsWithinItsDistanceUnderThePolicy) {
   EXPECT_EQ(decide_verdict(p, in).verdict.state, VerdictState::run);
   in.unknown_distance_m = kNaN;  // none known
   EXPECT_EQ(decide_verdict(p, in).verdict.state, VerdictState::run);
+}
+
+// unknown_margin_m = unknown distance − S_p of the verdict (ssm) or the stop distance (zones).
+// A standing robot, a person at 3 m: S_p = 1.198 m. Unknown space 1.5 m from the robot: margin
+// 0.302 m, so stop_within_protective runs; at 1.1 m the margin is −0.098 m: a stop. The same
+// unknown space at 0.2 m is beyond stop_within_m's 0.1 m: stop_within_m would run there.
+TEST(DecideVerdict, UnknownSpaceAgainstTheProtectiveDistance) {
+  SafetyParams p = ssm_params();
+  VerdictInput in = frame(3.0F, 0.0F);
+  in.unknown_distance_m = 1.5F;
+  Decision d = decide_verdict(p, in);
+  EXPECT_EQ(d.verdict.state, VerdictState::run);  // report: only reported
+  EXPECT_NEAR(d.unknown_margin_m, 0.302, 1e-5);
+  p.unknown_policy = SafetyParams::UnknownPolicy::stop_within_protective;
+  EXPECT_EQ(decide_verdict(p, in).verdict.state, VerdictState::run);
+  in.unknown_distance_m = 1.1F;
+  d = decide_verdict(p, in);
+  EXPECT_NEAR(d.unknown_margin_m, -0.098, 1e-5);
+  EXPECT_EQ(d.verdict.state, VerdictState::stop);
+  EXPECT_EQ(d.verdict.code, ReasonCode::unknown_space);
+  EXPECT_NEAR(d.verdict.protective_distance_m, 1.198, 1e-5);  // the stop keeps the S_p it was judged by
+  // A robot moving at 1 m/s towards the contact at 3 m: S_p = 1.548 m; the same 1.5 m of
+  // unknown space is now within it.
+  VerdictInput moving = frame(3.0F, 1.0F);
+  moving.unknown_distance_m = 1.5F;
+  d = decide_verdict(p, moving);
+  EXPECT_NEAR(d.unknown_margin_m, -0.048, 1e-5);
+  EXPECT_EQ(d.verdict.code, ReasonCode::unknown_space);
+  // With the hysteresis as the margin (VerdictHold's test): 1.6 m (margin 0.052 m) clears
+  // 0.05 m, 1.59 m (0.042 m) does not.
+  moving.unknown_distance_m = 1.6F;
+  EXPECT_EQ(decide_verdict(p, moving, 0.05F).verdict.code, ReasonCode::clear);
+  moving.unknown_distance_m = 1.59F;  // margin 0.042 m < 0.05 m
+  EXPECT_EQ(decide_verdict(p, moving, 0.05F).verdict.code, ReasonCode::unknown_space);
+  // No unknown space: no margin, no stop.
+  moving.unknown_distance_m = kNaN;
+  d = decide_verdict(p, moving);
+  EXPECT_TRUE(std::isnan(d.unknown_margin_m));
+  EXPECT_EQ(d.verdict.state, VerdictState::run);
+  // Nobody in the cell: S_p at rest for a person at walking speed (1.198 m with Z_d 0: 1.178 m).
+  VerdictInput empty = frame(0.0F, 0.0F);
+  empty.contact.valid = false;
+  empty.foreground_points = 0;
+  empty.unknown_distance_m = 1.0F;
+  d = decide_verdict(p, empty);
+  EXPECT_NEAR(d.unknown_margin_m, 1.0 - 1.178, 1e-5);
+  EXPECT_EQ(d.verdict.code, ReasonCode::unknown_space);
+  // Zones mode: against the stop distance, 0.5 m.
+  SafetyParams zones;
+  zones.unknown_policy = SafetyParams::UnknownPolicy::stop_within_protective;
+  VerdictInput far = frame(3.0F, 0.0F);
+  far.unknown_distance_m = 0.45F;
+  d = decide_verdict(zones, far);
+  EXPECT_NEAR(d.unknown_margin_m, -0.05, 1e-6);
+  EXPECT_EQ(d.verdict.code, ReasonCode::unknown_space);
 }
 
 // Zones mode (stop 0.5 m, slow 1.0 m) with a hysteresis of 0.05 m and a hold of 0.5 s; one

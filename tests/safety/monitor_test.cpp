@@ -16,10 +16,12 @@ namespace {
 // The ssm defaults: v_h 1.6 m/s beyond 0.5 m; controller latency 0.05 s; T_s 0.5 s without a
 // deceleration (S_s = v·T_s/2); C = 8·(40 − 14) mm = 0.208 m; Z_r 0.01 m. At an age of 0 T_r is
 // 0.05 s, so with Z_d 0.02 m S_p(v) = 1.6·0.55 + 0.208 + 0.02 + 0.01 + v·(0.05 + 0.25)
-// = 1.118 + 0.3·v.
+// = 1.118 + 0.3·v. The receiver's timeout, a part of T_r of its own, is 0 here (its table test
+// is in ssm_test.cpp), and without a nominal rate there is no frame period in T_r.
 SafetyParams ssm_mode() {
   SafetyParams p;
   p.mode = SafetyParams::Mode::ssm;
+  p.ssm.receiver_timeout_s = 0.0;
   return p;
 }
 
@@ -49,16 +51,15 @@ FrameResult measured(std::initializer_list<LinkContact> links) {
 }
 
 // The case: a still base closest (1.3 m) and a fast wrist a little farther (1.5 m,
-// 1.5 m/s towards the person). Base: S_p = 1.118 m, cleared: run. Wrist: S_p = 1.118 + 0.45 =
-// 1.568 m > 1.5 m, but at rest 1.118 m < 1.5 m: slow, allowed speed (1.5 − 1.118) / 0.3 =
-// 1.27333 m/s, scale 1.27333 / 1.5 = 0.848889. The wrist governs; the overall pair stays the base's.
+// 1.5 m/s towards the person). Base: S_p = 1.118 m, cleared: run. Wrist: S_p at its present
+// speed = 1.118 + 0.45 = 1.568 m > 1.5 m: it has not reacted yet, and no braking is shorter
+// than its stop, so stop. The wrist governs; the overall pair stays the base's.
 TEST(SafetyMonitor, AFastFartherLinkGovernsOverAStillCloserOne) {
   SafetyMonitor monitor(ssm_mode());
   FrameResult r = measured({link(0, 1.3F, 0.0F), link(5, 1.5F, 1.5F)});
   monitor.decide(r, 0);
-  EXPECT_EQ(r.verdict.state, VerdictState::slow);
-  EXPECT_EQ(r.verdict.code, ReasonCode::speed_limited);
-  EXPECT_NEAR(r.verdict.speed_scale, 0.848889, 1e-5);
+  EXPECT_EQ(r.verdict.state, VerdictState::stop);
+  EXPECT_EQ(r.verdict.code, ReasonCode::below_protective_distance);
   EXPECT_EQ(r.governing_link, 5);
   EXPECT_NEAR(r.verdict.protective_distance_m, 1.568, 1e-5);
   EXPECT_FLOAT_EQ(r.robot_speed_towards_mps, 1.5F);
@@ -68,6 +69,26 @@ TEST(SafetyMonitor, AFastFartherLinkGovernsOverAStillCloserOne) {
   EXPECT_NEAR(r.link_protective_distance_m[1], 1.568, 1e-5);
   ASSERT_TRUE(r.ssm.has_value());
   EXPECT_NEAR(r.ssm->s_r_m, 1.5 * 0.05, 1e-6);
+}
+
+// The same wrist already slowed to half its programmed 1.5 m/s (0.75 m/s, speed fraction 0.5):
+// S_p(0.75) = 1.118 + 0.225 = 1.343 m ≤ 1.5 m, so it may go on, up to (1.5 − 1.118) / 0.3 =
+// 1.27333 m/s: slow at 1.27333 / 1.5 = 0.848889 of the programmed speed.
+FrameResult slowed_wrist() {
+  FrameResult r = measured({link(0, 1.3F, 0.0F), link(5, 1.5F, 0.75F)});
+  r.robot_state.speed_fraction = 0.5;
+  return r;
+}
+
+TEST(SafetyMonitor, ASlowedFartherLinkGovernsWithItsScale) {
+  SafetyMonitor monitor(ssm_mode());
+  FrameResult r = slowed_wrist();
+  monitor.decide(r, 0);
+  EXPECT_EQ(r.verdict.state, VerdictState::slow);
+  EXPECT_EQ(r.verdict.code, ReasonCode::speed_limited);
+  EXPECT_NEAR(r.verdict.speed_scale, 0.848889, 1e-5);
+  EXPECT_EQ(r.governing_link, 5);
+  EXPECT_NEAR(r.verdict.protective_distance_m, 1.343, 1e-5);
 }
 
 // When every link clears its S_p the verdict is run, and the link with the least slack
@@ -147,6 +168,58 @@ TEST(SafetyMonitor, OlderThanTheWatchdogLimitIsStale) {
   }
 }
 
+// A live camera's frame is stale from its capture (seen_ns, on the host clock), not from its
+// delivery: captured 80 ms ago but delivered 10 ms ago, at 30 frames/s (limit 66.7 ms), it is a
+// stop. A recording's or the simulator's frame has no capture time on the host clock (seen_ns is
+// its delivery) and keeps the delivery rule.
+TEST(SafetyMonitor, ALiveFrameIsStaleFromItsCapture) {
+  SafetyMonitor monitor(SafetyParams{}, 30.0, true);
+  FrameResult live = measured({link(0, 3.0F, 0.0F)});
+  live.clocked = true;
+  live.seen_ns = 1'000'000'000;
+  live.delivered_ns = 1'070'000'000;
+  monitor.decide(live, 1'080'000'000);
+  EXPECT_EQ(live.verdict.code, ReasonCode::stale_frame) << live.verdict.reason;
+  FrameResult recorded = measured({link(0, 3.0F, 0.0F)});
+  recorded.clocked = true;
+  recorded.seen_ns = recorded.delivered_ns = 1'070'000'000;
+  monitor.reset();
+  monitor.decide(recorded, 1'080'000'000);
+  EXPECT_EQ(recorded.verdict.code, ReasonCode::clear) << recorded.verdict.reason;
+}
+
+// The robot state 40 ms older than its frame, 8 ms of it covered by extrapolation: Z_r grows by
+// robot_max_speed_mps (3 m/s) · 0.032 s = 0.096 m, and so does S_p: 1.118 + 0.096 = 1.214 m.
+TEST(SafetyMonitor, TheRobotStatesUncoveredAgeWidensZr) {
+  SafetyMonitor monitor(ssm_mode());
+  FrameResult r = measured({link(0, 3.0F, 0.0F)});
+  r.robot_state_age_ms = 40.0;
+  r.robot_state.extrapolated_ns = 8'000'000;
+  monitor.decide(r, 0);
+  ASSERT_TRUE(r.ssm.has_value());
+  EXPECT_NEAR(r.ssm->z_r_state_m, 0.096, 1e-6);
+  EXPECT_NEAR(r.ssm->z_r_m, 0.106, 1e-6);
+  EXPECT_NEAR(r.verdict.protective_distance_m, 1.214, 1e-5);
+  // Fully extrapolated (8 ms old, 8 ms covered): nothing added.
+  r.robot_state_age_ms = 8.0;
+  monitor.decide(r, 0);
+  EXPECT_NEAR(r.ssm->z_r_m, 0.01, 1e-7);
+}
+
+// The monitor adds one nominal frame period to T_r: at 30 frames/s, 1/30 s, so S_p at rest of
+// a person at 3 m is 1.118 + 1.6/30 = 1.1713 m; `unknown_margin_m` is taken against it.
+TEST(SafetyMonitor, ANominalRateAddsItsPeriodToTr) {
+  SafetyMonitor monitor(ssm_mode(), 30.0);
+  FrameResult r = measured({link(0, 3.0F, 0.0F)});
+  r.unknown_distance_m = 1.5F;
+  monitor.decide(r, 0);
+  ASSERT_TRUE(r.ssm.has_value());
+  EXPECT_NEAR(r.ssm->frame_period_s, 1.0 / 30.0, 1e-12);
+  EXPECT_NEAR(r.ssm->reaction_time_s, 0.05 + 1.0 / 30.0, 1e-12);
+  EXPECT_NEAR(r.verdict.protective_distance_m, 1.118 + 1.6 / 30.0, 1e-5);
+  EXPECT_NEAR(r.unknown_margin_m, 1.5 - (1.118 + 1.6 / 30.0), 1e-5);
+}
+
 // A stop that a mailbox replaced before it was decided is carried: the run that replaced it is
 // written as that stop, with its reason, and the replacement is counted.
 TEST(SafetyMonitor, AReplacedStopIsCarriedIntoTheNextResult) {
@@ -162,7 +235,7 @@ TEST(SafetyMonitor, AReplacedStopIsCarriedIntoTheNextResult) {
 
   // A run that replaced a slow: written as that slow, at its scale.
   SafetyMonitor second(ssm_mode());
-  const FrameResult slow = measured({link(5, 1.5F, 1.5F)});  // scale 0.848889, as above
+  const FrameResult slow = slowed_wrist();  // scale 0.848889, as above
   FrameResult run;
   run.valid = true;
   carry_replaced(second, slow, 0, run);
@@ -179,7 +252,7 @@ TEST(SafetyMonitor, TheStrictestOfSeveralReplacedWins) {
   FrameResult second;                                    // run, replaces first
   second.valid = true;
   carry_replaced(monitor, first, 0, second);
-  FrameResult third = measured({link(5, 1.5F, 1.5F)});  // slow, replaces second
+  FrameResult third = slowed_wrist();  // slow, replaces second
   carry_replaced(monitor, second, 0, third);
   EXPECT_EQ(third.replaced.count, 2);
   monitor.decide(third, 0);
@@ -270,35 +343,36 @@ TEST(SafetyMonitor, TheScaleIsOfTheProgrammedSpeedTheStateReads) {
 }
 
 // No reading (udp_json without speed_fraction): the robot is taken to run at the scale sent
-// last. Frame 1, nothing sent yet (1): 1 m/s → scale 0.5. Frame 2, the robot obeyed and moves
-// at 0.5 m/s: against the 0.5 sent, programmed 1 m/s → the scale stays 0.5 (not run).
+// last. Frame 1 reads 0.5 and moves at 0.4 m/s: programmed 0.8 m/s, scale 0.5 / 0.8 = 0.625.
+// Frame 2 reads nothing and moves at 0.5 m/s (S_p(0.5) = 1.268 m: it may go on): against the
+// 0.625 sent, programmed 0.8 m/s → the scale stays 0.625 (taking 0.5 m/s as programmed would say
+// run, and the robot would return to 0.8 m/s).
 TEST(SafetyMonitor, WithoutAReadingTheLastScaleSentCounts) {
   SafetyMonitor monitor(no_hold());
-  const double unknown = std::numeric_limits<double>::quiet_NaN();
-  FrameResult first = moving_at(1.0F, unknown);
+  FrameResult first = moving_at(0.4F, 0.5);
   monitor.decide(first, 0);
   EXPECT_EQ(first.verdict.state, VerdictState::slow);
-  EXPECT_NEAR(first.verdict.speed_scale, 0.5, 1e-5);
-  EXPECT_EQ(first.robot_speed_fraction, 1.0);
-  EXPECT_NEAR(monitor.scale_sent(), 0.5, 1e-6);
-  FrameResult second = moving_at(0.5F, unknown);
+  EXPECT_NEAR(first.verdict.speed_scale, 0.625, 1e-5);
+  EXPECT_NEAR(monitor.scale_sent(), 0.625, 1e-6);
+  FrameResult second = moving_at(0.5F, std::numeric_limits<double>::quiet_NaN());
   second.host_time_ns = 33'000'000;
   monitor.decide(second, 0);
   EXPECT_EQ(second.verdict.state, VerdictState::slow);
-  EXPECT_NEAR(second.verdict.speed_scale, 0.5, 1e-5);
-  EXPECT_NEAR(second.robot_speed_fraction, 0.5, 1e-6);
+  EXPECT_NEAR(second.verdict.speed_scale, 0.625, 1e-4);
+  EXPECT_NEAR(second.robot_speed_fraction, 0.625, 1e-6);
 }
 
-// A reading wins over what was sent: the scale sent was 0.5 but the robot reads 1 (someone set
-// the slider back) and moves at 1 m/s: programmed 1 m/s, scale 0.5.
+// A reading wins over what was sent: the scale sent was 0.625 but the robot reads 1 (someone
+// set the slider back) and moves at 0.45 m/s: programmed 0.45 m/s, within the 0.5 m/s allowed:
+// run (against the scale sent it would have been 0.5 / (0.45 / 0.625) = 0.694).
 TEST(SafetyMonitor, AReadingWinsOverTheScaleSent) {
   SafetyMonitor monitor(no_hold());
-  FrameResult first = moving_at(1.0F, std::numeric_limits<double>::quiet_NaN());
+  FrameResult first = moving_at(0.4F, 0.5);
   monitor.decide(first, 0);
-  ASSERT_NEAR(monitor.scale_sent(), 0.5, 1e-6);
-  FrameResult second = moving_at(1.0F, 1.0);
+  ASSERT_NEAR(monitor.scale_sent(), 0.625, 1e-6);
+  FrameResult second = moving_at(0.45F, 1.0);
   monitor.decide(second, 0);
-  EXPECT_NEAR(second.verdict.speed_scale, 0.5, 1e-5);
+  EXPECT_EQ(second.verdict.state, VerdictState::run);
   EXPECT_EQ(second.robot_speed_fraction, 1.0);
   // After a silence the links sent a stop: 0.
   monitor.silence(ReasonCode::no_frame, "no frame");

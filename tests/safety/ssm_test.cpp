@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // The protective separation distance, its terms and the speed scale against values worked by
 // hand (docs/SAFETY.md's formula): a fixed and a moving robot, both human speeds, with and
-// without a deceleration.
+// without a deceleration; every part of T_r, a stopping table, stopping limits, the robot
+// state's age in Z_r, and the stop when the present speed leaves no room.
 
 #include "hrcsense/ssm.hpp"
 
@@ -13,8 +14,15 @@ namespace hrcsense {
 namespace {
 
 // The defaults: v_h 1.6 m/s (2.0 within 0.5 m), controller latency 0.05 s, stopping time
-// 0.5 s without a deceleration, d = 40 mm (C = 8·(40 − 14) = 208 mm), Z_r 0.01 m. Every case
-// has a frame age of 0.03 s (T_r = 0.08 s) and Z_d 0.02 m.
+// 0.5 s without a deceleration, d = 40 mm (C = 8·(40 − 14) = 208 mm), Z_r 0.01 m; the
+// receiver's timeout is 0 unless a case sets it (no frame period or source latency either).
+// Every case has a frame age of 0.03 s (T_r = 0.08 s) and Z_d 0.02 m.
+SsmParams defaults() {
+  SsmParams params;
+  params.receiver_timeout_s = 0.0;
+  return params;
+}
+
 SsmInput input(float distance_m, float robot_speed_mps) {
   SsmInput in;
   in.distance_m = distance_m;
@@ -25,7 +33,7 @@ SsmInput input(float distance_m, float robot_speed_mps) {
 }
 
 TEST(Ssm, FixedRobotFar) {
-  const SsmParams params;
+  const SsmParams params = defaults();
   const SsmTerms t = protective_distance(params, input(2.0F, 0.0F), 0.0F);
   EXPECT_NEAR(t.reaction_time_s, 0.08, 1e-12);
   EXPECT_NEAR(t.stop_time_s, 0.5, 1e-12);    // applies at zero speed too
@@ -43,7 +51,7 @@ TEST(Ssm, FixedRobotFar) {
 }
 
 TEST(Ssm, WithinHalfAMetreThePersonIsFaster) {
-  const SsmParams params;
+  const SsmParams params = defaults();
   const SsmTerms t = protective_distance(params, input(0.4F, 0.0F), 0.0F);
   EXPECT_NEAR(t.s_h_m, 2.0 * 0.58, 1e-6);  // 1.16
   EXPECT_NEAR(t.protective_distance_m, 1.16 + 0.208 + 0.02 + 0.01, 1e-5);
@@ -54,7 +62,7 @@ TEST(Ssm, WithinHalfAMetreThePersonIsFaster) {
 }
 
 TEST(Ssm, MovingRobotWithoutDeceleration) {
-  const SsmParams params;
+  const SsmParams params = defaults();
   // v_r 0.5 m/s: S_r = 0.5·0.08 = 0.04, S_s = 0.5·0.5/2 = 0.125; S_p = 1.166 + 0.165 = 1.331.
   const SsmTerms t = protective_distance(params, input(2.0F, 0.5F), 0.5F);
   EXPECT_NEAR(t.s_r_m, 0.04, 1e-6);
@@ -63,13 +71,18 @@ TEST(Ssm, MovingRobotWithoutDeceleration) {
   EXPECT_EQ(ssm_speed_scale(params, input(2.0F, 0.5F)), 1.0F);
   // S_p(v) = 1.166 + v·(T_r + T_s/2) = 1.166 + 0.33·v: at 2 m, v up to 0.834 / 0.33.
   EXPECT_NEAR(allowed_robot_speed_mps(params, input(2.0F, 0.5F)), 0.834 / 0.33, 1e-5);
-  // v_r 1 m/s at 1.3 m: S_p(1) = 1.496 > 1.3, so slow to 0.134 / 0.33 = 0.40606 m/s.
-  EXPECT_NEAR(ssm_speed_scale(params, input(1.3F, 1.0F)), 0.134 / 0.33, 1e-5);
+  // v_r 1 m/s at 1.3 m: S_p(1) = 1.496 > 1.3. The old rule slowed to 0.134 / 0.33 = 0.40606
+  // m/s; the robot keeps 1 m/s for T_r and no braking is shorter than its stop: none fits.
+  EXPECT_LT(allowed_robot_speed_mps(params, input(1.3F, 1.0F)), 0.0);
+  EXPECT_EQ(ssm_speed_scale(params, input(1.3F, 1.0F)), 0.0F);
   EXPECT_NEAR(protective_distance(params, input(1.3F, 1.0F), 1.0F).protective_distance_m, 1.496, 1e-5);
+  // At 0.4 m/s S_p = 1.298 ≤ 1.3: it may go on, up to 0.134 / 0.33 m/s.
+  EXPECT_NEAR(allowed_robot_speed_mps(params, input(1.3F, 0.4F)), 0.134 / 0.33, 1e-5);
+  EXPECT_EQ(ssm_speed_scale(params, input(1.3F, 0.4F)), 1.0F);
 }
 
 TEST(Ssm, MovingRobotWithDeceleration) {
-  SsmParams params;
+  SsmParams params = defaults();
   params.robot_decel_mps2 = 2.0F;
   params.robot_stop_time_s = 0.1;  // before braking starts
   // v_r 1 m/s: T_s = 0.1 + 1/2 = 0.6, S_h = 1.6·(0.08 + 0.6) = 1.088, S_r = 0.08,
@@ -81,16 +94,20 @@ TEST(Ssm, MovingRobotWithDeceleration) {
   EXPECT_NEAR(t.s_s_m, 0.35, 1e-6);
   EXPECT_NEAR(t.protective_distance_m, 1.756, 1e-5);
   // S_p(v) = 0.526 + 0.98·v + 0.25·v² = 1.5: v = (−0.98 + √(0.98² + 0.974)) / 0.5 = 0.821654.
+  // At 1 m/s now the robot is inside S_p(1) = 1.756: a stop. At 0.5 m/s now (S_p 1.0785) it
+  // may go up to v, and at 0.9 m/s (S_p 1.6282) it may not.
   const double v = (-0.98 + std::sqrt(0.98 * 0.98 + 0.974)) / 0.5;
-  EXPECT_NEAR(allowed_robot_speed_mps(params, input(1.5F, 1.0F)), v, 1e-5);
-  EXPECT_NEAR(ssm_speed_scale(params, input(1.5F, 1.0F)), v, 1e-5);
+  EXPECT_LT(allowed_robot_speed_mps(params, input(1.5F, 1.0F)), 0.0);
+  EXPECT_NEAR(allowed_robot_speed_mps(params, input(1.5F, 0.5F)), v, 1e-5);
+  EXPECT_EQ(ssm_speed_scale(params, input(1.5F, 0.5F)), 1.0F);
+  EXPECT_EQ(ssm_speed_scale(params, input(1.5F, 0.9F)), 0.0F);
   EXPECT_NEAR(protective_distance(params, input(1.5F, 1.0F), static_cast<float>(v)).protective_distance_m, 1.5, 1e-5);
   // At rest the brake delay still counts: S_p(0) = 1.6·0.18 + 0.238 = 0.526.
   EXPECT_NEAR(protective_distance(params, input(1.5F, 0.0F), 0.0F).protective_distance_m, 0.526, 1e-5);
 }
 
 TEST(Ssm, DetectionCapabilityBelow14mmGivesNoIntrusionDistance) {
-  SsmParams params;
+  SsmParams params = defaults();
   params.detection_mm = 10.0F;
   EXPECT_EQ(protective_distance(params, input(2.0F, 0.0F), 0.0F).c_m, 0.0F);
   params.detection_mm = 40.0F;  // the formula's last value: 8·26 mm
@@ -100,14 +117,108 @@ TEST(Ssm, DetectionCapabilityBelow14mmGivesNoIntrusionDistance) {
 }
 
 TEST(Ssm, MovingAwayCountsAsStandingStill) {
-  const SsmParams params;
+  const SsmParams params = defaults();
   EXPECT_EQ(protective_distance(params, input(2.0F, -0.7F), -0.7F).s_r_m, 0.0F);
   EXPECT_EQ(ssm_speed_scale(params, input(2.0F, -0.7F)), 1.0F);
   EXPECT_EQ(ssm_speed_scale(params, input(1.0F, -0.7F)), 0.0F);  // too close even at rest
 }
 
+// ---- S2's terms, each against values worked by hand.
+
+// T_r = frame age + one nominal frame period + the camera's latency before its stamp + the
+// controller's latency + the receiver's silence timeout: 0.03 + 1/30 + 0.033 + 0.05 + 0.2 =
+// 0.3463333 s. At rest S_p = 1.6·(0.3463333 + 0.5) + 0.208 + 0.02 + 0.01 = 1.5921333 m.
+TEST(Ssm, ReactionTimeHasEveryLatency) {
+  SsmParams params;  // the receiver's default timeout, 0.2 s
+  params.frame_period_s = 1.0 / 30.0;
+  params.source_latency_s = 0.033;
+  const SsmTerms t = protective_distance(params, input(2.0F, 0.0F), 0.0F);
+  EXPECT_NEAR(t.frame_age_s, 0.03, 1e-12);
+  EXPECT_NEAR(t.frame_period_s, 0.0333333, 1e-7);
+  EXPECT_NEAR(t.source_latency_s, 0.033, 1e-12);
+  EXPECT_NEAR(t.controller_latency_s, 0.05, 1e-12);
+  EXPECT_NEAR(t.receiver_timeout_s, 0.2, 1e-12);
+  EXPECT_NEAR(t.reaction_time_s, 0.3463333, 1e-7);
+  EXPECT_NEAR(t.s_h_m, 1.6 * 0.8463333, 1e-6);
+  EXPECT_NEAR(t.protective_distance_m, 1.5921333, 1e-5);
+  // Each part costs v_h · part at rest: the receiver's 0.2 s alone 0.32 m at 1.6 m/s.
+  SsmParams without_receiver = params;
+  without_receiver.receiver_timeout_s = 0.0;
+  EXPECT_NEAR(t.protective_distance_m - protective_distance(without_receiver, input(2.0F, 0.0F), 0.0F).protective_distance_m,
+              0.32, 1e-5);
+}
+
+// A table (speed → distance, time), linear between rows: 0.5 m/s → 0.10 m in 0.30 s,
+// 1.0 → 0.30 m in 0.45 s, 1.5 → 0.60 m in 0.60 s.
+SsmParams with_table() {
+  SsmParams params = defaults();
+  params.stopping_table = {{0.5F, 0.10F, 0.30}, {1.0F, 0.30F, 0.45}, {1.5F, 0.60F, 0.60}};
+  params.stopping_data = StoppingData::table;
+  return params;
+}
+
+TEST(Ssm, StoppingTableIsReadBetweenAndBeyondItsRows) {
+  const SsmParams params = with_table();
+  // At rest: no distance, the first row's time (the person walks while even a slow robot stops).
+  EXPECT_NEAR(robot_stop(params, 0.0).distance_m, 0.0, 1e-12);
+  EXPECT_NEAR(robot_stop(params, 0.0).time_s, 0.30, 1e-12);
+  EXPECT_NEAR(robot_stop(params, 0.25).distance_m, 0.05, 1e-7);  // half the first row's distance
+  EXPECT_NEAR(robot_stop(params, 0.25).time_s, 0.30, 1e-12);
+  EXPECT_NEAR(robot_stop(params, 0.75).distance_m, 0.20, 1e-7);  // between rows 1 and 2
+  EXPECT_NEAR(robot_stop(params, 0.75).time_s, 0.375, 1e-7);
+  EXPECT_NEAR(robot_stop(params, 1.0).distance_m, 0.30, 1e-7);   // on a row
+  // Beyond the last row, at its deceleration: 0.6·(2/1.5)² = 1.0666667 m in 0.6·2/1.5 = 0.8 s.
+  EXPECT_NEAR(robot_stop(params, 2.0).distance_m, 1.0666667, 1e-6);
+  EXPECT_NEAR(robot_stop(params, 2.0).time_s, 0.8, 1e-7);
+  // S_p at 0.75 m/s: 1.6·(0.08 + 0.375) + 0.75·0.08 + 0.20 + 0.238 = 1.226 m.
+  const SsmTerms t = protective_distance(params, input(2.0F, 0.75F), 0.75F);
+  EXPECT_NEAR(t.stop_time_s, 0.375, 1e-7);
+  EXPECT_NEAR(t.s_s_m, 0.20, 1e-6);
+  EXPECT_NEAR(t.protective_distance_m, 1.226, 1e-5);
+  // The allowed speed at 1.5 m, from 0.5 m/s now: between 1.0 and 1.5 m/s S_p(v) = 1.466 +
+  // 1.16·(v − 1) (S_p(1) = 1.6·0.53 + 0.08 + 0.30 + 0.238), so v = 1 + 0.034 / 1.16.
+  EXPECT_NEAR(allowed_robot_speed_mps(params, input(1.5F, 0.5F)), 1.0 + 0.034 / 1.16, 1e-6);
+}
+
+// The robot's own stopping limits (its safety configuration): the same distance and time at
+// any speed. S_p(v) = 1.6·(0.08 + 0.6) + 0.08·v + 0.4 + 0.238 = 1.726 + 0.08·v.
+TEST(Ssm, StoppingLimitsHoldAtAnySpeed) {
+  SsmParams params = defaults();
+  params.stopping_limit_distance_m = 0.4F;
+  params.stopping_limit_time_s = 0.6;
+  params.stopping_data = StoppingData::limits;
+  EXPECT_NEAR(protective_distance(params, input(3.0F, 0.0F), 0.0F).protective_distance_m, 1.726, 1e-5);
+  EXPECT_NEAR(protective_distance(params, input(3.0F, 1.0F), 1.0F).protective_distance_m, 1.806, 1e-5);
+  EXPECT_NEAR(allowed_robot_speed_mps(params, input(1.75F, 0.1F)), 0.024 / 0.08, 1e-6);
+  EXPECT_STREQ(stopping_data_name(params.stopping_data), "limits");
+}
+
+// The robot state 30 ms older than the frame, of which extrapolation covered 10 ms: the arm may
+// have moved 3 m/s · 0.02 s = 0.06 m unseen, so Z_r = 0.01 + 0.06 = 0.07 m.
+TEST(Ssm, RobotStateAgeBeyondExtrapolationWidensZr) {
+  const SsmParams params = defaults();
+  SsmInput in = input(2.0F, 0.0F);
+  in.robot_state_gap_s = 0.02;
+  const SsmTerms t = protective_distance(params, in, 0.0F);
+  EXPECT_NEAR(t.z_r_state_m, 0.06, 1e-6);
+  EXPECT_NEAR(t.z_r_m, 0.07, 1e-6);
+  EXPECT_NEAR(t.protective_distance_m, 1.166 + 0.06, 1e-5);
+}
+
+// Some v_a ≥ 0 fits exactly when the distance is at least S_p at the present speed: just
+// above it the robot may keep (at least) its speed, just below it nothing does.
+TEST(Ssm, NoSpeedFitsBelowTheProtectiveDistanceAtThePresentSpeed) {
+  const SsmParams params = defaults();
+  for (const float v_r : {0.0F, 0.3F, 0.8F, 1.5F}) {
+    const float at_present = 1.166F + 0.33F * v_r;  // S_p(v_r) = 1.166 + v_r·(T_r + T_s/2)
+    EXPECT_GE(allowed_robot_speed_mps(params, input(at_present + 1e-3F, v_r)), v_r) << v_r;
+    EXPECT_LT(allowed_robot_speed_mps(params, input(at_present - 1e-3F, v_r)), 0.0) << v_r;
+    EXPECT_EQ(ssm_speed_scale(params, input(at_present - 1e-3F, v_r)), 0.0F) << v_r;
+  }
+}
+
 TEST(Ssm, NanIsNeverASpeed) {
-  const SsmParams params;
+  const SsmParams params = defaults();
   EXPECT_EQ(ssm_speed_scale(params, input(std::nanf(""), 0.5F)), 0.0F);
   EXPECT_EQ(ssm_speed_scale(params, input(2.0F, std::nanf(""))), 0.0F);
   SsmInput age = input(2.0F, 0.5F);

@@ -86,6 +86,10 @@ struct ColorStreamConfig {
 
 struct SourceConfig {
   SourceType type = SourceType::sim;  ///< `source.type`
+  /// `source.latency_s`: how long before its stamp the camera saw the scene (exposure and
+  /// readout), s; part of T_r. Default per source type: 0 for the simulator (it renders at its
+  /// stamp), kCameraLatencyS for cameras and recordings of them (docs/SAFETY.md).
+  double latency_s = 0.0;
   std::string path;                ///< file or folder for recorded sources (realsense: a .bag to play through the SDK)
   bool pace = false;               ///< play at the recorded / nominal rate
   bool loop = false;               ///< start over at the end
@@ -180,7 +184,14 @@ struct Config {
   PublishConfig publish;                 ///< `publish.*`
   LinkConfig link;                       ///< `link.*`
   std::string canonical_yaml;      ///< the effective configuration, for the hash in the header
+  /// What a person starting the run must hear about this configuration (e.g. ssm without the
+  /// robot's stopping data); logged as warnings at the start, one line each.
+  std::vector<std::string> warnings;
 };
+
+/// `source.latency_s`'s default for cameras (realsense, ros2) and recordings (bag, folder):
+/// one exposure and readout at 30 frames/s.
+inline constexpr double kCameraLatencyS = 0.033;
 
 /// Reads `path` (may be empty: defaults only) and applies `overrides` ("key.sub=value",
 /// value in YAML syntax) in order. Throws ConfigError naming file and key.
