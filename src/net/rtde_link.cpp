@@ -340,11 +340,16 @@ bool RtdeLinkSink::drain(Connection& c) {
 void RtdeLinkSink::stream(Connection& c) {
   const double stop_value = value_for(VerdictState::stop, 0.0F);
   std::unique_lock<std::mutex> lock(mutex_);
-  // First the newest verdict (after a reconnect too), or a stop when none came yet.
-  double value = have_value_ ? pending_value_ : stop_value;
-  bool is_stop = have_value_ ? pending_stop_ : true;
+  // First the newest verdict when its frame came at most one period ago (after a reconnect
+  // too); else, or when none came yet, the stop value, and the next frame's value follows. A
+  // value written from the newest frame keeps that frame's heartbeat deadline, so the stop
+  // comes one period after the frame, as on a connection that never broke.
+  const int64_t start_ns = clock_.now_ns();
+  const bool fresh = have_value_ && start_ns - last_frame_ns_ <= period_ns_;
+  double value = fresh ? pending_value_ : stop_value;
+  bool is_stop = fresh ? pending_stop_ : true;
   pending_ = false;
-  int64_t heartbeat_due_ns = std::max(clock_.now_ns(), last_frame_ns_) + period_ns_;
+  int64_t heartbeat_due_ns = fresh ? last_frame_ns_ + period_ns_ : std::max(start_ns, last_frame_ns_) + period_ns_;
   bool due = true;
   while (!stop_) {
     if (final_requested_) {
@@ -372,6 +377,14 @@ void RtdeLinkSink::stream(Connection& c) {
     }
     if (due) {
       due = false;
+      if (!is_stop && now_ns - last_frame_ns_ > period_ns_) {
+        // A non-stop value is only ever the newest frame's (taken under this lock). Older than
+        // a period (the writer was held up: a slow send, a thread not scheduled), the stop
+        // value goes out instead, as the heartbeat's would.
+        value = stop_value;
+        is_stop = true;
+        heartbeat_due_ns = now_ns + period_ns_;
+      }
       lock.unlock();
       const bool written = write(c, value, is_stop);
       lock.lock();

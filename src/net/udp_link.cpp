@@ -249,19 +249,24 @@ sockaddr_storage parse_link_address(const std::string& address, unsigned& length
 // ---- UdpLinkSink
 
 // The json format's frame lines: JsonLinesSink writing into a reused string (its capacity stays,
-// so a frame allocates nothing once the longest line has been seen).
+// so a frame allocates nothing once the longest line has been seen). Every json datagram says
+// `"for_control":false`: frame lines carry no sequence and no CRC (docs/SAFETY.md, "The json
+// format"), so they are for logs and dashboards, not for a controller to act on.
 class UdpLinkSink::JsonFrames {
  public:
   JsonFrames(const std::string& backend, uint32_t session)
-      : stream_(&buffer_), sink_(stream_, backend), session_member_("\"session\":" + std::to_string(session) + ",") {}
+      : stream_(&buffer_),
+        sink_(stream_, backend),
+        session_member_("\"session\":" + std::to_string(session) + ",\"for_control\":false,") {}
   void header(const RunHeader& header) {
     sink_.header(header);  // the sink learns what frames carry (robot_status); the line is not sent
     buffer_.text.clear();
   }
-  /// The frame's line without its newline, with `"session":N` after its first member (`type`),
-  /// so that a json receiver can tell a restarted sender too. The line is the JSON Lines
-  /// sink's, whose first member is always `"type":"frame"` or `"type":"verdict"` (no comma
-  /// inside), so the first comma ends it.
+  /// The frame's line without its newline, with `"session":N,"for_control":false` after its
+  /// first member (`type`), so that a json receiver can tell a restarted sender too and no one
+  /// takes the line for a control datagram. The line is the JSON Lines sink's, whose first
+  /// member is always `"type":"frame"` or `"type":"verdict"` (no comma inside), so the first
+  /// comma ends it.
   std::string_view line(const FrameResult& result) {
     buffer_.text.clear();
     stream_.clear();
@@ -288,7 +293,7 @@ class UdpLinkSink::JsonFrames {
   Buffer buffer_;
   std::ostream stream_;
   JsonLinesSink sink_;
-  std::string session_member_;  ///< `"session":N,`
+  std::string session_member_;  ///< `"session":N,"for_control":false,`
 };
 
 UdpLinkSink::UdpLinkSink(const UdpLinkParams& params, const RunClock& clock)
@@ -393,11 +398,12 @@ void UdpLinkSink::send_locked(LinkKind kind, const FrameResult* result, ReasonCo
     return;
   }
   if (json_) {
-    // {"type":"heartbeat"|"final_stop","session":S,"sequence":N,"timestamp_ns":T,"verdict":"stop","reason_code":"..."}
+    // {"type":"heartbeat"|"final_stop","session":S,"for_control":false,"sequence":N,"timestamp_ns":T,
+    //  "verdict":"stop","reason_code":"..."}
     char text[256];
     const int n = std::snprintf(text, sizeof text,
-                                "{\"type\":\"%s\",\"session\":%u,\"sequence\":%u,\"timestamp_ns\":%lld,"
-                                "\"verdict\":\"stop\",\"reason_code\":\"%s\"}",
+                                "{\"type\":\"%s\",\"session\":%u,\"for_control\":false,\"sequence\":%u,"
+                                "\"timestamp_ns\":%lld,\"verdict\":\"stop\",\"reason_code\":\"%s\"}",
                                 kind == LinkKind::heartbeat ? "heartbeat" : "final_stop", session_, sequence,
                                 static_cast<long long>(last_timestamp_ns_), reason_code_name(reason));
     send_bytes_locked(text, static_cast<size_t>(std::clamp(n, 0, static_cast<int>(sizeof text) - 1)), kind);

@@ -42,8 +42,9 @@ enum class RtdeFault { none, close, stall, truncated, oversized, unknown_type, w
                        huge_joint,  // joint 2 is 1e300 in one package: finite, but no pose of any arm
                        not_found, protocol1_only,
                        // input sessions: the setup reply has no recipe id (an empty payload); the
-                       // connection is closed after fault_at input packages
-                       malformed_input_reply, close_inputs };
+                       // connection is closed after fault_at input packages; closed so, and the
+                       // next client is not served before release()
+                       malformed_input_reply, close_inputs, close_inputs_hold };
 
 /// One input DATA_PACKAGE the fake received, decoded by its recipe's types.
 struct FakeInputWrite {
@@ -383,9 +384,11 @@ class FakeRtdeController {
         std::lock_guard<std::mutex> lock(mutex_);
         inputs_.push_back(write);
       }
-      if (fault == RtdeFault::close_inputs && ++received == script_.fault_at) {
+      const bool closes = fault == RtdeFault::close_inputs || fault == RtdeFault::close_inputs_hold;
+      if (closes && ++received == script_.fault_at) {
         faulted_ = true;
         ::close(fd);
+        if (fault == RtdeFault::close_inputs_hold) hold();
         return false;
       }
     }

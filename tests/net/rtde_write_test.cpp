@@ -2,7 +2,8 @@
 // link.rtde.write: the input packages against bytes laid out by hand from
 // ../shared/specs/ur-rtde.md, and RtdeLinkSink against the fake controller's input session
 // (tests/net/fake_rtde_controller.hpp) on 127.0.0.1: what arrives (the recipe, the values, the
-// stops), IN_USE refusals, malformed replies, a lost connection. Every wait is bounded.
+// stops), IN_USE refusals, malformed replies, a lost connection, and what a reconnect writes
+// first (never a value older than one heartbeat period). Every wait is bounded.
 #include "../support/units.hpp"
 #include "cli_cell.hpp"
 #include "fake_rtde_controller.hpp"
@@ -13,11 +14,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <memory>
+#include <ostream>
 #include <string>
 #include <thread>
 #include <tuple>
@@ -280,6 +284,160 @@ TEST(RtdeWrite, LostConnectionIsCountedAndTheNewestValueIsWrittenAgain) {
   ASSERT_TRUE(eventually([&] { return sink.counters().disconnects == 1; }));
   EXPECT_NE(sink.counters().last_problem.find("connection closed by the controller"), std::string::npos)
       << sink.counters().last_problem;
+}
+
+// ---- A reconnect never brings back a value older than one heartbeat period
+
+// The fake closes the first connection after two writes (the initial stop and a `run`) and
+// serves the next client only on release(), so the test moves the sink's clock while the link
+// is down. Register or slider; the newest frame either the `run` written on the first
+// connection or a `slow` handed over while the link was down (pending when the writer
+// reconnects).
+struct ReconnectCase {
+  RtdeLinkParams::Mode mode;
+  bool frame_while_down;
+};
+
+void PrintTo(const ReconnectCase& c, std::ostream* out) {
+  *out << (c.mode == RtdeLinkParams::Mode::input_register ? "register" : "speed_slider")
+       << (c.frame_while_down ? ", newest frame while the link is down" : ", newest frame written before the drop");
+}
+
+class RtdeWriteReconnect : public ::testing::TestWithParam<ReconnectCase> {
+ protected:
+  SteadyClock steady_;
+  FakeRtdeController fake_{reconnect_script(), steady_};
+  FakeClock clock_{0};
+  std::unique_ptr<RtdeLinkSink> sink_;
+
+  static FakeRtdeScript reconnect_script() {
+    FakeRtdeScript script;
+    script.fault = RtdeFault::close_inputs_hold;
+    script.fault_at = 2;
+    return script;
+  }
+  void SetUp() override {
+    fake_.start({});
+    sink_ = std::make_unique<RtdeLinkSink>(params_for(fake_, GetParam().mode), clock_);  // a 100 ms period
+  }
+  void TearDown() override {
+    fake_.release();
+    sink_.reset();
+    fake_.stop();
+  }
+  double stop_value() const { return sink_->value_for(VerdictState::stop, 0.0F); }
+  // The fraction or register value of a write (the slider's mask comes first).
+  static double written(const FakeInputWrite& write) { return write.values.back(); }
+  // The writes of the connections after the first, in order.
+  std::vector<FakeInputWrite> after_reconnect() const {
+    std::vector<FakeInputWrite> later;
+    for (const FakeInputWrite& write : fake_.inputs()) {
+      if (write.connection != 1) later.push_back(write);
+    }
+    return later;
+  }
+  // A `run` frame at clock time 0 written, the link dropped by the controller; with
+  // frame_while_down a `slow` 0.5 frame 20 ms later, while the link is down. Then the clock
+  // moves on until the newest frame is `age_ns` old, and the controller takes the writer's next
+  // connection. Returns the newest frame's value.
+  double drop_and_reconnect_at(int64_t age_ns) {
+    EXPECT_TRUE(eventually([&] { return fake_.inputs().size() == 1; })) << "the initial stop";
+    sink_->frame(verdict(VerdictState::run, 1.0F));
+    EXPECT_TRUE(eventually([&] { return fake_.faulted() && fake_.inputs().size() == 2; }));
+    EXPECT_EQ(written(fake_.inputs().back()), 1.0) << "the run on the first connection";
+    EXPECT_TRUE(eventually([&] { return sink_->counters().disconnects == 1; })) << "the writer saw the close";
+    double newest = 1.0;
+    if (GetParam().frame_while_down) {
+      clock_.advance(20 * kMs);
+      sink_->frame(verdict(VerdictState::slow, 0.5F));
+      newest = 0.5;
+    }
+    clock_.advance(age_ns);
+    fake_.release();  // the next connection is served
+    EXPECT_TRUE(eventually([&] { return !after_reconnect().empty(); })) << "the writer reconnects";
+    return newest;
+  }
+};
+
+TEST_P(RtdeWriteReconnect, AfterMoreThanOnePeriodTheStopValueComesFirst) {
+  drop_and_reconnect_at(150 * kMs);  // older than one period (100 ms)
+  ASSERT_FALSE(after_reconnect().empty());
+  EXPECT_EQ(written(after_reconnect().front()), stop_value()) << "never the old run or slow on a new connection";
+  // The next frame's value follows as usual.
+  sink_->frame(verdict(VerdictState::run, 1.0F));
+  ASSERT_TRUE(eventually([&] { return after_reconnect().size() == 2; }));
+  EXPECT_EQ(written(after_reconnect()[1]), 1.0);
+  EXPECT_EQ(fake_.input_errors(), 0);
+}
+
+TEST_P(RtdeWriteReconnect, WithinOnePeriodTheNewestValueComesFirstAndItsStopOnePeriodAfterTheFrame) {
+  const double newest = drop_and_reconnect_at(60 * kMs);
+  ASSERT_FALSE(after_reconnect().empty());
+  EXPECT_EQ(written(after_reconnect().front()), newest);
+  // The heartbeat's stop comes one period after the frame, as on a connection that never broke,
+  // not one period after the reconnect (which is 60 ms later).
+  clock_.advance(50 * kMs);
+  ASSERT_TRUE(eventually([&] { return after_reconnect().size() == 2; })) << "the heartbeat's stop";
+  EXPECT_EQ(written(after_reconnect()[1]), stop_value());
+}
+
+TEST_P(RtdeWriteReconnect, ExactlyOnePeriodOldIsWrittenAndStoppedAtOnce) {
+  const double newest = drop_and_reconnect_at(100 * kMs);  // "at most one period": still written
+  ASSERT_TRUE(eventually([&] { return after_reconnect().size() == 2; })) << "the heartbeat is due at once";
+  EXPECT_EQ(written(after_reconnect()[0]), newest);
+  EXPECT_EQ(written(after_reconnect()[1]), stop_value());
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, RtdeWriteReconnect,
+                         ::testing::Values(ReconnectCase{RtdeLinkParams::Mode::input_register, false},
+                                           ReconnectCase{RtdeLinkParams::Mode::input_register, true},
+                                           ReconnectCase{RtdeLinkParams::Mode::speed_slider, false},
+                                           ReconnectCase{RtdeLinkParams::Mode::speed_slider, true}),
+                         [](const ::testing::TestParamInfo<ReconnectCase>& info) {
+                           return std::string(info.param.mode == RtdeLinkParams::Mode::input_register ? "register"
+                                                                                                      : "slider") +
+                                  (info.param.frame_while_down ? "_frame_while_down" : "_frame_written");
+                         });
+
+// A clock that stands still except for one jump: armed by the thread that made it, it moves on
+// by `jump_ns` right after that thread's next reading. The sink's frame() stamps its frame before
+// the jump and the writer thread sees the time after it, as if the writer had been held up that
+// long between the frame and its write (a slow send, a thread not scheduled).
+class HeldUpWriterClock final : public RunClock {
+ public:
+  int64_t now_ns() const override {
+    const int64_t t_ns = now_ns_.load();
+    if (std::this_thread::get_id() == owner_ && armed_.exchange(false)) now_ns_ += jump_ns_.load();
+    return t_ns;
+  }
+  void sleep_until(int64_t, const std::atomic<bool>*) override {}
+  void jump_after_my_next_read(int64_t jump_ns) {
+    jump_ns_ = jump_ns;
+    armed_ = true;
+  }
+
+ private:
+  const std::thread::id owner_ = std::this_thread::get_id();
+  mutable std::atomic<int64_t> now_ns_{0};
+  mutable std::atomic<bool> armed_{false};
+  std::atomic<int64_t> jump_ns_{0};
+};
+
+TEST(RtdeWrite, AValueOlderThanOnePeriodWhenItsWriteComesDueIsWrittenAsTheStop) {
+  SteadyClock steady;
+  FakeRtdeController fake(FakeRtdeScript{}, steady);
+  fake.start({});
+  HeldUpWriterClock clock;
+  RtdeLinkSink sink(params_for(fake, RtdeLinkParams::Mode::input_register), clock);  // a 100 ms period
+  ASSERT_TRUE(eventually([&] { return fake.inputs().size() == 1; })) << "the initial stop";
+  clock.jump_after_my_next_read(150 * kMs);
+  sink.frame(verdict(VerdictState::run, 1.0F));  // stamped 0; the writer takes it at 150 ms
+  ASSERT_TRUE(eventually([&] { return fake.inputs().size() == 2; }));
+  EXPECT_EQ(fake.inputs().back().values, std::vector<double>{0.0}) << "not the run of 150 ms ago";
+  sink.frame(verdict(VerdictState::run, 1.0F));  // a fresh one is written as it is
+  ASSERT_TRUE(eventually([&] { return fake.inputs().size() == 3; }));
+  EXPECT_EQ(fake.inputs().back().values, std::vector<double>{1.0});
+  EXPECT_EQ(sink.counters().stop_writes, 2);
 }
 
 TEST(RtdeWrite, NoControllerNeverBlocksAndTheDestructorIsBounded) {

@@ -581,22 +581,24 @@ TEST(UdpLinkSink, JsonFormatSendsTheFramesLine) {
   std::string expected = expected_out.str();
   ASSERT_FALSE(expected.empty());
   expected.pop_back();  // the newline
-  // ... with the session as its second member.
+  // ... with the session and `"for_control":false` as its second and third members.
   const std::string type_member = "{\"type\":\"frame\",";
   ASSERT_EQ(expected.rfind(type_member, 0), 0U) << expected;
-  expected.insert(type_member.size(), "\"session\":4000000000,");
+  expected.insert(type_member.size(), "\"session\":4000000000,\"for_control\":false,");
   const std::optional<std::string> line = receiver.next();
   ASSERT_TRUE(line);
   EXPECT_EQ(*line, expected);
   EXPECT_EQ(nlohmann::json::parse(*line).at("type"), "frame");
   EXPECT_EQ(nlohmann::json::parse(*line).at("session").get<uint64_t>(), 4000000000U);
   EXPECT_EQ(nlohmann::json::parse(*line).at("backend"), "octree");
+  EXPECT_EQ(nlohmann::json::parse(*line).at("for_control"), false) << "a line for logs, not for a controller";
 
   clock.advance(100 * kMs);
   const std::optional<std::string> heartbeat = receiver.next();
   ASSERT_TRUE(heartbeat);
   EXPECT_EQ(*heartbeat,
-            "{\"type\":\"heartbeat\",\"session\":4000000000,\"sequence\":1,\"timestamp_ns\":42000000,"
+            "{\"type\":\"heartbeat\",\"session\":4000000000,\"for_control\":false,\"sequence\":1,"
+            "\"timestamp_ns\":42000000,"
             "\"verdict\":\"stop\",\"reason_code\":\"no_frame\"}");
   RunSummary summary;
   summary.end_code = ReasonCode::stop_requested;
@@ -604,8 +606,30 @@ TEST(UdpLinkSink, JsonFormatSendsTheFramesLine) {
   const std::optional<std::string> last = receiver.next();
   ASSERT_TRUE(last);
   EXPECT_EQ(*last,
-            "{\"type\":\"final_stop\",\"session\":4000000000,\"sequence\":2,\"timestamp_ns\":42000000,"
+            "{\"type\":\"final_stop\",\"session\":4000000000,\"for_control\":false,\"sequence\":2,"
+            "\"timestamp_ns\":42000000,"
             "\"verdict\":\"stop\",\"reason_code\":\"stop_requested\"}");
+}
+
+TEST(UdpLinkSink, JsonFormatVerdictLinesSayTheyAreNotForControlToo) {
+  // A watchdog's or the run's own stop (a `verdict` line: no source frame) as the third member
+  // too, beside the frame lines, heartbeats and final stop of the test above.
+  const Receiver receiver;
+  FakeClock clock(0);
+  UdpLinkParams params = params_for(receiver);
+  params.format = UdpLinkParams::Format::json;
+  params.session = 7;
+  UdpLinkSink sink(params, clock);
+  sink.header(RunHeader{});
+  FrameResult stop = frame_at(0, 5 * kMs, false);
+  stop.source_frame = false;
+  stop.verdict.state = VerdictState::stop;
+  stop.verdict.code = ReasonCode::no_frame;
+  sink.frame(stop);
+  const std::optional<std::string> line = receiver.next();
+  ASSERT_TRUE(line);
+  EXPECT_EQ(line->rfind("{\"type\":\"verdict\",\"session\":7,\"for_control\":false,", 0), 0U) << *line;
+  EXPECT_EQ(nlohmann::json::parse(*line).at("for_control"), false);
 }
 
 TEST(UdpLinkSink, SendErrorsAreCountedNeverThrown) {

@@ -96,7 +96,10 @@ sockaddr_storage parse_link_address(const std::string& address, unsigned& length
 /// How UdpLinkSink sends.
 struct UdpLinkParams {
   std::string address;  ///< `link.udp.address`, see parse_link_address
-  enum class Format { binary, json } format = Format::binary;  ///< `link.udp.format`
+  /// `link.udp.format`: binary (the HRCS layout, for a controller) or json (the frame's line, for
+  /// logs and dashboards: no sequence on frames, no CRC; every datagram says
+  /// `"for_control":false`)
+  enum class Format { binary, json } format = Format::binary;
   double heartbeat_hz = 20.0;  ///< `link.heartbeat_hz`, > 0
   /// json format: the proximity backend its lines name when no search ran (`proximity.backend`)
   std::string backend = "brute";

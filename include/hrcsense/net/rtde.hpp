@@ -130,7 +130,8 @@ struct RtdeLinkParams {
   int register_index = 24;        ///< `link.rtde.register`: N, 24..47 (0..23 belong to fieldbus adapters)
   double min_speed_slider = 0.01; ///< `link.rtde.min_speed_slider`: the slider never goes below this (0, 1]
   /// `link.heartbeat_hz`: while no frame comes for one period, the stop value is written at
-  /// this rate (a URScript watchdog sees writes, but only stops).
+  /// this rate (a URScript watchdog sees writes, but only stops); no frame's value is written
+  /// once it is older than one period, on a new connection neither.
   double heartbeat_hz = 20.0;
   double connect_timeout_s = 1.0;   ///< TCP connect, real time
   double receive_timeout_s = 1.0;   ///< each handshake reply, real time
@@ -165,10 +166,13 @@ struct RtdeLinkCounters {
 /// network); the writer connects, sets up the inputs (an IN_USE reply is a refusal naming the
 /// input and link.rtde.write), starts, writes the newest value, drains what the controller
 /// sends (text messages; anything unparseable is counted and ends the connection), and after a
-/// lost connection reconnects with back-off, writing the newest value first. While no frame
-/// comes for one heartbeat period it writes the stop value; summary() and the destructor write
-/// a final stop (the destructor waits for a connection attempt under way, at most the connect
-/// and receive timeouts, not for a writer that is backing off).
+/// lost connection reconnects with back-off. No value other than the stop value is ever written
+/// once its frame is more than one heartbeat period old (on `clock`): a new connection starts
+/// with the newest value only when its frame came at most one period ago, else with the stop
+/// value (the next frame's value follows as usual); while no frame comes for one period it
+/// writes the stop value at the heartbeat rate. summary() and the destructor write a final
+/// stop (the destructor waits for a connection attempt under way, at most the connect and
+/// receive timeouts, not for a writer that is backing off).
 class RtdeLinkSink final : public Sink {
  public:
   /// Starts the writer thread; `clock` must outlive the sink. std::invalid_argument naming the
@@ -210,7 +214,7 @@ class RtdeLinkSink final : public Sink {
   bool pending_ = false;        ///< a frame's value not yet written
   double pending_value_ = 0.0;
   bool pending_stop_ = true;
-  bool have_value_ = false;     ///< a frame came (its value is written first on a new connection)
+  bool have_value_ = false;     ///< a frame came (its value starts a new connection while at most one period old)
   int64_t last_frame_ns_ = 0;   ///< clock time of the last frame() (or of construction)
   bool final_requested_ = false;
   bool final_written_ = false;
