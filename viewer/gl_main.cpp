@@ -426,7 +426,7 @@ int run_viewer(const ViewArgs& args) {
 
   ViewTap tap(snapshot_frames);
   ViewSink view_sink(tap);
-  ControlInbox inbox;
+  ControlInbox inbox(config.pipeline);  // tunings are judged against the run's start
   PlaybackControl playback;
   // run_session wraps only recordings (.bag, folder); a headless run plays straight through.
   const bool replay = !snapshots && is_recording(config.source.type);

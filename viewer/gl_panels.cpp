@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <iterator>
+#include <string>
 #include <utility>
 
 namespace hrcsense::view {
@@ -57,6 +58,15 @@ void Panels::take_events() {
 void Panels::apply_edit() {
   try {
     Config tuned = tuned_config(context_.config_path, context_.sets, edit_);
+    // Refused here too, not only by the inbox, so that the sliders go back and "save" never
+    // writes a value the pipeline did not take.
+    const std::string refusal =
+        context_.inbox != nullptr ? live_tuning_refusal(context_.inbox->configured(), tuning_of(tuned.pipeline)) : "";
+    if (!refusal.empty()) {
+      note(refusal, true);
+      edit_ = tuning_of(tuned_.pipeline);  // back to the last accepted values
+      return;
+    }
     tuned_ = std::move(tuned);
     edit_ = tuning_of(tuned_.pipeline);  // as the parser read it
     if (context_.inbox != nullptr) context_.inbox->post_tuning(edit_);

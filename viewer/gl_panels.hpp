@@ -2,7 +2,8 @@
 // hrcsense viewer — the Dear ImGui panels: live filter and foreground parameters, the search
 // backend, relearning the background, saving the tuned parameters, replay controls and the
 // panes shown. Every change goes through the configuration parser first (the same checks as
-// a file) and reaches the pipeline through the ControlInbox, between frames.
+// a file), then in `ssm` mode live_tuning_refusal, and reaches the pipeline through the
+// ControlInbox, between frames.
 #pragma once
 
 #include "viewer/playback.hpp"

@@ -61,13 +61,20 @@ void ControlInbox::apply(Pipeline& pipeline, const FrameResult& previous) {
   const int64_t after_frame = previous.frame;
   std::vector<ControlEvent> events;
   if (tuning) {
-    try {
-      pipeline.retune(*tuning);
+    std::string refusal = live_tuning_refusal(configured_, *tuning);
+    if (refusal.empty()) {
+      try {
+        pipeline.retune(*tuning);
+      } catch (const std::invalid_argument& e) {
+        refusal = e.what();
+      }
+    }
+    if (refusal.empty()) {
       events.push_back({after_frame, false, "parameters applied"});
       spdlog::info("viewer: tuned parameters applied after frame {}", after_frame);
-    } catch (const std::invalid_argument& e) {
-      events.push_back({after_frame, true, std::string("parameters refused: ") + e.what()});
-      spdlog::warn("viewer: tuned parameters refused: {}", e.what());
+    } else {
+      events.push_back({after_frame, true, "parameters refused: " + refusal});
+      spdlog::warn("viewer: tuned parameters refused: {}", refusal);
     }
   }
   if (relearn) {

@@ -12,6 +12,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hrcsense::view {
@@ -39,19 +40,28 @@ struct ControlEvent {
 /// The latest-wins inbox between the panels (any thread) and the processing thread.
 class ControlInbox {
  public:
+  /// `configured`: the parameters the run started with (Config::pipeline, as the Pipeline was
+  /// built), which every posted tuning is judged against (live_tuning_refusal), never the last
+  /// tuning applied.
+  explicit ControlInbox(PipelineParams configured) : configured_(std::move(configured)) {}
+  /// The parameters the run started with (never changes, so any thread may read it).
+  const PipelineParams& configured() const { return configured_; }
   /// New parameters, taken before the next frame; a newer post replaces one not yet taken.
   void post_tuning(const LiveTuning& tuning);
   /// Relearn the background before the next frame, unless relearn_refusal() says no then.
   void post_relearn();
   /// The processing thread's side, before each frame (RunOptions::before_process): applies
-  /// what was posted (a relearn judged by relearn_refusal with the pipeline's safety
-  /// parameters), logs it and keeps the outcome for take_events(). Never waits for the
-  /// renderer (the lock only guards the posted values).
+  /// what was posted (a tuning unless live_tuning_refusal with configured() or Pipeline::retune
+  /// refuses it, the pipeline then keeping its tuning; a relearn judged by relearn_refusal with
+  /// the pipeline's safety parameters), logs it and keeps the outcome, refusals with their
+  /// reason, for take_events(). Never waits for the renderer (the lock only guards the posted
+  /// values).
   void apply(Pipeline& pipeline, const FrameResult& previous);
   /// Outcomes since the last call, oldest first.
   std::vector<ControlEvent> take_events();
 
  private:
+  const PipelineParams configured_;
   std::mutex mutex_;
   std::optional<LiveTuning> tuning_;
   bool relearn_ = false;

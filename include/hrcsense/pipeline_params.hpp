@@ -14,6 +14,8 @@
 #include "hrcsense/self_filter.hpp"
 #include "hrcsense/types.hpp"
 
+#include <string>
+
 namespace hrcsense {
 
 /// Everything the processing path needs, already parsed (see config.hpp).
@@ -44,5 +46,15 @@ struct LiveTuning {
 
 /// The tunable part of `params`.
 LiveTuning tuning_of(const PipelineParams& params);
+
+/// Why `proposed` may not replace the tuning of a run started with `configured`, or empty when
+/// it may. In `safety.mode: ssm` the configuration the run started with is what the safety case
+/// was validated for, so a live change may only keep the foreground at least as sensitive:
+/// `foreground.k_sigma` in (0, configured k_sigma], `min_margin_m` in [0, configured
+/// min_margin_m], and `min_object_mm` in [0, kSpeckleShareOfDetection · safety.detection_mm]
+/// (the rule load_config applies at start). NaN is refused. The reason names the key, the value
+/// asked, the bound and why. In `zones` mode always empty. Only the foreground is judged here;
+/// Pipeline::retune refuses what cannot change live at all (the filter order, the decimation).
+std::string live_tuning_refusal(const PipelineParams& configured, const LiveTuning& proposed);
 
 }  // namespace hrcsense

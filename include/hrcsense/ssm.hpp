@@ -169,4 +169,9 @@ inline constexpr float kDepthNoiseSigmas = 2.0F;
 /// human speed. NaN input gives NaN (a stop).
 float contact_uncertainty_m(const SsmParams& params, const ContactUncertaintyInput& input);
 
+/// In `ssm` mode `foreground.min_object_mm` may be at most this share of `safety.detection_mm`:
+/// a test piece of d measures down to about 0.88·d, and smaller blobs are removed as speckle
+/// (docs/SAFETY.md, "C and the detection capability"). At start (load_config) and live.
+inline constexpr float kSpeckleShareOfDetection = 0.8F;
+
 }  // namespace hrcsense

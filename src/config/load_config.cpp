@@ -213,7 +213,6 @@ void read_ssm_terms(KeyReader& r, Config& c) {
   // outline, and edge pixels drop out (35-45 mm for 40 mm on the simulated D435, docs/SAFETY.md,
   // "C and the detection capability"). So the speckle threshold must stay 20 % below d. Checked
   // where C is used, in ssm mode: zones mode never reads detection_mm.
-  constexpr float kSpeckleShareOfDetection = 0.8F;
   const float max_min_object_mm = kSpeckleShareOfDetection * ssm.detection_mm;
   if (safety.mode == SafetyParams::Mode::ssm && c.pipeline.foreground.min_object_mm > max_min_object_mm) {
     r.fail_pair("safety.detection_mm", "foreground.min_object_mm",

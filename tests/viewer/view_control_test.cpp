@@ -124,7 +124,7 @@ TEST(RelearnRefusal, RefusedWithoutARobotState) {
 
 TEST(ControlInbox, NothingPostedLeavesThePipelineAlone) {
   Pipeline pipeline(point_robot_params());
-  ControlInbox inbox;
+  ControlInbox inbox(point_robot_params());
   inbox.apply(pipeline, still_and_clear());
   EXPECT_TRUE(inbox.take_events().empty());
   EXPECT_EQ(pipeline.params().foreground.k_sigma, ForegroundParams{}.k_sigma);
@@ -132,7 +132,7 @@ TEST(ControlInbox, NothingPostedLeavesThePipelineAlone) {
 
 TEST(ControlInbox, LatestTuningWinsAndIsAppliedOnce) {
   Pipeline pipeline(point_robot_params());
-  ControlInbox inbox;
+  ControlInbox inbox(point_robot_params());
   LiveTuning tuning = pipeline.tuning();
   tuning.foreground.k_sigma = 2.0F;
   inbox.post_tuning(tuning);
@@ -151,7 +151,7 @@ TEST(ControlInbox, LatestTuningWinsAndIsAppliedOnce) {
 
 TEST(ControlInbox, RefusedTuningIsReportedAndChangesNothing) {
   Pipeline pipeline(point_robot_params());
-  ControlInbox inbox;
+  ControlInbox inbox(point_robot_params());
   LiveTuning tuning = pipeline.tuning();
   tuning.filters.order.push_back(FilterBlock::temporal);  // the order is fixed while the cell runs
   tuning.backend = ProximityBackend::octree;
@@ -161,6 +161,53 @@ TEST(ControlInbox, RefusedTuningIsReportedAndChangesNothing) {
   ASSERT_EQ(events.size(), 1U);
   EXPECT_TRUE(events[0].refused);
   EXPECT_EQ(pipeline.params().backend, ProximityBackend::brute);
+}
+
+// safety.mode ssm: a tuning that makes the foreground less sensitive than the configuration the
+// run started with is refused with its reason, and the pipeline keeps its tuning; the bound is
+// that configuration, not the last tuning applied.
+TEST(ControlInbox, SsmTuningLessSensitiveThanConfiguredIsRefusedWithTheReason) {
+  PipelineParams params = point_robot_params();
+  params.safety.mode = SafetyParams::Mode::ssm;
+  params.foreground.k_sigma = 3.0F;
+  Pipeline pipeline(params);
+  ControlInbox inbox(params);
+
+  LiveTuning lower = pipeline.tuning();
+  lower.foreground.k_sigma = 2.0F;  // more sensitive: taken
+  inbox.post_tuning(lower);
+  inbox.apply(pipeline, still_and_clear());
+  std::vector<ControlEvent> events = inbox.take_events();
+  ASSERT_EQ(events.size(), 1U);
+  EXPECT_FALSE(events[0].refused) << events[0].text;
+  ASSERT_EQ(pipeline.tuning().foreground.k_sigma, 2.0F);
+
+  LiveTuning higher = pipeline.tuning();
+  higher.foreground.k_sigma = 5.0F;
+  higher.foreground.min_margin_m = 0.01F;  // allowed, but the tuning is refused as a whole
+  higher.backend = ProximityBackend::octree;
+  inbox.post_tuning(higher);
+  inbox.apply(pipeline, still_and_clear());
+  events = inbox.take_events();
+  ASSERT_EQ(events.size(), 1U);
+  EXPECT_TRUE(events[0].refused);
+  EXPECT_EQ(events[0].after_frame, 7);
+  EXPECT_NE(events[0].text.find("foreground.k_sigma 5 refused in ssm mode: above the configured 3"), std::string::npos)
+      << events[0].text;
+  const LiveTuning kept = pipeline.tuning();
+  EXPECT_EQ(kept.foreground.k_sigma, 2.0F);
+  EXPECT_EQ(kept.foreground.min_margin_m, params.foreground.min_margin_m);
+  EXPECT_EQ(kept.foreground.min_object_mm, params.foreground.min_object_mm);
+  EXPECT_EQ(kept.backend, ProximityBackend::brute);
+
+  LiveTuning back = pipeline.tuning();
+  back.foreground.k_sigma = 3.0F;  // back up to the configured value: taken
+  inbox.post_tuning(back);
+  inbox.apply(pipeline, still_and_clear());
+  events = inbox.take_events();
+  ASSERT_EQ(events.size(), 1U);
+  EXPECT_FALSE(events[0].refused) << events[0].text;
+  EXPECT_EQ(pipeline.tuning().foreground.k_sigma, 3.0F);
 }
 
 TEST(ControlInbox, RelearnRefusedNearTheRobotThenDoneWhenClear) {
@@ -176,7 +223,7 @@ TEST(ControlInbox, RelearnRefusedNearTheRobotThenDoneWhenClear) {
   test::process_and_decide(pipeline, frame, fixed_robot_state({}), result);
   ASSERT_EQ(result.verdict.code, ReasonCode::in_slow_zone);
 
-  ControlInbox inbox;
+  ControlInbox inbox(point_robot_params());
   inbox.post_relearn();
   inbox.apply(pipeline, result);
   std::vector<ControlEvent> events = inbox.take_events();
