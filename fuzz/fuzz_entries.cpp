@@ -230,6 +230,13 @@ bool stage_parameters_finite(const Config& c) {
   for (const Capsule& capsule : fixed_robot_model(c).capsules) {
     ok = ok && capsule.a.allFinite() && capsule.b.allFinite() && std::isfinite(capsule.radius_m);
   }
+  // The stopping data give a finite stop at any speed up to the arm's fastest.
+  const SsmParams& ssm = p.safety.ssm;
+  for (const double v : {0.0, 0.5, static_cast<double>(ssm.robot_max_speed_mps)}) {
+    const StopProfile stop = robot_stop(ssm, v);
+    ok = ok && std::isfinite(stop.distance_m) && std::isfinite(stop.time_s) && stop.distance_m >= 0.0;
+  }
+  ok = ok && std::isfinite(ssm.source_latency_s) && std::isfinite(ssm.receiver_timeout_s);
   return ok;
 }
 
