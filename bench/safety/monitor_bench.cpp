@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Monitor/per_link/ur5: the SafetyMonitor's decision of one measurement of a UR5 with a tool
 // (8 links, each with a contact, as when a person stands beside the arm), in ssm mode with the
-// hysteresis on (two decisions per frame: as measured and with the margin). Budget: 50 us
+// hysteresis on (two decisions per frame: as measured and with the margin), every link's
+// allowed and planned speed solved by bisection over the stopping data. Budget: 50 us
 // (DESIGN.md, "per-link decision").
 #include "hrcsense/safety.hpp"
 
@@ -18,7 +19,9 @@ FrameResult ur5_measurement() {
     LinkContact l;
     l.link = link;
     l.contact.valid = true;
-    l.contact.distance_m = 0.9F + 0.1F * static_cast<float>(link);
+    // Beyond S_p at each link's present speed (about 1.55 m + 0.56 s · v with S2's T_r), so
+    // that every link's allowed and planned speeds are solved, not cut short by a stop.
+    l.contact.distance_m = 1.9F + 0.1F * static_cast<float>(link);
     l.contact.robot_link = link;
     l.contact.closest_base = {l.contact.distance_m, 0.0F, 1.0F};
     l.contact.closest_robot_base = {0.0F, 0.0F, 1.0F};
@@ -36,7 +39,7 @@ void BM_MonitorPerLinkUr5(benchmark::State& state) {
   params.mode = SafetyParams::Mode::ssm;
   params.hysteresis_m = 0.05F;
   params.min_hold_s = 0.2;
-  SafetyMonitor monitor(params);
+  SafetyMonitor monitor(params, 30.0);  // a frame period in T_r and the scale's look-ahead
   FrameResult m = ur5_measurement();
   int64_t t_ns = 0;
   for (auto _ : state) {

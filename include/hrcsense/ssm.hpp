@@ -142,7 +142,8 @@ double planned_robot_speed_mps(const SsmParams& params, const SsmInput& input);
 /// The fraction of the robot's present speed towards the person (taken as its programmed
 /// speed) that takes it to planned_robot_speed_mps, in [0, 1]: 1 when the present speed is
 /// already within it, 0 when no speed keeps S_p (allowed_robot_speed_mps < 0). A robot that
-/// stands still or moves away gets 1, or 0 when even rest does not fit. 0 for NaN input.
+/// stands still or moves away gets 1 outside S_p(0) (the scale of no speed says nothing). 0 for
+/// NaN input.
 float ssm_speed_scale(const SsmParams& params, const SsmInput& input);
 
 /// What Z_d of one contact is made of (contact_uncertainty_m).

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace hrcsense {
 namespace {
@@ -68,6 +69,57 @@ double protective_at(const SsmParams& params, const SsmInput& input, const SsmTe
          fixed.z_d_m + fixed.z_r_m;
 }
 
+// S_p(v) = a + b·v + c·v² where the stopping data make it one (the closed form, the limits);
+// nullopt for a table, which is piecewise.
+struct Quadratic {
+  double a = 0.0, b = 0.0, c = 0.0;
+};
+
+std::optional<Quadratic> protective_polynomial(const SsmParams& params, const SsmInput& input, const SsmTerms& fixed) {
+  if (!params.stopping_table.empty()) return std::nullopt;
+  const double v_h = human_speed(params, input.distance_m);
+  const double t_r = fixed.reaction_time_s;
+  const double rest_m = static_cast<double>(fixed.c_m) + fixed.z_d_m + fixed.z_r_m;
+  const StopProfile at_rest = robot_stop(params, 0.0);
+  Quadratic q;
+  q.a = v_h * (t_r + at_rest.time_s) + at_rest.distance_m + rest_m;
+  if (params.stopping_limit_distance_m > 0.0F) {
+    q.b = t_r;  // the limits do not grow with speed
+  } else if (params.robot_decel_mps2 > 0.0F) {
+    const double decel = params.robot_decel_mps2;
+    q.b = t_r + params.robot_stop_time_s + v_h / decel;  // S_r, the delay's travel, v_h · v / decel
+    q.c = 0.5 / decel;
+  } else {
+    q.b = t_r + 0.5 * params.robot_stop_time_s;
+  }
+  return q;
+}
+
+// The largest v ≥ `fits_from` (a speed known to fit) with S_p(v) + (v_h + v)·look_ahead_s ≤ d:
+// the positive root where S_p is a polynomial, else bisection (S_p grows with v).
+double largest_fitting_speed(const SsmParams& params, const SsmInput& input, const SsmTerms& fixed,
+                             double look_ahead_s, double fits_from) {
+  const double d = input.distance_m;
+  const double v_h = human_speed(params, input.distance_m);
+  if (const std::optional<Quadratic> q = protective_polynomial(params, input, fixed)) {
+    const double room = d - q->a - v_h * look_ahead_s;  // ≥ 0: fits_from fits
+    const double b = q->b + look_ahead_s;
+    if (q->c == 0.0) return b > 0.0 ? std::max(fits_from, room / b) : std::numeric_limits<double>::infinity();
+    // c·v² + b·v − room = 0, the positive root, written to avoid cancellation.
+    return std::max(fits_from, 2.0 * room / (b + std::sqrt(b * b + 4.0 * q->c * room)));
+  }
+  const auto fits = [&](double v) { return protective_at(params, input, fixed, v) + (v_h + v) * look_ahead_s <= d; };
+  double lo = fits_from;
+  double hi = std::max(1.0, 2.0 * fits_from);
+  for (int k = 0; k < 16 && fits(hi); ++k) hi *= 2.0;
+  if (fits(hi)) return hi;  // beyond any arm's speed
+  for (int k = 0; k < 100 && hi - lo > 1e-12 * hi; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (fits(mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
 }  // namespace
 
 const char* stopping_data_name(StoppingData data) {
@@ -123,17 +175,7 @@ double allowed_robot_speed_mps(const SsmParams& params, const SsmInput& input) {
   // Braking from v_r to any v_a and stopping from v_a is one braking on the robot's profile,
   // never shorter than the stop from v_r itself: below S_p(v_r) no speed helps.
   if (!(d >= at_present.protective_distance_m)) return -1.0;
-  // The largest v with S_p(v) ≤ d; S_p grows with v (the stopping data grow with speed), so
-  // bisection between v_r, which fits, and a speed that does not.
-  double lo = v_r;
-  double hi = std::max(1.0, 2.0 * v_r);
-  for (int k = 0; k < 16 && protective_at(params, input, at_present, hi) <= d; ++k) hi *= 2.0;
-  if (protective_at(params, input, at_present, hi) <= d) return hi;  // beyond any arm's speed
-  for (int k = 0; k < 100 && hi - lo > 1e-12 * hi; ++k) {
-    const double mid = 0.5 * (lo + hi);
-    (protective_at(params, input, at_present, mid) <= d ? lo : hi) = mid;
-  }
-  return lo;
+  return largest_fitting_speed(params, input, at_present, 0.0, v_r);
 }
 
 double planned_robot_speed_mps(const SsmParams& params, const SsmInput& input) {
@@ -144,17 +186,8 @@ double planned_robot_speed_mps(const SsmParams& params, const SsmInput& input) {
   // nearer and the robot v·period: S_p(v) + (v_h + v)·period ≤ d, which grows with v.
   const SsmTerms fixed = protective_distance(params, input, 0.0F);
   const double v_h = human_speed(params, input.distance_m);
-  const double d = input.distance_m;
-  const auto fits = [&](double v) { return protective_at(params, input, fixed, v) + (v_h + v) * period_s <= d; };
-  if (!fits(0.0)) return 0.0;
-  if (fits(allowed)) return allowed;
-  double lo = 0.0;
-  double hi = allowed;
-  for (int k = 0; k < 100 && hi - lo > 1e-12 * hi; ++k) {
-    const double mid = 0.5 * (lo + hi);
-    (fits(mid) ? lo : hi) = mid;
-  }
-  return lo;
+  if (!(protective_at(params, input, fixed, 0.0) + v_h * period_s <= input.distance_m)) return 0.0;
+  return std::min(allowed, largest_fitting_speed(params, input, fixed, period_s, 0.0));
 }
 
 float ssm_speed_scale(const SsmParams& params, const SsmInput& input) {
@@ -162,7 +195,7 @@ float ssm_speed_scale(const SsmParams& params, const SsmInput& input) {
   if (!(allowed >= 0.0)) return 0.0F;  // no speed keeps S_p, or NaN
   const double v_r = input.robot_speed_mps;
   if (std::isnan(v_r)) return 0.0F;  // an unknown speed is no proof of a slow robot
-  if (!(v_r > 0.0)) return 1.0F;     // standing still or moving away, and far enough
+  if (!(v_r > 0.0)) return 1.0F;     // standing still or moving away, and outside S_p(0)
   return static_cast<float>(std::min(1.0, allowed / v_r));
 }
 

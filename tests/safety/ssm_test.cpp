@@ -205,6 +205,31 @@ TEST(Ssm, RobotStateAgeBeyondExtrapolationWidensZr) {
   EXPECT_NEAR(t.protective_distance_m, 1.166 + 0.06, 1e-5);
 }
 
+// The scale's look-ahead, one frame period (1/30 s): T_r = 0.08 + 1/30 = 0.1133333 s, so
+// S_p(v) = 1.6·(0.1133333 + 0.5) + 0.238 + v·(0.1133333 + 0.25) = 1.2193333 + 0.3633333·v. At
+// 2 m the allowed speed is (2 − 1.2193333) / 0.3633333 = 2.1486239 m/s; the planned speed also
+// leaves the next frame room for the person's (1.6 m/s) and the robot's approach over 1/30 s:
+// 1.2193333 + 0.0533333 + (0.3633333 + 0.0333333)·v = 2, v = 1.8336134 m/s. A robot at 2 m/s
+// (S_p(2) = 1.946 m ≤ 2 m: no stop) is slowed to 1.8336134 / 2 = 0.9168067.
+TEST(Ssm, ThePlannedSpeedLeavesTheNextFrameRoom) {
+  SsmParams params = defaults();
+  params.frame_period_s = 1.0 / 30.0;
+  EXPECT_NEAR(allowed_robot_speed_mps(params, input(2.0F, 0.5F)), 2.1486239, 1e-6);
+  EXPECT_NEAR(planned_robot_speed_mps(params, input(2.0F, 0.5F)), 1.8336134, 1e-6);
+  EXPECT_NEAR(ssm_speed_scale(params, input(2.0F, 2.0F)), 0.9168067, 1e-6);
+  // At 1.25 m a standing robot is outside S_p(0) = 1.2193 m, but not with the look-ahead's
+  // 0.0533 m: the planned speed is 0. It stands, so its scale stays 1 (a scale of its present
+  // speed, 0, means nothing); a robot at 0.05 m/s (S_p 1.2375 m) is slowed to 0.
+  EXPECT_NEAR(allowed_robot_speed_mps(params, input(1.25F, 0.0F)), (1.25 - 1.2193333) / 0.3633333, 1e-5);
+  EXPECT_EQ(planned_robot_speed_mps(params, input(1.25F, 0.0F)), 0.0);
+  EXPECT_EQ(ssm_speed_scale(params, input(1.25F, 0.0F)), 1.0F);
+  EXPECT_EQ(ssm_speed_scale(params, input(1.25F, 0.05F)), 0.0F);
+  // The same by bisection over a table that is the closed form (0.25·v m in 0.5 s).
+  SsmParams table = params;
+  table.stopping_table = {{1.0F, 0.25F, 0.5}, {4.0F, 1.0F, 0.5}};
+  EXPECT_NEAR(planned_robot_speed_mps(table, input(2.0F, 0.5F)), 1.8336134, 1e-5);
+}
+
 // Some v_a ≥ 0 fits exactly when the distance is at least S_p at the present speed: just
 // above it the robot may keep (at least) its speed, just below it nothing does.
 TEST(Ssm, NoSpeedFitsBelowTheProtectiveDistanceAtThePresentSpeed) {
