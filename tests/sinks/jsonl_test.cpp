@@ -189,6 +189,56 @@ TEST(JsonLinesSink, FrameWithContactHasEveryField) {
   EXPECT_EQ(f["robot_state_age_ms"].get<double>(), 3.5);
 }
 
+// S2's fields: the ssm terms with T_r's parts (which add up to reaction_time_s), Z_r's part from
+// the robot state's age, unknown_margin_m, and the header's stopping_data (null in zones mode).
+TEST(JsonLinesSink, SsmTermsCarryTheReactionTimesPartsAndTheUnknownMargin) {
+  std::ostringstream out;
+  JsonLinesSink sink(out, "brute");
+  FrameResult r = contact_result();
+  SsmTerms t;
+  t.frame_age_s = 0.03;
+  t.frame_period_s = 0.0625;
+  t.source_latency_s = 0.033;
+  t.controller_latency_s = 0.05;
+  t.receiver_timeout_s = 0.2;
+  t.reaction_time_s = 0.375;
+  t.z_r_m = 0.04F;
+  t.z_r_state_m = 0.03F;
+  r.ssm = t;
+  r.unknown_distance_m = 1.25F;
+  r.unknown_margin_m = -0.125F;
+  sink.frame(r);
+  const json f = json::parse(out.str());
+  const json& parts = f["ssm"]["reaction_time_parts"];
+  EXPECT_EQ(parts["frame_age_s"].get<double>(), 0.03);
+  EXPECT_EQ(parts["frame_period_s"].get<double>(), 0.0625);
+  EXPECT_EQ(parts["source_latency_s"].get<double>(), 0.033);
+  EXPECT_EQ(parts["controller_latency_s"].get<double>(), 0.05);
+  EXPECT_EQ(parts["receiver_timeout_s"].get<double>(), 0.2);
+  EXPECT_EQ(f["ssm"]["reaction_time_s"].get<double>(), 0.375);
+  EXPECT_EQ(f["ssm"]["z_r_state_m"].get<float>(), 0.03F);
+  EXPECT_EQ(f["unknown_margin_m"].get<float>(), -0.125F);
+  // Without unknown space: null.
+  std::ostringstream none;
+  JsonLinesSink second(none, "brute");
+  second.frame(contact_result());
+  EXPECT_TRUE(json::parse(none.str())["unknown_margin_m"].is_null());
+  // The header: where S_s comes from in ssm mode, null in zones mode (an empty name).
+  for (const char* data : {"table", ""}) {
+    std::ostringstream head;
+    JsonLinesSink header_sink(head, "brute");
+    RunHeader header;
+    header.stopping_data = data;
+    header_sink.header(header);
+    const json h = json::parse(head.str());
+    if (*data != '\0') {
+      EXPECT_EQ(h["stopping_data"], data);
+    } else {
+      EXPECT_TRUE(h["stopping_data"].is_null());
+    }
+  }
+}
+
 // truth.contact_label is the extras' answer, asked only for a frame with a truth and a measured
 // contact; without a labeller (any source but the simulator) it is null.
 TEST(JsonLinesSink, ContactLabelComesFromTheExtrasOnlyForAMeasuredContact) {
