@@ -87,8 +87,11 @@ Verdict ssm_verdict(const SafetyParams& params, const VerdictInput& input, float
     return make_verdict(VerdictState::stop, 0.0F, terms->protective_distance_m,
                         ReasonCode::below_protective_distance, "below S_p");
   }
-  float scale = ssm_speed_scale(params.ssm, ssm);
-  const double planned = planned_robot_speed_mps(params.ssm, ssm);  // ≤ allowed: slows before a stop
+  // The speed the scale aims at (≤ allowed: slows before a stop), solved once; as
+  // ssm_speed_scale, a robot standing still or moving away outside S_p(0) gets 1.
+  const double planned = planned_robot_speed_mps(params.ssm, ssm);
+  const double v_r = input.robot_speed_towards_mps;
+  float scale = v_r > 0.0 ? static_cast<float>(std::min(1.0, planned / v_r)) : 1.0F;
   // The scale is of the programmed speed: the robot runs at robot_speed_scaling of it now (the
   // slider we set earlier times the controller's own reduction). Below 1 % (a robot we stopped,
   // or one paused) the present speed says nothing of the programmed one, and the arm's fastest,
