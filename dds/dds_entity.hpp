@@ -7,8 +7,11 @@
 
 #include <dds/dds.h>
 
+#include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace hrcsense::ros2 {
 
@@ -37,6 +40,36 @@ class DdsEntity {
 
  private:
   dds_entity_t entity_ = 0;
+};
+
+/// The process's DDS participant on `domain_id`, shared: the ROS 2 camera source, the outputs
+/// and the joint-state reader all join a domain through here, so a process is one participant
+/// per domain (one entry in discovery, one set of sockets), deleted with its last user. Cyclone
+/// reads its configuration (CYCLONEDDS_URI) when the first one is made; hrcsense never
+/// overrides it. Thread-safe; throws Ros2Error naming the domain when it cannot be made.
+std::shared_ptr<const DdsEntity> domain_participant(uint32_t domain_id);
+
+/// What one user made on a shared participant (topics, readers, writers, waitsets): deleted,
+/// newest first, when this goes, while the participant lives on for its other users. Holds the
+/// participant, so it outlives everything made on it here.
+class ParticipantScope {
+ public:
+  explicit ParticipantScope(uint32_t domain_id) : participant_(domain_participant(domain_id)) {}
+  ParticipantScope(const ParticipantScope&) = delete;
+  ParticipantScope& operator=(const ParticipantScope&) = delete;
+  ~ParticipantScope() {
+    for (auto it = owned_.rbegin(); it != owned_.rend(); ++it) dds_delete(*it);
+  }
+  dds_entity_t participant() const { return participant_->get(); }
+  /// Keeps `entity` (a DDS return code < 0 throws Ros2Error with `what`) and returns it.
+  dds_entity_t own(dds_return_t entity, const std::string& what) {
+    owned_.push_back(check_dds(entity, what));
+    return owned_.back();
+  }
+
+ private:
+  std::shared_ptr<const DdsEntity> participant_;
+  std::vector<dds_entity_t> owned_;
 };
 
 /// The QoS a ROS 2 endpoint is given here (../shared/specs/ros2-interop.md, "QoS").

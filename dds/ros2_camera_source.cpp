@@ -60,23 +60,23 @@ class Taken {
 
 }  // namespace
 
-// The participant owns everything else; readers and waitsets are plain handles into it.
+// The domain's shared participant; the topics, readers and waitsets made here go with this.
 struct Ros2CameraSource::Dds {
-  DdsEntity participant;
+  std::unique_ptr<ParticipantScope> scope;
   dds_entity_t depth_reader = 0, depth_info_reader = 0, color_reader = 0, color_info_reader = 0;
   dds_entity_t extrinsics_reader = 0;
   dds_entity_t depth_waitset = 0, color_waitset = 0, info_waitset = 0;
 
   dds_entity_t reader(const dds_topic_descriptor_t& type, const std::string& ros_topic, const EndpointQos& qos) {
     const std::string name = dds_topic_name(ros_topic);
-    const dds_entity_t topic = check_dds(dds_create_topic(participant.get(), &type, name.c_str(), nullptr, nullptr),
-                                         "DDS topic " + name);
+    const dds_entity_t topic =
+        scope->own(dds_create_topic(scope->participant(), &type, name.c_str(), nullptr, nullptr), "DDS topic " + name);
     const QosHandle handle(qos);
-    return check_dds(dds_create_reader(participant.get(), topic, handle.get(), nullptr), "DDS reader on " + name);
+    return scope->own(dds_create_reader(scope->participant(), topic, handle.get(), nullptr), "DDS reader on " + name);
   }
 
   dds_entity_t waitset_on(dds_entity_t reader) {
-    const dds_entity_t waitset = check_dds(dds_create_waitset(participant.get()), "DDS waitset");
+    const dds_entity_t waitset = scope->own(dds_create_waitset(scope->participant()), "DDS waitset");
     const dds_entity_t condition = check_dds(dds_create_readcondition(reader, DDS_ANY_STATE), "DDS read condition");
     check_dds(dds_waitset_attach(waitset, condition, condition), "DDS waitset attach");
     return waitset;
@@ -84,11 +84,9 @@ struct Ros2CameraSource::Dds {
 
   // The participant in params.domain_id, the readers of the configured topics (colour ones only
   // with params.color) and a waitset on each reader waited on.
-  void open(const Ros2SourceParams& params, const std::string& domain) {
+  void open(const Ros2SourceParams& params) {
     const CameraTopics& topics = params.topics;
-    // Cyclone reads its own configuration (CYCLONEDDS_URI) here; hrcsense never overrides it.
-    participant = DdsEntity(check_dds(dds_create_participant(params.domain_id, nullptr, nullptr),
-                                      "DDS participant on " + domain));
+    scope = std::make_unique<ParticipantScope>(params.domain_id);
     const EndpointQos images{false, false, static_cast<int32_t>(kMaxTake)};
     const EndpointQos infos{false, false, 1};
     depth_reader = reader(sensor_msgs_msg_dds__Image__desc, topics.depth_image, images);
@@ -149,7 +147,7 @@ struct Ros2CameraSource::Dds {
 
 Ros2CameraSource::Ros2CameraSource(Ros2SourceParams params) : params_(std::move(params)), dds_(std::make_unique<Dds>()) {
   const std::string domain = "domain " + std::to_string(params_.domain_id);
-  dds_->open(params_, domain);
+  dds_->open(params_);
   // The first depth CameraInfo gives the intrinsics the run starts with; a second one, when it
   // comes soon, gives the rate.
   const std::vector<int64_t> stamps = dds_->first_depth_infos(params_, domain, depth_intrinsics_);

@@ -178,7 +178,7 @@ inline constexpr int kJointCount = 6;
 using JointAngles = std::array<double, kJointCount>;
 
 /// Where a robot state came from (`robot.state.source`).
-enum class RobotStateOrigin { fixed, sim, rtde, udp_json, recorded };
+enum class RobotStateOrigin { fixed, sim, rtde, udp_json, recorded, ros2 };
 
 /// `record.on_error`: after a write error, go on without recording (continue) or end the run (stop).
 enum class RecordOnError { continue_run, stop_run };

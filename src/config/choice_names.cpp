@@ -64,4 +64,8 @@ const char* record_on_error_name(RecordOnError on_error) {
   return "unknown";
 }
 
+const char* speed_scaling_unit_name(SpeedScalingUnit unit) {
+  return unit == SpeedScalingUnit::percent ? "percent" : "fraction";
+}
+
 }  // namespace hrcsense

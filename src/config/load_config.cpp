@@ -7,6 +7,7 @@
 
 #include "hrcsense/camera.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <limits>
@@ -307,6 +308,13 @@ void ros2_name(KeyReader& r, const std::string& key, std::string& value, bool em
   if (!ok) r.fail(key, "expected an absolute ROS 2 name like /camera/camera (letters, digits, '_' between '/'), got '" + value + "'");
 }
 
+// A ROS 2 name token: letters, digits and '_', not starting with a digit.
+bool ros2_token(const std::string& value) {
+  if (value.empty() || std::isdigit(static_cast<unsigned char>(value.front())) != 0) return false;
+  return std::all_of(value.begin(), value.end(),
+                     [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) != 0 || ch == '_'; });
+}
+
 void read_ros2(KeyReader& r, Config& c) {
   Ros2SourceConfig& ros2 = c.source.ros2;
   ros2_name(r, "source.ros2.namespace", ros2.node_namespace, false);
@@ -323,6 +331,29 @@ void read_ros2(KeyReader& r, Config& c) {
   r.integer("publish.domain_id", publish.domain_id, 0, 232);
   r.integer("publish.wait_for_subscribers", publish.wait_for_subscribers, 0, 100);
   r.number_in("publish.wait_timeout_s", publish.wait_timeout_s, 0.1, 3600.0, " s");
+
+  // H1: the outputs, and the domain the ROS 2 joint states are read on.
+  Ros2Config& out = c.ros2;
+  r.flag("ros2.publish", out.publish);
+  r.integer("ros2.domain_id", out.domain_id, 0, 232);
+  ros2_name(r, "ros2.namespace", out.node_namespace, false);
+  r.number_in("ros2.cloud_hz", out.cloud_hz, 0.0, 100.0, " Hz");
+  ros2_name(r, "ros2.speed_scaling_topic", out.speed_scaling_topic, true);
+  r.text("ros2.camera_name", out.camera_name);
+  if (!ros2_token(out.camera_name)) {
+    r.fail("ros2.camera_name", "expected a ROS 2 name token (letters, digits, '_', not starting with a digit), got '" +
+                                   out.camera_name + "'");
+  }
+
+  Ros2JointStateConfig& joints = c.robot_state.ros2;
+  ros2_name(r, "robot.state.ros2.topic", joints.topic, false);
+  r.text("robot.state.ros2.tf_prefix", joints.tf_prefix);
+  if (!joints.tf_prefix.empty() && !ros2_token(joints.tf_prefix)) {
+    r.fail("robot.state.ros2.tf_prefix", "expected letters, digits and '_' (e.g. ur_), got '" + joints.tf_prefix + "'");
+  }
+  ros2_name(r, "robot.state.ros2.speed_scaling_topic", joints.speed_scaling_topic, true);
+  constexpr SpeedScalingUnit kUnits[] = {SpeedScalingUnit::percent, SpeedScalingUnit::fraction};
+  r.choice("robot.state.ros2.speed_scaling_unit", joints.speed_scaling_unit, kUnits, speed_scaling_unit_name);
 }
 
 void read_record(KeyReader& r, Config& c) {

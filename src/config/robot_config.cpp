@@ -306,7 +306,8 @@ YAML::Node robot_description_node(const RobotDescription& description) {
 // assembly builds the source or says it is not built.
 void read_robot_state(KeyReader& r, RobotStateConfig& s) {
   constexpr RobotStateOrigin kOrigins[] = {RobotStateOrigin::fixed, RobotStateOrigin::sim, RobotStateOrigin::rtde,
-                                           RobotStateOrigin::udp_json, RobotStateOrigin::recorded};
+                                           RobotStateOrigin::udp_json, RobotStateOrigin::recorded,
+                                           RobotStateOrigin::ros2};
   r.choice("robot.state.source", s.source, kOrigins, robot_state_origin_name);
   r.text("robot.state.host", s.host);
   r.integer("robot.state.port", s.port, 1, 65535);

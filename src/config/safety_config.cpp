@@ -122,7 +122,8 @@ void check_ssm_mode(KeyReader& r, Config& config) {
           "an older joint state leaves the arm where it no longer is");
 
   const RobotStateOrigin state = config.robot_state.source;
-  const bool live_state = state == RobotStateOrigin::rtde || state == RobotStateOrigin::udp_json;
+  const bool live_state =
+      state == RobotStateOrigin::rtde || state == RobotStateOrigin::udp_json || state == RobotStateOrigin::ros2;
   const bool controller_link = !config.link.udp_address.empty() || config.link.rtde_write != RtdeWrite::off;
   if (ssm.stopping_data == StoppingData::default_time && !ssm.stopping_data_confirmed) {
     const std::string what =

@@ -11,6 +11,7 @@ const char* robot_state_origin_name(RobotStateOrigin origin) {
     case RobotStateOrigin::rtde: return "rtde";
     case RobotStateOrigin::udp_json: return "udp_json";
     case RobotStateOrigin::recorded: return "recorded";
+    case RobotStateOrigin::ros2: return "ros2";
   }
   return "unknown";
 }

@@ -42,6 +42,9 @@ std::vector<NamedChoice> named_choices() {
        [](const Config& c) { return c.robot_state.source == RobotStateOrigin::udp_json; }},
       {{"robot.state.source=recorded"},
        [](const Config& c) { return c.robot_state.source == RobotStateOrigin::recorded; }},
+      {{"robot.state.source=ros2"}, [](const Config& c) { return c.robot_state.source == RobotStateOrigin::ros2; }},
+      {{"robot.state.ros2.speed_scaling_unit=fraction"},
+       [](const Config& c) { return c.robot_state.ros2.speed_scaling_unit == SpeedScalingUnit::fraction; }},
       {{"robot.model=points"}, [](const Config& c) { return c.robot_model == RobotModelType::points && !c.pipeline.robot.arm; }},
       {{"robot.model=ur5", kJoints},
        [](const Config& c) { return c.robot_model == RobotModelType::ur5 && c.pipeline.robot.arm->name == "ur5"; }},
@@ -100,8 +103,10 @@ TEST(ConfigChoices, AnotherSpellingIsRefusedWithTheList) {
   expect_config_error("", {"proximity.backend=Brute"}, {"'proximity.backend'", "brute, kdtree, octree, depth_space, auto"});
   expect_config_error("", {"link.udp.format=JSON"}, {"'link.udp.format'", "expected one of binary, json"});
   expect_config_error("", {"record.on_error=retry"}, {"'record.on_error'", "expected one of continue, stop"});
-  expect_config_error("", {"robot.state.source=ros2"},
-                      {"'robot.state.source'", "expected one of fixed, sim, rtde, udp_json, recorded"});
+  expect_config_error("", {"robot.state.source=ros"},
+                      {"'robot.state.source'", "expected one of fixed, sim, rtde, udp_json, recorded, ros2"});
+  expect_config_error("", {"robot.state.ros2.speed_scaling_unit=percentage"},
+                      {"'robot.state.ros2.speed_scaling_unit'", "expected one of percent, fraction"});
 }
 
 }  // namespace

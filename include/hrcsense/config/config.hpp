@@ -29,6 +29,8 @@ enum class UdpFormat { binary, json };
 enum class RtdeWrite { off, speed_slider, input_register };
 /// `robot.model`: padded points, a built-in arm, or an arm from `robot.description`.
 enum class RobotModelType { points, ur5, ur5e, ur10e, custom };
+/// `robot.state.ros2.speed_scaling_unit`: how the driver's std_msgs/Float64 speed scaling reads.
+enum class SpeedScalingUnit { percent, fraction };
 
 /// The configuration's name of each choice (a static string): "sim", "json", "register", ...
 const char* source_type_name(SourceType type);
@@ -36,6 +38,7 @@ const char* udp_format_name(UdpFormat format);
 const char* rtde_write_name(RtdeWrite write);
 const char* robot_model_name(RobotModelType model);
 const char* record_on_error_name(RecordOnError on_error);  ///< "continue", "stop"
+const char* speed_scaling_unit_name(SpeedScalingUnit unit);  ///< "percent", "fraction"
 /// The built-in arm a model names; nullopt for points and custom.
 std::optional<BuiltinArm> builtin_arm_of(RobotModelType model);
 
@@ -65,6 +68,21 @@ struct PublishConfig {
   int domain_id = 0;                ///< `publish.domain_id`
   int wait_for_subscribers = 0;     ///< `publish.wait_for_subscribers`: start once this many depth readers matched
   double wait_timeout_s = 30.0;     ///< `publish.wait_timeout_s`: how long to wait for them
+};
+
+/// `ros2.*`: hrcsense's results as ROS 2 topics over Cyclone DDS, and the DDS domain of its ROS 2
+/// inputs (robot.state.source ros2); docs/ROS2.md.
+struct Ros2Config {
+  bool publish = false;                    ///< `ros2.publish`: verdict, speed_scaling, markers, foreground, /tf_static
+  int domain_id = 0;                       ///< `ros2.domain_id`: the DDS domain (ROS_DOMAIN_ID)
+  std::string node_namespace = "/hrcsense";  ///< `ros2.namespace`: the topics' prefix
+  double cloud_hz = 10.0;                  ///< `ros2.cloud_hz`: foreground clouds per second at most; 0: none
+  /// `ros2.speed_scaling_topic`: an absolute name for the speed scaling output; empty:
+  /// <namespace>/speed_scaling.
+  std::string speed_scaling_topic;
+  /// `ros2.camera_name`: the camera's frames are <camera_name>_link and
+  /// <camera_name>_depth_optical_frame (realsense-ros's names).
+  std::string camera_name = "camera";
 };
 
 /// One RealSense SDK option to set on the depth sensor (`source.options.<name>`): the SDK's
@@ -110,9 +128,24 @@ struct SourceConfig {
 };
 
 /// Where the robot's joint state comes from (`robot.state.*`, docs/ROBOT.md).
+/// `robot.state.ros2.*`: sensor_msgs/JointState from a ROS 2 driver over Cyclone DDS, on
+/// `ros2.domain_id` (docs/ROS2.md, "Joint states in").
+struct Ros2JointStateConfig {
+  std::string topic = "/joint_states";  ///< `robot.state.ros2.topic`
+  /// `robot.state.ros2.tf_prefix`: put before UR's six joint names (e.g. "ur_" for
+  /// ur_shoulder_pan_joint); empty by default.
+  std::string tf_prefix;
+  /// `robot.state.ros2.speed_scaling_topic`: the driver's speed scaling, std_msgs/Float64; empty:
+  /// not read.
+  std::string speed_scaling_topic = "/speed_scaling_state_broadcaster/speed_scaling";
+  /// `robot.state.ros2.speed_scaling_unit`: percent (UR's driver publishes 0-100) or fraction (0-1).
+  SpeedScalingUnit speed_scaling_unit = SpeedScalingUnit::percent;
+};
+
 struct RobotStateConfig {
   /// `robot.state.source`: fixed (robot.joints_rad), sim (robot.trajectory), rtde (a UR
-  /// controller), udp_json (any robot), recorded (a .bag from hrcsense record).
+  /// controller), udp_json (any robot), recorded (a .bag from hrcsense record), ros2 (a ROS 2
+  /// driver's /joint_states).
   RobotStateOrigin source = RobotStateOrigin::fixed;
   /// `robot.joints_rad`: the fixed pose, joint 1 first (required for an arm with the fixed
   /// source; zeros when not given).
@@ -130,6 +163,7 @@ struct RobotStateConfig {
   /// sim source). Set: the simulator moves the arm along it instead of rendering it fixed at
   /// robot.joints_rad.
   std::optional<RobotTrajectory> trajectory;
+  Ros2JointStateConfig ros2;     ///< `robot.state.ros2.*`
 };
 
 /// `record.*`: recordings made by `hrcsense record` and `hrcsense run --record` (docs/RECORDINGS.md).
@@ -182,6 +216,7 @@ struct Config {
   RobotStateConfig robot_state;          ///< `robot.state.*` and `robot.joints_rad`
   RecordConfig record;                   ///< `record.*`
   PublishConfig publish;                 ///< `publish.*`
+  Ros2Config ros2;                       ///< `ros2.*`
   LinkConfig link;                       ///< `link.*`
   std::string canonical_yaml;      ///< the effective configuration, for the hash in the header
   /// What a person starting the run must hear about this configuration (e.g. ssm without the
