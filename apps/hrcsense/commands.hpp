@@ -40,7 +40,18 @@ struct EvalArgs {
   std::string report;               ///< --report FILE: the thesis study's report also here
 };
 
+/// `hrcsense echo`'s flags (docs/ROS2.md).
+struct EchoArgs {
+  std::string topic;        ///< TOPIC: a ROS 2 name, e.g. /hrcsense/verdict
+  int domain = -1;          ///< --domain N; -1: ROS_DOMAIN_ID when set, else 0
+  std::string type;         ///< --type NAME; empty: from the topic's name
+  int64_t count = -1;       ///< --count N; -1: until interrupted
+  double timeout_s = -1.0;  ///< --timeout-s S; < 0: none
+};
+
 int run_command(const CommandArgs& args);
+/// echo TOPIC: the samples of one of hrcsense's ROS 2 topics (or /joint_states) as JSON lines.
+int echo_command(const EchoArgs& args);
 /// eval: the thesis's measures over a sweep (results.csv in --out, resumable).
 int eval_command(const EvalArgs& args);
 /// eval --study NAME: table-4.1 … table-4.4, moving-cell, or thesis (all, with the report).

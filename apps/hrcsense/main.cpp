@@ -32,6 +32,7 @@ struct Subcommands {
   CLI::App* run = nullptr;
   CLI::App* record = nullptr;
   CLI::App* publish = nullptr;
+  CLI::App* echo = nullptr;
   CLI::App* info = nullptr;
   CLI::App* teach = nullptr;
   CLI::App* devices = nullptr;
@@ -81,15 +82,31 @@ CLI::App* add_eval_command(CLI::App& app, hrcsense::app::EvalArgs& eval_args) {
   return eval;
 }
 
-// Every subcommand, added in the order `--help` lists them; `args` and `eval_args` receive the
-// parsed flags.
-Subcommands add_subcommands(CLI::App& app, CommandArgs& args, hrcsense::app::EvalArgs& eval_args) {
+CLI::App* add_echo_command(CLI::App& app, hrcsense::app::EchoArgs& echo_args) {
+  CLI::App* echo = app.add_subcommand(
+      "echo", "print the samples of one of hrcsense's ROS 2 topics (or /joint_states) as JSON lines (docs/ROS2.md)");
+  echo->add_option("topic", echo_args.topic, "e.g. /hrcsense/verdict, /hrcsense/markers, /tf_static, /joint_states")
+      ->required();
+  echo->add_option("--domain", echo_args.domain, "DDS domain, 0 to 232 (default: ROS_DOMAIN_ID, else 0)")
+      ->check(CLI::Range(0, 232));
+  echo->add_option("--type", echo_args.type,
+                   "verdict, speed_scaling, markers, point_cloud, tf, joint_state or float64 (default: from the topic)");
+  echo->add_option("--count", echo_args.count, "exit after N samples")->check(CLI::Range(int64_t{1}, kMaxFrames));
+  echo->add_option("--timeout-s", echo_args.timeout_s, "exit after S seconds")->check(CLI::Range(0.0, 86400.0));
+  return echo;
+}
+
+// Every subcommand, added in the order `--help` lists them; `args`, `eval_args` and `echo_args`
+// receive the parsed flags.
+Subcommands add_subcommands(CLI::App& app, CommandArgs& args, hrcsense::app::EvalArgs& eval_args,
+                            hrcsense::app::EchoArgs& echo_args) {
   Subcommands commands;
   commands.run = add_run_command(app, args);
   commands.record = add_record_command(app, args);
   commands.publish = app.add_subcommand(
       "publish", "publish the configured source as a realsense-ros camera's ROS 2 topics (docs/CAMERAS.md)");
   add_common_flags(*commands.publish, args);
+  commands.echo = add_echo_command(app, echo_args);
   commands.info = app.add_subcommand("info", "describe a configured source or a recording");
   add_common_flags(*commands.info, args);
   commands.info->add_option("path", args.input, "a recording: a RealSense .bag file or a folder of depth PNGs");
@@ -112,15 +129,17 @@ Subcommands add_subcommands(CLI::App& app, CommandArgs& args, hrcsense::app::Eva
 // CLI11 would only say "a subcommand is required" for a misspelt one; main names it instead.
 bool is_unknown_command(const std::string& first) {
   return !first.empty() && first[0] != '-' && first != "run" && first != "record" && first != "publish" &&
-         first != "info" && first != "devices" && first != "bench" && first != "verify-filters" && first != "eval" &&
-         first != "teach";
+         first != "echo" && first != "info" && first != "devices" && first != "bench" && first != "verify-filters" &&
+         first != "eval" && first != "teach";
 }
 
 // Runs the one subcommand CLI11 parsed (require_subcommand(1)); `bench` is the one left.
-int run_parsed_command(const Subcommands& commands, const CommandArgs& args, const hrcsense::app::EvalArgs& eval_args) {
+int run_parsed_command(const Subcommands& commands, const CommandArgs& args, const hrcsense::app::EvalArgs& eval_args,
+                       const hrcsense::app::EchoArgs& echo_args) {
   if (commands.run->parsed()) return hrcsense::app::run_command(args);
   if (commands.record->parsed()) return hrcsense::app::record_command(args);
   if (commands.publish->parsed()) return hrcsense::app::publish_command(args);
+  if (commands.echo->parsed()) return hrcsense::app::echo_command(echo_args);
   if (commands.info->parsed()) return hrcsense::app::info_command(args);
   if (commands.teach->parsed()) return hrcsense::app::teach_command(args);
   if (commands.devices->parsed()) return hrcsense::app::devices_command();
@@ -140,11 +159,12 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   CommandArgs args;
   hrcsense::app::EvalArgs eval_args;
-  const Subcommands commands = add_subcommands(app, args, eval_args);
+  hrcsense::app::EchoArgs echo_args;
+  const Subcommands commands = add_subcommands(app, args, eval_args, echo_args);
 
   if (is_unknown_command(argc > 1 ? argv[1] : "")) {
     return hrcsense::app::report_error(std::string("unknown command '") + argv[1] +
-                                           "'; expected run, record, publish, info, teach, devices, bench, eval or "
+                                           "'; expected run, record, publish, echo, info, teach, devices, bench, eval or "
                                            "verify-filters",
                                        hrcsense::app::kExitUsage);
   }
@@ -156,7 +176,7 @@ int main(int argc, char** argv) {
   }
 
   try {
-    return run_parsed_command(commands, args, eval_args);
+    return run_parsed_command(commands, args, eval_args, echo_args);
   } catch (const std::exception& e) {
     return hrcsense::app::report_error(e);
   }
