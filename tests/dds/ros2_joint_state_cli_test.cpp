@@ -18,6 +18,8 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -32,8 +34,8 @@ std::string ros2_state_args(const std::string& topic) {
 }
 
 // Publishes the cell's joints (UR names, the driver's order reversed, velocities zero,
-// wall-clock stamps) at 250 Hz until `out` has kSilentAfterFrames frames (at most 20 s).
-void publish_until_silent(const std::string& topic, const std::string& out) {
+// wall-clock stamps) at 250 Hz while `keep_on()` (at most 20 s).
+void publish_while(const std::string& topic, const std::function<bool()>& keep_on) {
   ParticipantScope scope(test::test_domain());
   const std::string name = dds_topic_name(topic);
   const dds_entity_t dds_topic = scope.own(
@@ -55,7 +57,7 @@ void publish_until_silent(const std::string& topic, const std::string& out) {
   msg.position._length = msg.position._maximum = 6;
   msg.velocity._buffer = velocity.data();
   msg.velocity._length = msg.velocity._maximum = 6;
-  for (int k = 0; k < 5000 && test::frames_written(out) < test::kSilentAfterFrames; ++k) {
+  for (int k = 0; k < 5000 && keep_on(); ++k) {
     const int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
                             std::chrono::system_clock::now().time_since_epoch()).count();
     msg.header.stamp.sec = static_cast<int32_t>(now / 1'000'000'000);
@@ -63,6 +65,22 @@ void publish_until_silent(const std::string& topic, const std::string& out) {
     dds_write(writer, &msg);
     std::this_thread::sleep_for(4ms);
   }
+}
+
+// Frames of a bag replayed with robot.state.source recorded that carry joints; each must be
+// the cell's joints.
+int replayed_frames_with_the_cell_joints(const std::string& config, const std::string& bag) {
+  const test::ToolRun replay = test::run_tool(
+      config, "--set source.type=bag --set source.path=" + bag + " --set robot.state.source=recorded", "ros2_replay");
+  int with_joints = 0;
+  for (const auto& [index, frame] : replay.frames) {
+    if (frame.at("joints_rad").is_null()) continue;
+    ++with_joints;
+    for (size_t j = 0; j < 6; ++j) {
+      EXPECT_NEAR(frame.at("joints_rad").at(j).get<double>(), test::kCliJoints[j], 1e-9) << index;
+    }
+  }
+  return with_joints;
 }
 
 TEST(Ros2JointStateCli, RunFollowsThePublishedJointsStopsWhenSilentAndRecordsThem) {
@@ -73,7 +91,7 @@ TEST(Ros2JointStateCli, RunFollowsThePublishedJointsStopsWhenSilentAndRecordsThe
   const std::string bag = test::temp_path("ros2_joints", ".bag");
   std::remove(bag.c_str());
   const std::string out = test::cli_out_path("ros2_joints");
-  std::thread publisher([&] { publish_until_silent(topic, out); });
+  std::thread publisher([&] { publish_while(topic, [&] { return test::frames_written(out) < test::kSilentAfterFrames; }); });
   const test::ToolRun live = test::run_tool(config, ros2_state_args(topic) + " --record " + bag, "ros2_joints");
   publisher.join();
 
@@ -94,19 +112,31 @@ TEST(Ros2JointStateCli, RunFollowsThePublishedJointsStopsWhenSilentAndRecordsThe
 
   // The recording replays with the joints the run was measured against (frames without a state
   // were recorded without joints, and replay as stops).
-  const test::ToolRun replay = test::run_tool(
-      config, "--set source.type=bag --set source.path=" + bag + " --set robot.state.source=recorded", "ros2_replay");
+  EXPECT_GE(replayed_frames_with_the_cell_joints(config, bag), 10)
+      << "the recording should hold the joint states of the frames that had one";
   std::remove(bag.c_str());
   std::remove(config.c_str());
-  int with_joints = 0;
-  for (const auto& [index, frame] : replay.frames) {
-    if (frame.at("joints_rad").is_null()) continue;
-    ++with_joints;
-    for (size_t j = 0; j < 6; ++j) {
-      EXPECT_NEAR(frame.at("joints_rad").at(j).get<double>(), test::kCliJoints[j], 1e-9) << index;
-    }
-  }
-  EXPECT_GE(with_joints, 10) << "the recording should hold the joint states of the frames that had one";
+}
+
+// `hrcsense record` (no processing) keeps the ROS 2 joint states as it keeps RTDE's.
+TEST(Ros2JointStateCli, RecordKeepsTheJointStates) {
+  if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
+  const std::string config = test::write_cli_cell("ros2_record");
+  const std::string topic = "/cli_js_" + std::to_string(::getpid()) + "/recorded";
+  const std::string bag = test::temp_path("ros2_record", ".bag");
+  std::remove(bag.c_str());
+  std::atomic<bool> recording{true};
+  std::thread publisher([&] { publish_while(topic, [&] { return recording.load(); }); });
+  // Paced (2.5 s): the reader discovers the publisher within the first frames.
+  const std::string command = std::string(HRCSENSE_CLI) + " record --config " + config + " " + ros2_state_args(topic) +
+                              " --out " + bag + " 2>/dev/null";
+  const int status = std::system(command.c_str());
+  recording = false;
+  publisher.join();
+  ASSERT_EQ(status, 0) << command;
+  EXPECT_GE(replayed_frames_with_the_cell_joints(config, bag), 30) << "of the 75 frames";
+  std::remove(bag.c_str());
+  std::remove(config.c_str());
 }
 
 TEST(Ros2JointStateCli, WithoutAPublisherEveryFrameStopsForWantOfAState) {
