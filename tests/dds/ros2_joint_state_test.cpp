@@ -1,13 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
-// robot.state.source ros2: JointState read by name and the speed scaling as plain functions
-// (values worked out by hand), then Ros2JointStateSource against a JointState writer in this
+// robot.state.source ros2: Ros2JointStateSource against JointState and Float64 writers in this
 // process on loopback: joints by name, finite differences, no state before the first sample,
-// stale with the topic named when the publisher stops, domains apart, the speed reading's age.
+// stale with the topic named when the publisher stops, malformed messages counted, domains
+// apart, the speed reading's age (the plain functions: ros2_joint_state_parse_test.cpp).
 // Every wait is bounded and polls for its condition; no assertion is on timing.
 #include "dds/dds_entity.hpp"
 #include "dds/ros2_joint_state.hpp"
 #include "dds/ros2_joint_state_source.hpp"
 #include "dds_test_util.hpp"
+#include "joint_state_message.hpp"
 
 #include "std_msgs.h"
 
@@ -29,176 +30,7 @@ using namespace std::chrono_literals;
 constexpr int64_t kMsNs = 1'000'000;
 constexpr int64_t kSecondNs = 1'000'000'000;
 
-// A JointState pointing at the caller's vectors (which must outlive it); nothing is owned.
-struct JointStateMessage {
-  std::vector<std::string> names;
-  std::vector<double> position, velocity;
-  int32_t sec = 0;
-  uint32_t nanosec = 0;
-  std::vector<char*> name_pointers;
-  sensor_msgs_msg_dds__JointState_ msg{};
-
-  const sensor_msgs_msg_dds__JointState_& get() {
-    name_pointers.clear();
-    for (std::string& name : names) name_pointers.push_back(name.data());
-    msg = sensor_msgs_msg_dds__JointState_{};
-    msg.header.stamp.sec = sec;
-    msg.header.stamp.nanosec = nanosec;
-    msg.header.frame_id = const_cast<char*>("");
-    msg.name._buffer = name_pointers.data();
-    msg.name._length = msg.name._maximum = static_cast<uint32_t>(names.size());
-    msg.position._buffer = position.data();
-    msg.position._length = msg.position._maximum = static_cast<uint32_t>(position.size());
-    msg.velocity._buffer = velocity.data();
-    msg.velocity._length = msg.velocity._maximum = static_cast<uint32_t>(velocity.size());
-    return msg;
-  }
-};
-
-// UR's names in the driver's order with positions 0.1 ... 0.6 and no velocity.
-JointStateMessage ur_message(const std::string& prefix = "") {
-  JointStateMessage m;
-  m.names = {prefix + "shoulder_pan_joint", prefix + "shoulder_lift_joint", prefix + "elbow_joint",
-             prefix + "wrist_1_joint",      prefix + "wrist_2_joint",       prefix + "wrist_3_joint"};
-  m.position = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6};
-  return m;
-}
-
-// ---- The plain functions
-
-TEST(Ros2JointStateParse, ShuffledNamesAreMatchedByName) {
-  JointStateMessage m;
-  m.names = {"wrist_3_joint", "elbow_joint", "shoulder_pan_joint", "wrist_1_joint", "shoulder_lift_joint", "wrist_2_joint"};
-  m.position = {0.6, 0.3, 0.1, 0.4, 0.2, 0.5};
-  m.velocity = {-6.0, -3.0, -1.0, -4.0, -2.0, -5.0};
-  m.sec = 12;
-  m.nanosec = 345;
-  const JointStateSample s = parse_joint_state(m.get(), ur_joint_names(""));
-  ASSERT_TRUE(s.ok) << s.error;
-  EXPECT_EQ(s.q_rad, (JointAngles{0.1, 0.2, 0.3, 0.4, 0.5, 0.6}));
-  EXPECT_TRUE(s.has_velocity);
-  EXPECT_EQ(s.qd_rad_s, (JointAngles{-1.0, -2.0, -3.0, -4.0, -5.0, -6.0}));
-  EXPECT_EQ(s.stamp_ns, 12'000'000'345);
-}
-
-TEST(Ros2JointStateParse, TfPrefixComesBeforeEachName) {
-  const JointNames names = ur_joint_names("ur_");
-  EXPECT_EQ(names[0], "ur_shoulder_pan_joint");
-  EXPECT_EQ(names[2], "ur_elbow_joint");
-  EXPECT_EQ(names[5], "ur_wrist_3_joint");
-  JointStateMessage prefixed = ur_message("ur_");
-  const JointStateSample s = parse_joint_state(prefixed.get(), names);
-  ASSERT_TRUE(s.ok) << s.error;
-  EXPECT_FALSE(s.has_velocity);
-  EXPECT_EQ(s.q_rad, (JointAngles{0.1, 0.2, 0.3, 0.4, 0.5, 0.6}));
-  // The driver without the prefix: the first joint looked for is missing.
-  JointStateMessage plain = ur_message();
-  const JointStateSample missing = parse_joint_state(plain.get(), names);
-  EXPECT_FALSE(missing.ok);
-  EXPECT_NE(missing.error.find("'ur_shoulder_pan_joint' (joint 1)"), std::string::npos) << missing.error;
-}
-
-TEST(Ros2JointStateParse, ExtraJointsAreIgnoredWhateverTheirValues) {
-  JointStateMessage m = ur_message();
-  m.names.insert(m.names.begin() + 2, "gripper_finger_joint");
-  m.position.insert(m.position.begin() + 2, std::nan(""));
-  const JointStateSample s = parse_joint_state(m.get(), ur_joint_names(""));
-  ASSERT_TRUE(s.ok) << s.error;
-  EXPECT_EQ(s.q_rad, (JointAngles{0.1, 0.2, 0.3, 0.4, 0.5, 0.6}));
-}
-
-TEST(Ros2JointStateParse, AMissingJointIsNamed) {
-  JointStateMessage m = ur_message();
-  m.names.erase(m.names.begin() + 2);  // elbow_joint
-  m.position.erase(m.position.begin() + 2);
-  const JointStateSample s = parse_joint_state(m.get(), ur_joint_names(""));
-  EXPECT_FALSE(s.ok);
-  EXPECT_FALSE(s.non_finite);
-  EXPECT_EQ(s.error, "no joint 'elbow_joint' (joint 3) among the 5 names");
-}
-
-TEST(Ros2JointStateParse, ArraysOfOtherLengthsAreMalformed) {
-  JointStateMessage short_position = ur_message();
-  short_position.position.pop_back();
-  JointStateSample s = parse_joint_state(short_position.get(), ur_joint_names(""));
-  EXPECT_FALSE(s.ok);
-  EXPECT_EQ(s.error, "position: 5 values for 6 names");
-
-  JointStateMessage short_velocity = ur_message();
-  short_velocity.velocity = {0.0, 0.0, 0.0};
-  s = parse_joint_state(short_velocity.get(), ur_joint_names(""));
-  EXPECT_FALSE(s.ok);
-  EXPECT_NE(s.error.find("velocity: 3 values for 6 names"), std::string::npos) << s.error;
-
-  // effort is not read: any length is fine.
-  JointStateMessage with_effort = ur_message();
-  std::vector<double> effort{1.0, 2.0};
-  sensor_msgs_msg_dds__JointState_ msg = with_effort.get();
-  msg.effort._buffer = effort.data();
-  msg.effort._length = msg.effort._maximum = 2;
-  EXPECT_TRUE(parse_joint_state(msg, ur_joint_names("")).ok);
-}
-
-TEST(Ros2JointStateParse, DuplicateNamesAndBadStampsAreMalformed) {
-  JointStateMessage twice = ur_message();
-  twice.names.push_back("elbow_joint");
-  twice.position.push_back(0.3);
-  JointStateSample s = parse_joint_state(twice.get(), ur_joint_names(""));
-  EXPECT_FALSE(s.ok);
-  EXPECT_EQ(s.error, "name: 'elbow_joint' appears twice");
-
-  JointStateMessage stamp = ur_message();
-  stamp.nanosec = 1'000'000'000;
-  s = parse_joint_state(stamp.get(), ur_joint_names(""));
-  EXPECT_FALSE(s.ok);
-  EXPECT_NE(s.error.find("header.stamp.nanosec"), std::string::npos) << s.error;
-}
-
-TEST(Ros2JointStateParse, NonFiniteValuesOfTheSixAreRejectedNamingTheJoint) {
-  JointStateMessage m = ur_message();
-  m.position[3] = std::nan("");
-  JointStateSample s = parse_joint_state(m.get(), ur_joint_names(""));
-  EXPECT_FALSE(s.ok);
-  EXPECT_TRUE(s.non_finite);
-  EXPECT_EQ(s.error, "position of 'wrist_1_joint' (joint 4) is not finite");
-
-  JointStateMessage v = ur_message();
-  v.velocity = {0.0, 0.0, 0.0, 0.0, 0.0, -INFINITY};
-  s = parse_joint_state(v.get(), ur_joint_names(""));
-  EXPECT_TRUE(s.non_finite);
-  EXPECT_EQ(s.error, "velocity of 'wrist_3_joint' (joint 6) is not finite");
-}
-
-TEST(Ros2JointStateParse, FiniteDifferences) {
-  // Joint 1 from 0.100 to 0.104 rad in 8 ms: 0.5 rad/s; joint 2 from -1.0 to -1.016: -2 rad/s.
-  const JointAngles before{0.100, -1.0, 0.0, 0.0, 0.0, 3.0};
-  const JointAngles after{0.104, -1.016, 0.0, 0.0, 0.0, 3.0};
-  const JointAngles qd = finite_difference_rad_s(before, after, 0.008);
-  EXPECT_NEAR(qd[0], 0.5, 1e-12);
-  EXPECT_NEAR(qd[1], -2.0, 1e-12);
-  EXPECT_EQ(qd[2], 0.0);
-  EXPECT_EQ(qd[5], 0.0);
-}
-
-TEST(Ros2JointStateParse, SpeedScalingAsAFraction) {
-  EXPECT_DOUBLE_EQ(speed_fraction_from(37.5, SpeedScalingUnit::percent), 0.375);
-  EXPECT_EQ(speed_fraction_from(100.0, SpeedScalingUnit::percent), 1.0);
-  EXPECT_EQ(speed_fraction_from(0.0, SpeedScalingUnit::percent), 0.0);
-  EXPECT_EQ(speed_fraction_from(0.6, SpeedScalingUnit::fraction), 0.6);
-  EXPECT_EQ(speed_fraction_from(1.0, SpeedScalingUnit::fraction), 1.0);
-  // Rounding just past the ends is taken as the end; anything further is no reading.
-  EXPECT_EQ(speed_fraction_from(100.00001, SpeedScalingUnit::percent), 1.0);
-  EXPECT_EQ(speed_fraction_from(-1e-9, SpeedScalingUnit::fraction), 0.0);
-  EXPECT_TRUE(std::isnan(speed_fraction_from(150.0, SpeedScalingUnit::percent)));
-  EXPECT_TRUE(std::isnan(speed_fraction_from(-1.0, SpeedScalingUnit::percent)));
-  EXPECT_TRUE(std::isnan(speed_fraction_from(37.5, SpeedScalingUnit::fraction)));  // percent read as fraction
-  EXPECT_TRUE(std::isnan(speed_fraction_from(std::nan(""), SpeedScalingUnit::fraction)));
-  EXPECT_TRUE(std::isnan(speed_fraction_from(INFINITY, SpeedScalingUnit::percent)));
-}
-
-// ---- Over DDS, in this process
-
-// A writer of `Msg` on a ROS 2 topic, with ROS's default QoS (reliable, volatile, keep-last 10).
+// A writer of `type` on a ROS 2 topic, with ROS's default QoS (reliable, volatile, keep-last 10).
 class TestWriter {
  public:
   TestWriter(uint32_t domain, const dds_topic_descriptor_t& type, const std::string& ros_topic) : scope_(domain) {
