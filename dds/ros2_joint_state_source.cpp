@@ -234,7 +234,9 @@ bool Ros2JointStateSource::state_at(int64_t host_time_ns, RobotState& out) {
   }
   if (lookup.code == ReasonCode::robot_state_stale) {
     lookup_error_ = "ros2 " + description_ + ": newest joint state " + ms_text(lookup.age_ms) + " old (max " +
-                    ms_text(history_.params.max_age_s * 1e3) + "): the publisher stalled or went away";
+                    ms_text(history_.params.max_age_s * 1e3) + ")" +
+                    (connections_ > disconnects_ ? ": the publisher is matched but silent"
+                                                 : ": no publisher matched (it went away)");
   } else {
     lookup_error_ = "ros2 " + description_ + ": no joint state accepted";
   }
