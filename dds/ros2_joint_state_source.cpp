@@ -150,7 +150,10 @@ void Ros2JointStateSource::add_sample(const JointStateSample& parsed, int64_t ho
   sample.qd_rad_s = parsed.qd_rad_s;
   sample.valid = true;
   sample.origin = RobotStateOrigin::ros2;
-  const std::string stamp_text = "JointState stamped " + std::to_string(parsed.stamp_ns) + " ns rejected: ";
+  // Built on a rejection only: an accepted sample allocates nothing here.
+  const auto stamp_text = [&parsed] {
+    return "JointState stamped " + std::to_string(parsed.stamp_ns) + " ns rejected: ";
+  };
   const auto max_age_ns = static_cast<int64_t>(history_.params.max_age_s * 1e9);
   if (parsed.ok && !parsed.has_velocity) {
     const int64_t host_step_ns = host_time_ns - reference_.host_time_ns;
@@ -168,7 +171,7 @@ void Ros2JointStateSource::add_sample(const JointStateSample& parsed, int64_t ho
         const double moved = std::fabs(parsed.q_rad[j] - reference_.q_rad[j]);
         if (!(moved <= std::fabs(reference_.qd_rad_s[j]) * dt_s + history_.params.jump_tolerance_rad)) {
           ++fd_jumps_;
-          reject(params_.topic, stamp_text + "'" + names_[j] + "' (joint " + std::to_string(j + 1) + ") jumped " +
+          reject(params_.topic, stamp_text() + "'" + names_[j] + "' (joint " + std::to_string(j + 1) + ") jumped " +
                                     std::to_string(moved) + " rad since the previous sample, further than qd·dt + "
                                     "tolerance");
           return;
@@ -180,7 +183,7 @@ void Ros2JointStateSource::add_sample(const JointStateSample& parsed, int64_t ho
   }
   if (!history_.add(sample)) {
     // A non-finite sample's parser names the joint; every other rejection the history names.
-    reject(params_.topic, stamp_text + (parsed.non_finite ? parsed.error : history_.last_rejection()));
+    reject(params_.topic, stamp_text() + (parsed.non_finite ? parsed.error : history_.last_rejection()));
     return;
   }
   reference_ = Reference{true, parsed.stamp_ns, host_time_ns, sample.q_rad, sample.qd_rad_s};

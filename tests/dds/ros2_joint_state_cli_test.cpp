@@ -42,7 +42,8 @@ void publish_while(const std::string& topic, const std::function<bool()>& keep_o
       dds_create_topic(scope.participant(), &sensor_msgs_msg_dds__JointState__desc, name.c_str(), nullptr, nullptr),
       "topic");
   const QosHandle qos(EndpointQos{true, false, 10});  // ROS's default QoS, as joint_state_broadcaster
-  const dds_entity_t writer = scope.own(dds_create_writer(scope.participant(), dds_topic, qos.get(), nullptr), "writer");
+  const dds_entity_t writer =
+      scope.own(dds_create_writer(scope.participant(), dds_topic, qos.get(), nullptr), "writer");
   std::vector<std::string> names = {"wrist_3_joint", "wrist_2_joint",       "wrist_1_joint",
                                     "elbow_joint",   "shoulder_lift_joint", "shoulder_pan_joint"};
   std::vector<char*> name_pointers;
@@ -91,7 +92,8 @@ TEST(Ros2JointStateCli, RunFollowsThePublishedJointsStopsWhenSilentAndRecordsThe
   const std::string bag = test::temp_path("ros2_joints", ".bag");
   std::remove(bag.c_str());
   const std::string out = test::cli_out_path("ros2_joints");
-  std::thread publisher([&] { publish_while(topic, [&] { return test::frames_written(out) < test::kSilentAfterFrames; }); });
+  std::thread publisher(
+      [&] { publish_while(topic, [&] { return test::frames_written(out) < test::kSilentAfterFrames; }); });
   const test::ToolRun live = test::run_tool(config, ros2_state_args(topic) + " --record " + bag, "ros2_joints");
   publisher.join();
 

@@ -15,7 +15,8 @@ namespace hrcsense::ros2::joint_state_test {
 
 TEST(Ros2JointStateParse, ShuffledNamesAreMatchedByName) {
   JointStateMessage m;
-  m.names = {"wrist_3_joint", "elbow_joint", "shoulder_pan_joint", "wrist_1_joint", "shoulder_lift_joint", "wrist_2_joint"};
+  m.names = {"wrist_3_joint", "elbow_joint",         "shoulder_pan_joint",
+             "wrist_1_joint", "shoulder_lift_joint", "wrist_2_joint"};
   m.position = {0.6, 0.3, 0.1, 0.4, 0.2, 0.5};
   m.velocity = {-6.0, -3.0, -1.0, -4.0, -2.0, -5.0};
   m.sec = 12;
