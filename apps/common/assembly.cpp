@@ -12,6 +12,7 @@
 
 #if HRCSENSE_HAVE_DDS
 #include "dds/ros2_camera_source.hpp"
+#include "dds/ros2_joint_state_source.hpp"
 #endif
 #ifdef HRCSENSE_HAVE_REALSENSE
 #include "realsense/realsense_source.hpp"
@@ -177,6 +178,26 @@ RobotStateHistoryParams robot_state_history_params(const Config& config) {
   return params;
 }
 
+// robot.state.source ros2: a ROS 2 driver's /joint_states over Cyclone DDS (docs/ROS2.md).
+std::unique_ptr<RobotStateSource> make_ros2_robot_state_source([[maybe_unused]] const Config& config,
+                                                               [[maybe_unused]] RunClock& clock,
+                                                               [[maybe_unused]] const std::string& where) {
+#if HRCSENSE_HAVE_DDS
+  const Ros2JointStateConfig& ros2 = config.robot_state.ros2;
+  ros2::Ros2JointStateParams params;
+  params.topic = ros2.topic;
+  params.tf_prefix = ros2.tf_prefix;
+  params.speed_scaling_topic = ros2.speed_scaling_topic;
+  params.speed_scaling_unit = ros2.speed_scaling_unit;
+  params.domain_id = static_cast<uint32_t>(config.ros2.domain_id);
+  params.history = robot_state_history_params(config);
+  return std::make_unique<ros2::Ros2JointStateSource>(params, clock);
+#else
+  throw ConfigError(where + ": robot.state.source 'ros2': this hrcsense was built without Cyclone DDS; install "
+                    "cyclonedds-dev and cyclonedds-tools (scripts/setup does) and rebuild");
+#endif
+}
+
 }  // namespace
 
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock,
@@ -223,6 +244,7 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
     params.arm = config.pipeline.robot.arm;  // the forward kinematics actual_TCP_pose is checked against
     return std::make_unique<RtdeRobotState>(params, run_clock);
   }
+  if (source == RobotStateOrigin::ros2) return make_ros2_robot_state_source(config, run_clock, where);
   if (source == RobotStateOrigin::recorded) {
     throw ConfigError(where + ": robot.state.source recorded: the joint states come from the recording (source.type bag)");
   }

@@ -72,9 +72,10 @@ RealSenseParams realsense_params(const SourceConfig& source, const std::atomic<b
 std::vector<DeviceDescriptor> list_cameras();
 
 /// The robot state source (robot.state.source): fixed; sim (SimRobotState on the trajectory,
-/// with robot.state.sim_latency_s / sim_jitter_s, seeded by source.seed); rtde; udp_json.
-/// Throws ConfigError for one this build does not have, for rtde without robot.state.host, and
-/// for recorded (it needs the source: the overload below). A live source (rtde, udp_json) stamps arrivals with `clock` (null: the
+/// with robot.state.sim_latency_s / sim_jitter_s, seeded by source.seed); rtde; udp_json; ros2
+/// (robot.state.ros2.* on ros2.domain_id). Throws ConfigError for one this build does not have
+/// (ros2 without Cyclone DDS), for rtde without robot.state.host, and for recorded (it needs
+/// the source: the overload below). A live source (rtde, udp_json, ros2) stamps arrivals with `clock` (null: the
 /// steady clock, run_pipeline's default); it must outlive the source. `sim` reads the arm's
 /// joints at `trajectory_clock`'s time when given (the simulator's, follow_link).
 std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, RunClock* clock = nullptr,

@@ -83,7 +83,7 @@ BackgroundModel learn(const PipelineParams& params, const std::vector<Frame>& fr
 }
 
 // The robot state the configured source gives each frame at its timestamp (the simulator's
-// trajectory for `sim`, the recording's for `recorded`); live sources (rtde, udp_json) have no
+// trajectory for `sim`, the recording's for `recorded`); live sources (rtde, udp_json, ros2) have no
 // state to replay, so their frames get robot.joints_rad, with a warning.
 std::vector<RobotState> robot_states_for(const Config& config, Source& source, const std::vector<Frame>& frames) {
   std::unique_ptr<RobotStateSource> states;

@@ -136,7 +136,7 @@ int print_recording(const std::string& path) {
 // (never measured, or moving far from the robot while learnt): loaded from background.path
 // when that file exists, else learnt from the source's first frames as `run` learns it (same
 // filters; motion judged near the robot at its fixed or simulated state). A live robot state
-// (rtde, udp_json) is not connected to from `info`: learning then judges motion everywhere,
+// (rtde, udp_json, ros2) is not connected to from `info`: learning then judges motion everywhere,
 // which can only refuse more batches than `run` would. At most `max_frames` frames (-1: until
 // the source ends); nothing is saved.
 void print_background(const Config& config, int64_t max_frames) {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — a source of robot joint states: one of the four one-level virtual interfaces
-// (source.hpp says which). `fixed` (robot.joints_rad) is here; the live ones (RTDE, UDP JSON),
+// (source.hpp says which). `fixed` (robot.joints_rad) is here; the live ones (RTDE, UDP JSON, ROS 2),
 // the simulator's scripted arm and the states recorded in a bag implement the same interface.
 #pragma once
 
@@ -12,7 +12,7 @@
 
 namespace hrcsense {
 
-/// `robot.state.source` as a name: fixed, sim, rtde, udp_json, recorded.
+/// `robot.state.source` as a name: fixed, sim, rtde, udp_json, recorded, ros2.
 const char* robot_state_origin_name(RobotStateOrigin origin);
 
 /// UR's robot_mode as a snake_case name: no_controller (-1), disconnected, confirm_safety,

@@ -25,7 +25,7 @@ struct RunHeader {
   /// carry, so a file and a receiver's log can be matched; 0: not known (written as null).
   uint32_t session = 0;
   SourceInfo source;
-  std::string robot_state;  ///< `robot.state.source` (fixed, sim, rtde, udp_json); empty: not written
+  std::string robot_state;  ///< `robot.state.source` (fixed, sim, rtde, udp_json, recorded, ros2); empty: not written
   /// `safety.mode: ssm`: where S_s comes from, stopping_data_name() ("default", "table",
   /// "limits"); empty (null): zones mode.
   std::string stopping_data;
