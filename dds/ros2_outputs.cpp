@@ -9,6 +9,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <utility>
 
 namespace hrcsense::ros2 {
@@ -85,10 +86,22 @@ Ros2OutputSink::~Ros2OutputSink() = default;
 void Ros2OutputSink::read_camera_chain() {
   const std::string link = camera_link_frame(params_.camera_name);
   const std::string optical = camera_optical_frame(params_.camera_name);
+  // The camera node's domain may differ from the outputs' (source.ros2.domain_id): its transforms
+  // are read where it publishes them.
+  std::unique_ptr<ParticipantScope> camera_scope;
+  dds_entity_t participant = dds_->scope.participant();
+  dds_entity_t topic = dds_->tf_topic;
+  if (params_.camera_domain_id != params_.domain_id) {
+    camera_scope = std::make_unique<ParticipantScope>(params_.camera_domain_id);
+    participant = camera_scope->participant();
+    topic = camera_scope->own(
+        dds_create_topic(participant, &tf2_msgs_msg_dds__TFMessage__desc, "rt/tf_static", nullptr, nullptr),
+        "DDS topic rt/tf_static");
+  }
   // A reader of its own, deleted when the chain is read (the writer comes later, in header()).
   const QosHandle qos(EndpointQos{true, true, kTfReaderDepth});
-  const DdsEntity reader(check_dds(dds_create_reader(dds_->scope.participant(), dds_->tf_topic, qos.get(), nullptr),
-                                   "DDS reader on rt/tf_static"));
+  const DdsEntity reader(
+      check_dds(dds_create_reader(participant, topic, qos.get(), nullptr), "DDS reader on rt/tf_static"));
   std::vector<TfEdge> seen;
   std::optional<Pose> T_link_optical;
   const dds_time_t deadline = dds_time() + seconds_to_ns(params_.camera_tf_wait_s);
@@ -109,10 +122,11 @@ void Ros2OutputSink::read_camera_chain() {
     dds_sleepfor(DDS_MSECS(20));
   }
   if (!T_link_optical) {
-    camera_tf_note_ = "no " + link + " → " + optical + " on /tf_static within " +
-                      std::to_string(params_.camera_tf_wait_s) + " s (is the camera node running in domain " +
-                      std::to_string(params_.domain_id) + "?): " + params_.base_frame + " → " + link +
-                      " uses the D435's fixed link → optical rotation instead";
+    char wait_text[32];
+    std::snprintf(wait_text, sizeof wait_text, "%g", params_.camera_tf_wait_s);
+    camera_tf_note_ = "no " + link + " → " + optical + " on /tf_static within " + wait_text +
+                      " s (is the camera node running in domain " + std::to_string(params_.camera_domain_id) +
+                      "?): " + params_.base_frame + " → " + link + " uses the D435's fixed link → optical rotation instead";
     T_link_optical = T_link_optical_fixed();
   }
   // The camera node is the parent of its optical frames: only base → link is hrcsense's.

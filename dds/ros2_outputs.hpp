@@ -34,6 +34,7 @@ struct Ros2OutputParams {
   /// the chain read from its /tf_static.
   bool camera_publishes_optical = false;
   double camera_tf_wait_s = 2.0;           ///< how long the constructor waits for that chain
+  uint32_t camera_domain_id = 0;           ///< where the camera node's /tf_static is read (`source.ros2.domain_id`)
 };
 
 /// The ROS 2 names the sink writes.

@@ -334,6 +334,7 @@ Ros2Outputs make_ros2_output_sink(const Config& config) {
   params.max_frame_age_s = config.pipeline.safety.max_frame_age_s;
   // realsense-ros publishes its link → optical frames itself: a second parent is never given.
   params.camera_publishes_optical = config.source.type == SourceType::ros2;
+  params.camera_domain_id = static_cast<uint32_t>(config.source.ros2.domain_id);
   auto sink = std::make_unique<ros2::Ros2OutputSink>(params);
   const ros2::Ros2OutputTopics& topics = sink->topics();
   std::string frames;
@@ -348,6 +349,17 @@ Ros2Outputs make_ros2_output_sink(const Config& config) {
   Ros2Outputs outputs;
   outputs.on_processed = [tap = sink.get()](const Frame& frame, const Pipeline& pipeline, const FrameResult& result) {
     tap->on_processed(frame, pipeline, result);
+  };
+  outputs.status = [view = sink.get()] {
+    const ros2::Ros2OutputCounters c = view->counters();
+    Ros2OutputsStatus status;
+    status.failed_writes = c.failed_writes;
+    status.last_error = c.last_error;
+    status.description = "ROS 2 outputs: " + std::to_string(c.verdicts) + " verdicts, " +
+                         std::to_string(c.marker_arrays) + " marker arrays, " + std::to_string(c.clouds) +
+                         " foreground clouds; " + std::to_string(c.failed_writes) + " writes refused";
+    if (!c.last_error.empty()) status.description += " (last: " + c.last_error + ")";
+    return status;
   };
   outputs.sink = std::move(sink);
   return outputs;

@@ -108,12 +108,22 @@ std::unique_ptr<UdpLinkSink> make_udp_link_sink(const Config& config, const RunC
 /// the file and the key for a value outside its range (load_config checks them first).
 std::unique_ptr<RtdeLinkSink> make_rtde_link_sink(const Config& config, const RunClock* clock = nullptr);
 
+/// What the ROS 2 outputs did: for the fault log while the run goes, and its last line.
+struct Ros2OutputsStatus {
+  int64_t failed_writes = 0;  ///< writes DDS refused, on any topic
+  std::string last_error;     ///< the last of them, naming the topic
+  std::string description;    ///< "ROS 2 outputs: N verdicts, ..." for the log
+};
+
 /// `ros2.publish`: the ROS 2 outputs (dds/ros2_outputs.hpp, docs/ROS2.md) as a sink and the
 /// processing thread's tap that hands it the foreground cloud.
 struct Ros2Outputs {
   std::unique_ptr<Sink> sink;  ///< null without ros2.publish
   /// RunOptions::on_processed for the foreground cloud; null without a sink.
   std::function<void(const Frame&, const Pipeline&, const FrameResult&)> on_processed;
+  /// What the outputs have written so far (call on the output thread or after the run); null
+  /// without a sink.
+  std::function<Ros2OutputsStatus()> status;
 };
 
 /// The outputs of ros2.* (domain, namespace, cloud rate, speed scaling topic, camera name) in

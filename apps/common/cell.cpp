@@ -83,6 +83,7 @@ void add_links(Cell& cell, const Config& config) {
 std::function<void(const Frame&, const Pipeline&, const FrameResult&)> add_ros2_outputs(Cell& cell, const Config& config) {
   Ros2Outputs outputs = make_ros2_output_sink(config);
   cell.ros2_outputs = std::move(outputs.sink);
+  cell.ros2_status = std::move(outputs.status);
   return std::move(outputs.on_processed);
 }
 
@@ -114,7 +115,7 @@ RunOptions run_options(const Config& config, const CellOptions& options, Cell& c
     // The recording holds the state processing used, so its replay decides as this run did.
     Recorder* recorder = cell.recorder.get();
     run.on_processed = [recorder, tap = run.on_processed](const Frame& frame, const Pipeline& pipeline,
-                                                              const FrameResult& result) {
+                                                          const FrameResult& result) {
       recorder->state_used(frame.index, result.robot_state);
       if (tap) tap(frame, pipeline, result);
     };

@@ -76,6 +76,7 @@ struct Cell {
   /// ros2.publish: verdict, speed scaling, markers, foreground cloud and /tf_static over DDS
   /// (make_ros2_output_sink); its cloud tap is in run_options.on_processed.
   std::unique_ptr<Sink> ros2_outputs;
+  std::function<Ros2OutputsStatus()> ros2_status;  ///< what ros2_outputs did (null without it)
   /// Simulated runs: the simulator that labels each result's truth (TruthLabeller).
   std::optional<Simulator> truth;
   RunHeader header;

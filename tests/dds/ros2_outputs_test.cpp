@@ -273,6 +273,7 @@ Pose camera_looking_along_base_x() {
 Ros2OutputParams chain_params() {
   Ros2OutputParams params;
   params.domain_id = test::test_domain();
+  params.camera_domain_id = test::test_domain();
   params.node_namespace = "/h1chain";
   params.T_base_camera = camera_looking_along_base_x();
   params.camera_publishes_optical = true;
