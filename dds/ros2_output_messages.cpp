@@ -238,6 +238,12 @@ MarkerColor verdict_color(VerdictState state, float alpha) {
 
 std::vector<MarkerSpec> safety_markers(const FrameResult& result, const RobotModel& robot) {
   std::vector<MarkerSpec> markers;
+  safety_markers(result, robot, markers);
+  return markers;
+}
+
+void safety_markers(const FrameResult& result, const RobotModel& robot, std::vector<MarkerSpec>& markers) {
+  markers.clear();
   MarkerSpec delete_all;
   delete_all.action = kMarkerDeleteAll;
   markers.push_back(delete_all);
@@ -280,7 +286,6 @@ std::vector<MarkerSpec> safety_markers(const FrameResult& result, const RobotMod
     text.text = buffer;
     markers.push_back(text);
   }
-  return markers;
 }
 
 void fill_marker_array(const std::vector<MarkerSpec>& specs, int64_t stamp_ns, const std::string& frame_id,

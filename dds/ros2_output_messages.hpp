@@ -134,6 +134,8 @@ inline constexpr double kPointMarkerDiameterM = 0.02;
 /// S_p of the governing link is FrameResult::link_protective_distance_m of its entry in
 /// links, else Verdict::protective_distance_m.
 std::vector<MarkerSpec> safety_markers(const FrameResult& result, const RobotModel& robot);
+/// Same, into `out` (cleared first; its capacity is kept, so a steady scene reallocates little).
+void safety_markers(const FrameResult& result, const RobotModel& robot, std::vector<MarkerSpec>& out);
 
 /// Buffers a MarkerArray points into (reused from one array to the next).
 struct MarkerArrayBuffers {

@@ -182,9 +182,9 @@ void Ros2OutputSink::frame(const FrameResult& result) {
   // A joint state without a valid reading would put the arm somewhere it is not: no capsules.
   robot_.capsules.clear();
   if (!params_.robot.arm || result.robot_state.valid) robot_model_at(params_.robot, result.robot_state.q_rad, robot_);
-  const std::vector<MarkerSpec> specs = safety_markers(result, robot_);
+  safety_markers(result, robot_, marker_specs_);
   visualization_msgs_msg_dds__MarkerArray_ markers{};
-  fill_marker_array(specs, result.timestamp_ns, params_.base_frame, marker_buffers_, markers);
+  fill_marker_array(marker_specs_, result.timestamp_ns, params_.base_frame, marker_buffers_, markers);
   if (write(dds_->markers, &markers, topics_.markers)) ++counters_.marker_arrays;
 
   write_pending_cloud();

@@ -125,6 +125,7 @@ class Ros2OutputSink final : public Sink {
   std::string failure_;
   Ros2OutputCounters counters_;
   RobotModel robot_;  ///< capsules of the current result (buffer reused)
+  std::vector<MarkerSpec> marker_specs_;  ///< the current result's markers (buffer reused)
   MarkerArrayBuffers marker_buffers_;
   std::vector<uint8_t> cloud_bytes_;
 
