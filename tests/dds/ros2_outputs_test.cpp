@@ -105,6 +105,18 @@ std::unique_ptr<app::Cell> run_cell(const Config& config, CaptureSink& capture) 
   return cell;
 }
 
+TEST(Ros2Outputs, TopicNamesUnderTheNamespaceAndTheSpeedScalingOverride) {
+  const Ros2OutputTopics plain = ros2_output_topics("/hrcsense", "");
+  EXPECT_EQ(plain.verdict, "/hrcsense/verdict");
+  EXPECT_EQ(plain.speed_scaling, "/hrcsense/speed_scaling");
+  EXPECT_EQ(plain.markers, "/hrcsense/markers");
+  EXPECT_EQ(plain.foreground, "/hrcsense/foreground");
+  EXPECT_EQ(plain.tf_static, "/tf_static");
+  EXPECT_EQ(ros2_output_topics("/cell", "/speed_scaling_state_broadcaster/speed_scaling").speed_scaling,
+            "/speed_scaling_state_broadcaster/speed_scaling");
+  EXPECT_THROW(ros2_output_topics("/cell", "speed_scaling"), Ros2Error);
+}
+
 struct VerdictSample {
   hrcsense_msgs_msg_dds__Verdict_ msg{};
   std::string frame_id;
