@@ -347,5 +347,25 @@ TEST(Ros2Outputs, WithoutTheCameraNodesChainTheFixedRotationStandsIn) {
   EXPECT_NEAR(edge.T_parent_child.translation().z(), 1.0, 1e-12);
 }
 
+TEST(Ros2Outputs, RefusedVerdictsAreCountedThenAPersistentFailure) {
+  if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
+  Ros2OutputParams params = chain_params();
+  params.camera_publishes_optical = false;
+  Ros2OutputSink outputs(params);
+  // Without header() there are no writers: every write is refused, and frame() never throws.
+  FrameResult result;
+  for (int i = 1; i < Ros2OutputSink::kFailedVerdictsInARow; ++i) {
+    EXPECT_NO_THROW(outputs.frame(result));
+    EXPECT_FALSE(outputs.failed()) << "a refused write alone is counted, not a failure";
+  }
+  EXPECT_GT(outputs.counters().failed_writes, 0);
+  EXPECT_NE(outputs.counters().last_error.find("DDS write on /h1chain/"), std::string::npos) << outputs.counters().last_error;
+  outputs.frame(result);
+  EXPECT_TRUE(outputs.failed());
+  EXPECT_NE(outputs.failure().find("in a row"), std::string::npos) << outputs.failure();
+  EXPECT_NE(outputs.failure().find("/h1chain/verdict"), std::string::npos) << outputs.failure();
+  EXPECT_EQ(outputs.counters().verdicts, 0);
+}
+
 }  // namespace
 }  // namespace hrcsense::ros2
