@@ -352,14 +352,7 @@ Ros2Outputs make_ros2_output_sink(const Config& config) {
   };
   outputs.status = [view = sink.get()] {
     const ros2::Ros2OutputCounters c = view->counters();
-    Ros2OutputsStatus status;
-    status.failed_writes = c.failed_writes;
-    status.last_error = c.last_error;
-    status.description = "ROS 2 outputs: " + std::to_string(c.verdicts) + " verdicts, " +
-                         std::to_string(c.marker_arrays) + " marker arrays, " + std::to_string(c.clouds) +
-                         " foreground clouds; " + std::to_string(c.failed_writes) + " writes refused";
-    if (!c.last_error.empty()) status.description += " (last: " + c.last_error + ")";
-    return status;
+    return Ros2OutputsStatus{c.verdicts, c.marker_arrays, c.clouds, c.failed_writes, c.last_error};
   };
   outputs.sink = std::move(sink);
   return outputs;
@@ -367,6 +360,14 @@ Ros2Outputs make_ros2_output_sink(const Config& config) {
   throw ConfigError(config_where(config) + ": ros2.publish: this hrcsense was built without Cyclone DDS; install "
                     "cyclonedds-dev and cyclonedds-tools (scripts/setup does) and rebuild");
 #endif
+}
+
+std::string describe_ros2_outputs(const Ros2OutputsStatus& status) {
+  std::string text = "ROS 2 outputs: " + std::to_string(status.verdicts) + " verdicts, " +
+                     std::to_string(status.marker_arrays) + " marker arrays, " + std::to_string(status.clouds) +
+                     " foreground clouds; " + std::to_string(status.failed_writes) + " writes refused";
+  if (!status.last_error.empty()) text += " (last: " + status.last_error + ")";
+  return text;
 }
 
 std::string describe_link_counters(const RtdeLinkSink& link) {

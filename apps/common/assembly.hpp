@@ -110,10 +110,15 @@ std::unique_ptr<RtdeLinkSink> make_rtde_link_sink(const Config& config, const Ru
 
 /// What the ROS 2 outputs did: for the fault log while the run goes, and its last line.
 struct Ros2OutputsStatus {
+  int64_t verdicts = 0;       ///< Verdict samples written
+  int64_t marker_arrays = 0;  ///< MarkerArray samples written
+  int64_t clouds = 0;         ///< foreground PointCloud2 samples written
   int64_t failed_writes = 0;  ///< writes DDS refused, on any topic
   std::string last_error;     ///< the last of them, naming the topic
-  std::string description;    ///< "ROS 2 outputs: N verdicts, ..." for the log
 };
+
+/// "ROS 2 outputs: N verdicts, M marker arrays, K foreground clouds; F writes refused (last: ...)".
+std::string describe_ros2_outputs(const Ros2OutputsStatus& status);
 
 /// `ros2.publish`: the ROS 2 outputs (dds/ros2_outputs.hpp, docs/ROS2.md) as a sink and the
 /// processing thread's tap that hands it the foreground cloud.

@@ -212,7 +212,7 @@ void report_links(const Cell& cell) {
   }
   if (cell.ros2_status) {
     const Ros2OutputsStatus status = cell.ros2_status();
-    spdlog::log(status.failed_writes > 0 ? spdlog::level::warn : spdlog::level::info, "{}", status.description);
+    spdlog::log(status.failed_writes > 0 ? spdlog::level::warn : spdlog::level::info, "{}", describe_ros2_outputs(status));
   }
 }
 
