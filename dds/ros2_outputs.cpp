@@ -129,6 +129,16 @@ void Ros2OutputSink::read_camera_chain() {
                       "?): " + params_.base_frame + " → " + link + " uses the D435's fixed link → optical rotation instead";
     T_link_optical = T_link_optical_fixed();
   }
+  // A frame never gets a second parent: when someone already places the camera's link (a
+  // static_transform_publisher of the cell's calibration), hrcsense publishes nothing.
+  for (const TfEdge& edge : seen) {
+    if (edge.child_frame != link) continue;
+    camera_tf_note_ = link + " already has the parent " + edge.parent_frame +
+                      " on /tf_static: hrcsense publishes no " + params_.base_frame + " → " + link +
+                      " (check that it agrees with camera.T_base_camera)";
+    tf_edges_.clear();
+    return;
+  }
   // The camera node is the parent of its optical frames: only base → link is hrcsense's.
   tf_edges_ = {camera_link_edge(params_.T_base_camera, *T_link_optical, params_.base_frame, params_.camera_name)};
 }
@@ -152,6 +162,7 @@ void Ros2OutputSink::header(const RunHeader& header) {
     failure_ = std::string("ROS 2 outputs: ") + e.what();
     return;
   }
+  if (tf_edges_.empty()) return;  // the camera's link has a parent already (camera_tf_note())
   tf2_msgs_msg_dds__TFMessage_ tf{};
   fill_tf_message(tf_edges_, 0, dds_->tf_storage, tf);
   write(dds_->tf_static, &tf, topics_.tf_static);

@@ -74,8 +74,10 @@ class Ros2OutputSink final : public Sink {
 
   /// Joins the domain (one participant per domain per process) and, with
   /// camera_publishes_optical, waits up to camera_tf_wait_s for the camera's /tf_static chain;
-  /// without it, the fixed D435 rotation stands in (camera_tf_note() says so). Throws Ros2Error
-  /// when the domain cannot be joined or a topic name is not absolute.
+  /// without it, the fixed D435 rotation stands in (camera_tf_note() says so). When what it read
+  /// there already gives `<camera>_link` a parent, nothing is published on /tf_static (a frame
+  /// never gets a second parent; camera_tf_note() says so). Throws Ros2Error when the domain
+  /// cannot be joined or a topic name is not absolute.
   explicit Ros2OutputSink(Ros2OutputParams params);
   ~Ros2OutputSink() override;
   Ros2OutputSink(const Ros2OutputSink&) = delete;
@@ -95,7 +97,7 @@ class Ros2OutputSink final : public Sink {
   void on_processed(const Frame& frame, const Pipeline& pipeline, const FrameResult& result);
 
   const Ros2OutputTopics& topics() const { return topics_; }
-  /// What /tf_static holds (written by header()).
+  /// What /tf_static holds (written by header()); empty: nothing is written.
   const std::vector<TfEdge>& tf_static_edges() const { return tf_edges_; }
   /// Empty, or why the camera's own link → optical chain was not used (a warning for the log).
   const std::string& camera_tf_note() const { return camera_tf_note_; }

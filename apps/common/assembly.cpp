@@ -337,7 +337,7 @@ Ros2Outputs make_ros2_output_sink(const Config& config) {
   params.camera_domain_id = static_cast<uint32_t>(config.source.ros2.domain_id);
   auto sink = std::make_unique<ros2::Ros2OutputSink>(params);
   const ros2::Ros2OutputTopics& topics = sink->topics();
-  std::string frames;
+  std::string frames = sink->tf_static_edges().empty() ? "none" : "";
   for (const ros2::TfEdge& edge : sink->tf_static_edges()) {
     frames += (frames.empty() ? "" : ", ") + edge.parent_frame + " → " + edge.child_frame;
   }

@@ -333,6 +333,35 @@ TEST(Ros2Outputs, CameraNodesOwnChainIsUsedUnderTheLinkOnly) {
   EXPECT_NEAR(edge.T_parent_child.translation().z(), 1.0, 1e-12);
 }
 
+TEST(Ros2Outputs, ALinkThatHasAParentAlreadyGetsNoSecond) {
+  if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
+  ParticipantScope scope(test::test_domain());
+  const dds_entity_t topic = scope.own(
+      dds_create_topic(scope.participant(), &tf2_msgs_msg_dds__TFMessage__desc, "rt/tf_static", nullptr, nullptr),
+      "topic");
+  const QosHandle latched(EndpointQos{true, true, 1});
+  const dds_entity_t calibration = scope.own(dds_create_writer(scope.participant(), topic, latched.get(), nullptr), "writer");
+  // Someone's static_transform_publisher already places the link; the camera node its optics.
+  geometry_msgs_msg_dds__TransformStamped_ t[2]{};
+  t[0].header.frame_id = const_cast<char*>("world");
+  t[0].child_frame_id = const_cast<char*>("placed_cam_link");
+  t[0].transform.rotation.w = 1.0;
+  t[1].header.frame_id = const_cast<char*>("placed_cam_link");
+  t[1].child_frame_id = const_cast<char*>("placed_cam_depth_optical_frame");
+  t[1].transform.rotation = geometry_msgs_msg_dds__Quaternion_{-0.5, 0.5, -0.5, 0.5};
+  tf2_msgs_msg_dds__TFMessage_ msg{};
+  msg.transforms._buffer = t;
+  msg.transforms._length = msg.transforms._maximum = 2;
+  ASSERT_EQ(dds_write(calibration, &msg), DDS_RETCODE_OK);
+
+  Ros2OutputParams params = chain_params();
+  params.camera_name = "placed_cam";
+  params.camera_tf_wait_s = 10.0;
+  Ros2OutputSink outputs(params);
+  EXPECT_TRUE(outputs.tf_static_edges().empty());
+  EXPECT_NE(outputs.camera_tf_note().find("already has the parent world"), std::string::npos) << outputs.camera_tf_note();
+}
+
 TEST(Ros2Outputs, WithoutTheCameraNodesChainTheFixedRotationStandsIn) {
   if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
   Ros2OutputParams params = chain_params();
