@@ -77,6 +77,13 @@ struct EndpointQos {
   bool reliable = false;
   bool transient_local = false;
   int32_t depth = 1;  ///< keep-last depth
+  /// DEADLINE: a writer offers a sample at least this often, a reader requests one (a reader
+  /// requesting a shorter deadline than the writer offers does not match it), ns; 0: off
+  /// (infinite, DDS's default).
+  int64_t deadline_ns = 0;
+  /// LIVELINESS automatic with this lease, ns: the endpoint counts as alive while its
+  /// participant runs (a reader learns within a lease that a process died); 0: off (infinite).
+  int64_t liveliness_lease_ns = 0;
 };
 
 /// A dds_qos_t for `qos`, deleted with the returned holder.
@@ -86,6 +93,8 @@ class QosHandle {
     dds_qset_reliability(qos_, qos.reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT, DDS_MSECS(100));
     dds_qset_durability(qos_, qos.transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
     dds_qset_history(qos_, DDS_HISTORY_KEEP_LAST, qos.depth);
+    if (qos.deadline_ns > 0) dds_qset_deadline(qos_, qos.deadline_ns);
+    if (qos.liveliness_lease_ns > 0) dds_qset_liveliness(qos_, DDS_LIVELINESS_AUTOMATIC, qos.liveliness_lease_ns);
   }
   QosHandle(const QosHandle&) = delete;
   QosHandle& operator=(const QosHandle&) = delete;

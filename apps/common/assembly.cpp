@@ -13,6 +13,7 @@
 #if HRCSENSE_HAVE_DDS
 #include "dds/ros2_camera_source.hpp"
 #include "dds/ros2_joint_state_source.hpp"
+#include "dds/ros2_outputs.hpp"
 #endif
 #ifdef HRCSENSE_HAVE_REALSENSE
 #include "realsense/realsense_source.hpp"
@@ -336,6 +337,59 @@ std::unique_ptr<RtdeLinkSink> make_rtde_link_sink(const Config& config, const Ru
   } catch (const std::invalid_argument& e) {
     throw ConfigError(where + ": " + e.what());
   }
+}
+
+Ros2Outputs make_ros2_output_sink(const Config& config) {
+  const Ros2Config& ros2 = config.ros2;
+  if (!ros2.publish) return {};
+#if HRCSENSE_HAVE_DDS
+  ros2::Ros2OutputParams params;
+  params.domain_id = static_cast<uint32_t>(ros2.domain_id);
+  params.node_namespace = ros2.node_namespace;
+  params.speed_scaling_topic = ros2.speed_scaling_topic;
+  params.cloud_hz = ros2.cloud_hz;
+  params.camera_name = ros2.camera_name;
+  params.base_frame = ros2::base_frame_id(config.pipeline.robot.base_frame);
+  params.T_base_camera = config.pipeline.T_base_camera;
+  params.robot = config.pipeline.robot;
+  params.max_frame_gap_periods = config.pipeline.safety.max_frame_gap_periods;
+  params.max_frame_age_s = config.pipeline.safety.max_frame_age_s;
+  // realsense-ros publishes its link → optical frames itself: a second parent is never given.
+  params.camera_publishes_optical = config.source.type == SourceType::ros2;
+  params.camera_domain_id = static_cast<uint32_t>(config.source.ros2.domain_id);
+  auto sink = std::make_unique<ros2::Ros2OutputSink>(params);
+  const ros2::Ros2OutputTopics& topics = sink->topics();
+  std::string frames = sink->tf_static_edges().empty() ? "none" : "";
+  for (const ros2::TfEdge& edge : sink->tf_static_edges()) {
+    frames += (frames.empty() ? "" : ", ") + edge.parent_frame + " → " + edge.child_frame;
+  }
+  const std::string clouds = ros2.cloud_hz > 0.0 ? fmt::format("at most {:g} Hz", ros2.cloud_hz) : std::string("off");
+  spdlog::info("ROS 2 outputs on domain {} under {} (verdict, speed scaling on {}, markers, foreground {}, /tf_static "
+               "{}; frame {})",
+               ros2.domain_id, ros2.node_namespace, topics.speed_scaling, clouds, frames, params.base_frame);
+  if (!sink->camera_tf_note().empty()) spdlog::warn("ROS 2 outputs: {}", sink->camera_tf_note());
+  Ros2Outputs outputs;
+  outputs.on_processed = [tap = sink.get()](const Frame& frame, const Pipeline& pipeline, const FrameResult& result) {
+    tap->on_processed(frame, pipeline, result);
+  };
+  outputs.status = [view = sink.get()] {
+    const ros2::Ros2OutputCounters c = view->counters();
+    return Ros2OutputsStatus{c.verdicts, c.marker_arrays, c.clouds, c.failed_writes, c.last_error};
+  };
+  outputs.sink = std::move(sink);
+  return outputs;
+#else
+  throw ConfigError(config_where(config) + ": ros2.publish: this hrcsense was built without Cyclone DDS; install "
+                    "cyclonedds-dev and cyclonedds-tools (scripts/setup does) and rebuild");
+#endif
+}
+
+std::string describe_ros2_outputs(const Ros2OutputsStatus& status) {
+  std::string text = "ROS 2 outputs: " + std::to_string(status.verdicts) + " verdicts, " +
+                     std::to_string(status.marker_arrays) + " marker arrays, " + std::to_string(status.clouds) +
+                     " foreground clouds; " + std::to_string(status.failed_writes) + " writes refused";
+  if (!status.last_error.empty()) text += " (last: " + status.last_error + ")";
+  return text;
 }
 
 std::string describe_link_counters(const RtdeLinkSink& link) {

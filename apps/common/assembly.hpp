@@ -16,6 +16,7 @@
 #include "realsense/realsense_plan.hpp"
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <optional>
@@ -107,6 +108,36 @@ std::unique_ptr<UdpLinkSink> make_udp_link_sink(const Config& config, const RunC
 /// robot.state.host:port with its own connection; null for `off`. Throws ConfigError naming
 /// the file and the key for a value outside its range (load_config checks them first).
 std::unique_ptr<RtdeLinkSink> make_rtde_link_sink(const Config& config, const RunClock* clock = nullptr);
+
+/// What the ROS 2 outputs did: for the fault log while the run goes, and its last line.
+struct Ros2OutputsStatus {
+  int64_t verdicts = 0;       ///< Verdict samples written
+  int64_t marker_arrays = 0;  ///< MarkerArray samples written
+  int64_t clouds = 0;         ///< foreground PointCloud2 samples written
+  int64_t failed_writes = 0;  ///< writes DDS refused, on any topic
+  std::string last_error;     ///< the last of them, naming the topic
+};
+
+/// "ROS 2 outputs: N verdicts, M marker arrays, K foreground clouds; F writes refused (last: ...)".
+std::string describe_ros2_outputs(const Ros2OutputsStatus& status);
+
+/// `ros2.publish`: the ROS 2 outputs (dds/ros2_outputs.hpp, docs/ROS2.md) as a sink and the
+/// processing thread's tap that hands it the foreground cloud.
+struct Ros2Outputs {
+  std::unique_ptr<Sink> sink;  ///< null without ros2.publish
+  /// RunOptions::on_processed for the foreground cloud; null without a sink.
+  std::function<void(const Frame&, const Pipeline&, const FrameResult&)> on_processed;
+  /// What the outputs have written so far (call on the output thread or after the run); null
+  /// without a sink.
+  std::function<Ros2OutputsStatus()> status;
+};
+
+/// The outputs of ros2.* (domain, namespace, cloud rate, speed scaling topic, camera name) in
+/// robot.base_frame, with camera.T_base_camera on /tf_static and the verdict's deadline from
+/// safety.max_frame_gap_periods / max_frame_age_s; with source.type ros2 the camera's own
+/// link → optical chain is read from its /tf_static first (up to 2 s). Logs what it publishes.
+/// Empty without ros2.publish; throws ConfigError in a build without Cyclone DDS, saying so.
+Ros2Outputs make_ros2_output_sink(const Config& config);
 
 /// What an RTDE link did, as one line for the log.
 std::string describe_link_counters(const RtdeLinkSink& link);

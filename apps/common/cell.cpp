@@ -78,7 +78,30 @@ void add_links(Cell& cell, const Config& config) {
   }
 }
 
-RunOptions run_options(const Config& config, const CellOptions& options, Cell& cell, bool paced) {
+// ros2.publish: after the controller's links in the sinks' order; its cloud tap beside the
+// caller's (a viewer's) on the processing thread.
+std::function<void(const Frame&, const Pipeline&, const FrameResult&)> add_ros2_outputs(Cell& cell, const Config& config) {
+  Ros2Outputs outputs = make_ros2_output_sink(config);
+  cell.ros2_outputs = std::move(outputs.sink);
+  cell.ros2_status = std::move(outputs.status);
+  return std::move(outputs.on_processed);
+}
+
+// Both taps, the caller's first (null when neither is set).
+std::function<void(const Frame&, const Pipeline&, const FrameResult&)> both_taps(
+    std::function<void(const Frame&, const Pipeline&, const FrameResult&)> first,
+    std::function<void(const Frame&, const Pipeline&, const FrameResult&)> second) {
+  if (!first) return second;
+  if (!second) return first;
+  return [first = std::move(first), second = std::move(second)](const Frame& frame, const Pipeline& pipeline,
+                                                                const FrameResult& result) {
+    first(frame, pipeline, result);
+    second(frame, pipeline, result);
+  };
+}
+
+RunOptions run_options(const Config& config, const CellOptions& options, Cell& cell, bool paced,
+                       std::function<void(const Frame&, const Pipeline&, const FrameResult&)> ros2_tap) {
   RunOptions run;
   run.pace = paced;
   run.camera_latency_s = config.robot_state.camera_latency_s;
@@ -87,12 +110,12 @@ RunOptions run_options(const Config& config, const CellOptions& options, Cell& c
   // wait, is how the run ends.
   run.stop_requested = cell.source_started ? options.stop_requested : nullptr;
   run.before_process = options.before_process;
-  run.on_processed = options.on_processed;
+  run.on_processed = both_taps(options.on_processed, std::move(ros2_tap));
   if (cell.recorder) {
     // The recording holds the state processing used, so its replay decides as this run did.
     Recorder* recorder = cell.recorder.get();
-    run.on_processed = [recorder, tap = options.on_processed](const Frame& frame, const Pipeline& pipeline,
-                                                              const FrameResult& result) {
+    run.on_processed = [recorder, tap = run.on_processed](const Frame& frame, const Pipeline& pipeline,
+                                                          const FrameResult& result) {
       recorder->state_used(frame.index, result.robot_state);
       if (tap) tap(frame, pipeline, result);
     };
@@ -111,7 +134,11 @@ std::unique_ptr<Cell> assemble_cell(const Config& config, const CellOptions& opt
   if (!options.record.empty()) add_recording(*cell, config, options, paced);
   cell->pipeline = std::make_unique<Pipeline>(config.pipeline);
   if (options.background_files) cell->background = start_background(config, info, *cell->pipeline);
-  if (options.links) add_links(*cell, config);
+  std::function<void(const Frame&, const Pipeline&, const FrameResult&)> ros2_tap;
+  if (options.links) {
+    add_links(*cell, config);
+    ros2_tap = add_ros2_outputs(*cell, config);
+  }
   // follow_link: the simulated arm takes the scale the links have just sent.
   if (cell->trajectory_clock) cell->follow = std::make_unique<FollowLinkSink>(cell->trajectory_clock);
   // Simulated runs: truth.contact_label from the simulator's own labels.
@@ -120,7 +147,7 @@ std::unique_ptr<Cell> assemble_cell(const Config& config, const CellOptions& opt
   cell->header.unknown_background_share = cell->pipeline->unknown_background_share();  // a loaded background's
   if (!cell->header.filters.note.empty()) spdlog::warn("filters: {}", cell->header.filters.note);
   for (const std::string& warning : config.warnings) spdlog::warn("config: {}", warning);
-  cell->run_options = run_options(config, options, *cell, paced);
+  cell->run_options = run_options(config, options, *cell, paced, std::move(ros2_tap));
   return cell;
 }
 

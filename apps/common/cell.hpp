@@ -35,7 +35,7 @@ struct CellOptions {
   /// live camera paces itself either way.
   bool unpaced = false;
   bool with_color = false;      ///< recorded sources decode their colour frames (a viewer, a recording)
-  bool links = true;            ///< link.udp and link.rtde as configured (the evaluation sends nothing)
+  bool links = true;            ///< link.udp, link.rtde and ros2.publish as configured (the evaluation sends nothing)
   /// robot.trajectory.follow_link as configured; false: a simulated arm plays its trajectory as
   /// programmed (`teach`: nothing is sent, and the arm must not wait for a scale).
   bool follow_link = true;
@@ -73,6 +73,10 @@ struct Cell {
   std::unique_ptr<UdpLinkSink> udp_link;    ///< link.udp.address
   std::unique_ptr<RtdeLinkSink> rtde_link;  ///< link.rtde.write
   std::unique_ptr<FollowLinkSink> follow;   ///< follow_link: the arm takes the scale just sent
+  /// ros2.publish: verdict, speed scaling, markers, foreground cloud and /tf_static over DDS
+  /// (make_ros2_output_sink); its cloud tap is in run_options.on_processed.
+  std::unique_ptr<Sink> ros2_outputs;
+  std::function<Ros2OutputsStatus()> ros2_status;  ///< what ros2_outputs did (null without it)
   /// Simulated runs: the simulator that labels each result's truth (TruthLabeller).
   std::optional<Simulator> truth;
   RunHeader header;
@@ -84,8 +88,8 @@ struct Cell {
 
   /// What run_pipeline reads: the recording when there is one, else the source.
   Source& frames() { return recording ? static_cast<Source&>(*recording) : *source; }
-  /// The links in the order they get each result: the controller first.
-  std::vector<Sink*> link_sinks() const { return {udp_link.get(), rtde_link.get(), follow.get()}; }
+  /// The links in the order they get each result: the controller first, then the ROS 2 outputs.
+  std::vector<Sink*> link_sinks() const { return {udp_link.get(), rtde_link.get(), follow.get(), ros2_outputs.get()}; }
 };
 
 /// Builds the cell `config` describes. Throws ConfigError for what the configuration gets

@@ -55,7 +55,8 @@ void install_signal_handlers() {
 
 // What each part of the run can say is wrong while it runs (fault_log.hpp).
 std::vector<FaultProbe> fault_probes(const RobotStateSource& robot_states, const Recorder* recorder,
-                                     const UdpLinkSink* link, const RtdeLinkSink* rtde_link) {
+                                     const UdpLinkSink* link, const RtdeLinkSink* rtde_link,
+                                     const std::function<Ros2OutputsStatus()>& ros2_status) {
   std::vector<FaultProbe> probes;
   // A frame stopped for want of a state says why (the source's problem is in its reason);
   // samples rejected while frames still find a state are said as they come.
@@ -109,6 +110,10 @@ std::vector<FaultProbe> fault_probes(const RobotStateSource& robot_states, const
                         return failed(newest);
                       }});
   }
+  if (ros2_status) {
+    probes.push_back({"ros2", when_rising([ros2_status] { return ros2_status().failed_writes; },
+                                          [ros2_status] { return ros2_status().last_error; })});
+  }
   return probes;
 }
 
@@ -154,7 +159,8 @@ class SessionSinks {
   SessionSinks(Cell& cell, std::ostream& out, const Config& config, const SessionOptions& args)
       : jsonl_(out, proximity_backend_name(config.pipeline.backend), extras(cell, args)),
         tee_(sinks(cell, args)),
-        faults_(tee_, fault_probes(*cell.robot_states, cell.recorder.get(), cell.udp_link.get(), cell.rtde_link.get()),
+        faults_(tee_, fault_probes(*cell.robot_states, cell.recorder.get(), cell.udp_link.get(), cell.rtde_link.get(),
+                             cell.ros2_status),
                 [] { return SteadyClock().now_ns(); }) {}
   Sink& sink() { return faults_; }
 
@@ -203,6 +209,10 @@ void report_links(const Cell& cell) {
     const RtdeLinkCounters c = cell.rtde_link->counters();
     const bool failed = c.disconnects + c.refusals + c.malformed > 0 || c.writes == 0;
     spdlog::log(failed ? spdlog::level::warn : spdlog::level::info, "{}", describe_link_counters(*cell.rtde_link));
+  }
+  if (cell.ros2_status) {
+    const Ros2OutputsStatus status = cell.ros2_status();
+    spdlog::log(status.failed_writes > 0 ? spdlog::level::warn : spdlog::level::info, "{}", describe_ros2_outputs(status));
   }
 }
 

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — a consumer of results: one of the four virtual interfaces (source.hpp says which).
 // JSON Lines, the console, the UDP and RTDE links to the controller and the viewer's tap
-// implement it (a ROS 2 output is still to come); with what a run says before and after its
-// frames.
+// implement it, and so do the ROS 2 outputs (dds/ros2_outputs.hpp); with what a run says
+// before and after its frames.
 #pragma once
 
 #include "hrcsense/robot_state.hpp"
