@@ -141,7 +141,11 @@ std::optional<Pose> chain_transform(const std::vector<TfEdge>& edges, const std:
   Pose T_frame_descendant = Pose::Identity();
   std::string frame = descendant;
   for (int step = 0; step <= kMaxChainEdges; ++step) {
-    if (frame == ancestor) return T_frame_descendant;
+    if (frame == ancestor) {
+      // Edges far apart in size can still add up to no number.
+      if (!T_frame_descendant.matrix().allFinite()) return std::nullopt;
+      return T_frame_descendant;
+    }
     const TfEdge* up = nullptr;
     for (const TfEdge& edge : edges) {
       if (edge.child_frame == frame) up = &edge;  // the newest edge of a frame wins
@@ -158,16 +162,19 @@ std::vector<TfEdge> tf_edges_from_msg(const tf2_msgs_msg_dds__TFMessage_& messag
   for (uint32_t i = 0; i < message.transforms._length; ++i) {
     const geometry_msgs_msg_dds__TransformStamped_& t = message.transforms._buffer[i];
     const geometry_msgs_msg_dds__Quaternion_& r = t.transform.rotation;
+    const geometry_msgs_msg_dds__Vector3_& p = t.transform.translation;
     Eigen::Quaterniond q(r.w, r.x, r.y, r.z);
-    if (!(q.norm() > 0.0)) q = Eigen::Quaterniond::Identity();
+    const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && q.coeffs().allFinite();
+    // |q| must be about 1; far from it the sender computed garbage (and 1e-3 keeps the
+    // normalisation away from dividing by nothing).
+    if (!finite || !(q.norm() > 1e-3)) continue;
     q.normalize();
     TfEdge edge;
     edge.parent_frame = t.header.frame_id != nullptr ? t.header.frame_id : "";
     edge.child_frame = t.child_frame_id != nullptr ? t.child_frame_id : "";
     edge.T_parent_child = Pose::Identity();
     edge.T_parent_child.linear() = q.toRotationMatrix();
-    edge.T_parent_child.translation() =
-        Eigen::Vector3d(t.transform.translation.x, t.transform.translation.y, t.transform.translation.z);
+    edge.T_parent_child.translation() = Eigen::Vector3d(p.x, p.y, p.z);
     edges.push_back(std::move(edge));
   }
   return edges;

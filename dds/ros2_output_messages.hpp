@@ -68,11 +68,13 @@ std::vector<TfEdge> camera_tf_edges(const Pose& T_base_camera, const std::string
 
 /// T_ancestor_descendant along the edges from `descendant` up its parents to `ancestor`
 /// (e.g. camera_link → camera_depth_frame → camera_depth_optical_frame); none when the chain
-/// is broken or longer than 16 edges (a loop).
+/// is broken, longer than 16 edges (a loop) or adds up to a pose that is not finite.
 std::optional<Pose> chain_transform(const std::vector<TfEdge>& edges, const std::string& ancestor,
                                     const std::string& descendant);
 
-/// The transforms of a TFMessage as edges (quaternions normalised; a zero one is the identity).
+/// The transforms of a TFMessage as edges, quaternions normalised. A transform with a value that
+/// is not finite, or a quaternion of (near) zero length, is no pose and is left out (another
+/// node's message: a chain through it is then missing, and the fixed rotation stands in).
 std::vector<TfEdge> tf_edges_from_msg(const tf2_msgs_msg_dds__TFMessage_& message);
 
 /// A TFMessage of `edges`, all stamped `stamp_ns`: `storage` holds the transforms; both

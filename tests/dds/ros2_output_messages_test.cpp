@@ -352,5 +352,32 @@ TEST(Ros2OutputMessages, MarkerArrayCarriesStampFrameAndText) {
   EXPECT_NEAR(line.points._buffer[0].x, 0.582, 1e-6);
 }
 
+TEST(Ros2OutputMessages, ATransformThatIsNoPoseIsLeftOut) {
+  // Another node's /tf_static: a NaN translation, an infinite quaternion and a zero one are no
+  // poses; only the good edge, a quarter turn about z (w = x = 0, z = y = sqrt(1/2), given here
+  // at twice unit length), comes back, normalised.
+  geometry_msgs_msg_dds__TransformStamped_ t[4]{};
+  const char* children[] = {"a", "b", "c", "d"};
+  for (int i = 0; i < 4; ++i) {
+    t[i].header.frame_id = const_cast<char*>("camera_link");
+    t[i].child_frame_id = const_cast<char*>(children[i]);
+    t[i].transform.rotation = {0.0, 0.0, 0.0, 1.0};
+  }
+  t[0].transform.translation.x = std::nan("");
+  t[1].transform.rotation = {0.0, 0.0, INFINITY, 1.0};
+  t[2].transform.rotation = {0.0, 0.0, 0.0, 0.0};
+  t[3].transform.rotation = {0.0, 0.0, std::sqrt(2.0), std::sqrt(2.0)};
+  t[3].transform.translation = {0.0, 0.015, 0.0};
+  tf2_msgs_msg_dds__TFMessage_ message{};
+  message.transforms._buffer = t;
+  message.transforms._length = message.transforms._maximum = 4;
+  const std::vector<TfEdge> edges = tf_edges_from_msg(message);
+  ASSERT_EQ(edges.size(), 1U);
+  EXPECT_EQ(edges[0].child_frame, "d");
+  // x of d is y of camera_link.
+  EXPECT_LT((edges[0].T_parent_child.linear() * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY()).norm(), 1e-12);
+  EXPECT_EQ(edges[0].T_parent_child.translation(), Eigen::Vector3d(0.0, 0.015, 0.0));
+}
+
 }  // namespace
 }  // namespace hrcsense::ros2

@@ -67,7 +67,7 @@ TEST(Ros2JointStates, FramesCarryThePublishedJointsAndAStalledPublisherStopsTheC
   ChildProcess child({HRCSENSE_CLI, "run", "--config", scene_path("cell-ur5.yaml"), "--frames", "900", "--set",
                       "source.pace=true", "--set", "robot.state.source=ros2", "--set",
                       "robot.state.ros2.tf_prefix=ur_", "--set", "ros2.domain_id=" + std::to_string(domain), "--set",
-                      "robot.state.ros2.speed_scaling_topic=", "--set", "robot.state.max_age_s=0.1"});
+                      "robot.state.ros2.speed_scaling_topic=''", "--set", "robot.state.max_age_s=0.1"});
   int with_joints = 0, stopped_stale = 0, after_stall = 0;
   std::string stale_reason;
   std::string line;

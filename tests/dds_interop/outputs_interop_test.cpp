@@ -230,7 +230,7 @@ TEST(Ros2Outputs, EverySampleEqualsItsJsonLineAndTheFramesAreTheConfiguredPose) 
   ASSERT_GE(arrays.size(), 10U);
   int with_pair = 0;
   for (const MarkerSample& a : arrays) {
-    ASSERT_GT(a.count, 1U);
+    ASSERT_GE(a.count, 1U);  // a stop without a robot state draws nothing but the DELETEALL
     EXPECT_EQ(a.first_action, 3) << "DELETEALL first";
     if (a.line_lists > 0) {
       ++with_pair;
