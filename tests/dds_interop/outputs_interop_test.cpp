@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <string>
@@ -43,6 +44,7 @@ struct CloudSample {
 };
 
 struct MarkerSample {
+  int64_t stamp_ns = 0;
   std::string first_frame_id;
   int first_action = -1;
   size_t count = 0;
@@ -119,6 +121,7 @@ TEST(Ros2Outputs, EverySampleEqualsItsJsonLineAndTheFramesAreTheConfiguredPose) 
       MarkerSample sample;
       sample.count = a.markers._length;
       if (sample.count > 0) {
+        sample.stamp_ns = stamp_ns(a.markers._buffer[0].header.stamp);
         sample.first_frame_id = a.markers._buffer[0].header.frame_id;
         sample.first_action = a.markers._buffer[0].action;
       }
@@ -220,10 +223,15 @@ TEST(Ros2Outputs, EverySampleEqualsItsJsonLineAndTheFramesAreTheConfiguredPose) 
   EXPECT_EQ(got.back().verdict, 2);
   EXPECT_EQ(heard_elsewhere, 0) << "a reader on domain " << domain + 1 << " heard hrcsense on " << domain;
 
-  // speed_scaling: the verdicts' scales, ending with the final stop's pause; latched.
+  // speed_scaling: each sample is its line's speed_scale, in order, ending with the final stop's
+  // pause; latched.
   ASSERT_FALSE(factors.empty());
+  ASSERT_LE(factors.size(), lines.size());
   EXPECT_EQ(factors.back(), 0.0);
-  for (double f : factors) EXPECT_TRUE(f >= 0.0 && f <= 1.0) << f;
+  for (size_t i = 0; i < factors.size(); ++i) {
+    const json& line = lines[lines.size() - factors.size() + i];
+    EXPECT_FLOAT_EQ(static_cast<float>(factors[i]), line["speed_scale"].get<float>()) << line.dump().substr(0, 120);
+  }
   EXPECT_GE(late_scale_samples, 1) << "a late subscriber gets the latest speed scaling (transient-local)";
 
   // markers: each array starts by deleting the last one's, in the base frame.
@@ -232,12 +240,27 @@ TEST(Ros2Outputs, EverySampleEqualsItsJsonLineAndTheFramesAreTheConfiguredPose) 
   for (const MarkerSample& a : arrays) {
     ASSERT_GE(a.count, 1U);  // a stop without a robot state draws nothing but the DELETEALL
     EXPECT_EQ(a.first_action, 3) << "DELETEALL first";
-    if (a.line_lists > 0) {
-      ++with_pair;
-      bool has_distance = false;
-      for (const std::string& text : a.texts) has_distance |= text.find(" m") != std::string::npos;
-      EXPECT_TRUE(has_distance) << "the closest pair's distance as text";
+    EXPECT_EQ(a.first_frame_id, "base");
+    const json* frame_line = nullptr;
+    for (const json& line : lines) {
+      if (line["type"] == "frame" && line["timestamp_ns"].get<int64_t>() == a.stamp_ns) frame_line = &line;
     }
+    if (frame_line == nullptr) continue;  // the final stop's array: it repeats the last frame's stamp
+    const bool contact = !(*frame_line)["distance_m"].is_null();
+    EXPECT_EQ(a.line_lists > 0, contact) << "the closest pair is drawn when the frame has one";
+    if (!contact) continue;
+    ++with_pair;
+    // The distance as text, "0.532 m", to the millimetre (half of one for rounding).
+    const double distance = (*frame_line)["distance_m"].get<double>();
+    bool has_distance = false;
+    for (const std::string& text : a.texts) {
+      double value = NAN;
+      char unit[4] = {};
+      if (std::sscanf(text.c_str(), "%lf %3s", &value, unit) == 2 && std::string(unit) == "m") {
+        has_distance |= std::abs(value - distance) <= 0.0005 + 1e-6;
+      }
+    }
+    EXPECT_TRUE(has_distance) << "no text giving " << distance << " m";
   }
   EXPECT_GT(with_pair, 0) << "the closest pair is drawn once the person is in the cell";
 
