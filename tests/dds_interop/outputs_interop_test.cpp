@@ -237,21 +237,23 @@ TEST(Ros2Outputs, EverySampleEqualsItsJsonLineAndTheFramesAreTheConfiguredPose) 
   // markers: each array starts by deleting the last one's, in the base frame.
   ASSERT_GE(arrays.size(), 10U);
   int with_pair = 0;
-  for (const MarkerSample& a : arrays) {
+  // One array per line, in order (the first ones may go before discovery): array k of n is line
+  // lines.size() - n + k.
+  ASSERT_LE(arrays.size(), lines.size());
+  for (size_t k = 0; k < arrays.size(); ++k) {
+    const MarkerSample& a = arrays[k];
+    const json& line = lines[lines.size() - arrays.size() + k];
+    SCOPED_TRACE(line.dump().substr(0, 120));
     ASSERT_GE(a.count, 1U);  // a stop without a robot state draws nothing but the DELETEALL
     EXPECT_EQ(a.first_action, 3) << "DELETEALL first";
     EXPECT_EQ(a.first_frame_id, "base");
-    const json* frame_line = nullptr;
-    for (const json& line : lines) {
-      if (line["type"] == "frame" && line["timestamp_ns"].get<int64_t>() == a.stamp_ns) frame_line = &line;
-    }
-    if (frame_line == nullptr) continue;  // the final stop's array: it repeats the last frame's stamp
-    const bool contact = !(*frame_line)["distance_m"].is_null();
-    EXPECT_EQ(a.line_lists > 0, contact) << "the closest pair is drawn when the frame has one";
+    EXPECT_EQ(a.stamp_ns, line["timestamp_ns"].get<int64_t>());
+    const bool contact = !line["distance_m"].is_null();
+    EXPECT_EQ(a.line_lists > 0, contact) << "the closest pair is drawn when the line has one";
     if (!contact) continue;
     ++with_pair;
     // The distance as text, "0.532 m", to the millimetre (half of one for rounding).
-    const double distance = (*frame_line)["distance_m"].get<double>();
+    const double distance = line["distance_m"].get<double>();
     bool has_distance = false;
     for (const std::string& text : a.texts) {
       double value = NAN;
