@@ -7,6 +7,7 @@
 // color_image_problem / copy_color_image and intrinsics_from_camera_info. The contract: no
 // crash or sanitizer report; an image is copied only when accepted; CameraInfo either maps
 // to finite intrinsics or throws Ros2Error.
+#include "field_reader.hpp"
 #include "dds/ros2_messages.hpp"
 
 #include <cmath>
@@ -17,27 +18,7 @@
 
 namespace {
 
-// Reads fields off the front of the input; past the end, zeros.
-struct Reader {
-  const uint8_t* data;
-  size_t size;
-  template <typename T>
-  T take() {
-    T value{};
-    const size_t n = std::min(sizeof(T), size);
-    std::memcpy(&value, data, n);
-    data += n;
-    size -= n;
-    return value;
-  }
-  std::string text(size_t max_length) {
-    const size_t n = std::min<size_t>(take<uint8_t>() % (max_length + 1), size);
-    std::string s(reinterpret_cast<const char*>(data), n);
-    data += n;
-    size -= n;
-    return s.c_str();  // a C string stops at its first NUL, as Cyclone's would
-  }
-};
+using Reader = hrcsense::fuzz::FieldReader;
 
 const char* const kEncodings[] = {"16UC1", "mono16", "rgb8", "bgr8", "32FC1", ""};
 const char* const kModels[] = {"plumb_bob", "rational_polynomial", "equidistant", "none", "", "fisheye"};

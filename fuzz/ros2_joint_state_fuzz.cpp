@@ -7,6 +7,7 @@
 // a double and a unit go through speed_fraction_from. The contract: no crash or sanitizer
 // report; an accepted JointState has six finite positions and velocities and no error; a
 // rejected one says why; a speed reading is NaN or within 0..1.
+#include "field_reader.hpp"
 #include "dds/ros2_joint_state.hpp"
 
 #include <algorithm>
@@ -18,27 +19,7 @@
 
 namespace {
 
-// Reads fields off the front of the input; past the end, zeros.
-struct Reader {
-  const uint8_t* data;
-  size_t size;
-  template <typename T>
-  T take() {
-    T value{};
-    const size_t n = std::min(sizeof(T), size);
-    std::memcpy(&value, data, n);
-    data += n;
-    size -= n;
-    return value;
-  }
-  std::string text(size_t max_length) {
-    const size_t n = std::min<size_t>(take<uint8_t>() % (max_length + 1), size);
-    std::string s(reinterpret_cast<const char*>(data), n);
-    data += n;
-    size -= n;
-    return s.c_str();  // a C string stops at its first NUL, as Cyclone's would
-  }
-};
+using Reader = hrcsense::fuzz::FieldReader;
 
 // An array length: mostly one per name (what a driver sends), sometimes none, sometimes any.
 uint32_t array_length(uint8_t pick, uint32_t names) {

@@ -7,6 +7,7 @@
 // optical frame, as `ros2.publish` with `source.type: ros2` reads it. The contract: no crash or
 // sanitizer report, no endless walk; every edge kept and any chain found is a finite pose with
 // a rotation (orthonormal, determinant 1).
+#include "field_reader.hpp"
 #include "dds/ros2_output_messages.hpp"
 
 #include <algorithm>
@@ -18,29 +19,14 @@
 
 namespace {
 
-struct TfReader {
-  const uint8_t* data;
-  size_t size;
-  template <typename T>
-  T take() {
-    T value{};
-    const size_t n = std::min(sizeof(T), size);
-    std::memcpy(&value, data, n);
-    data += n;
-    size -= n;
-    return value;
-  }
+struct TfReader : hrcsense::fuzz::FieldReader {
   // One of realsense-ros's frames most of the time, so that chains form; else any short text.
   std::string frame() {
     static const char* const kFrames[] = {"camera_link", "camera_depth_frame", "camera_depth_optical_frame",
                                           "camera_color_frame", "base", ""};
     const uint8_t pick = take<uint8_t>();
     if (pick < 200) return kFrames[pick % 6];
-    const size_t n = std::min<size_t>(take<uint8_t>() % 24, size);
-    std::string text(reinterpret_cast<const char*>(data), n);
-    data += n;
-    size -= n;
-    return text.c_str();  // a C string stops at its first NUL, as Cyclone's would
+    return text(23);
   }
 };
 
@@ -53,7 +39,7 @@ bool is_rotation(const Eigen::Matrix3d& r) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace hrcsense::ros2;
-  TfReader in{data, size};
+  TfReader in{{data, size}};
   const size_t count = in.take<uint8_t>() % 25;
   std::vector<std::string> parents(count), children(count);
   std::vector<geometry_msgs_msg_dds__TransformStamped_> transforms(count);
