@@ -58,7 +58,9 @@ Simulator make_simulator(const Config& config, std::shared_ptr<TrajectoryClock> 
   Simulator simulator;
   simulator.params = config.sim;
   simulator.scene = config.scene;
-  simulator.T_base_camera = config.pipeline.T_base_camera;
+  // The true pose renders; the pipeline keeps the one it is told (they differ only on request).
+  simulator.T_base_camera = config.sim_camera_T_base_camera.value_or(config.pipeline.T_base_camera);
+  simulator.camera_knock = config.sim_camera_knock;
   simulator.robot = fixed_robot_model(config);
   if (config.robot_state.trajectory) {
     // A moving arm: rendered at each frame's time with its own label (robot.trajectory).

@@ -11,6 +11,7 @@
 #include <cctype>
 #include <cstdio>
 #include <limits>
+#include <optional>
 
 namespace hrcsense {
 namespace {
@@ -42,6 +43,44 @@ Pose pose_from_rpy(const Eigen::Vector3f& translation_m, const Eigen::Vector3f& 
   pose.linear() = rotation;
   pose.translation() = translation_m.cast<double>();
   return pose;
+}
+
+// A pose in camera.T_base_camera's form below `key` ({translation_m, rotation_rpy_deg}), both
+// parts required (a true pose half taken from elsewhere would be a guess); nullopt when neither
+// is given. An absent pose stays out of the effective configuration, so that configurations
+// without it keep their hash.
+std::optional<Pose> read_optional_pose(KeyReader& r, const std::string& key) {
+  const std::string translation_key = key + ".translation_m";
+  const std::string rotation_key = key + ".rotation_rpy_deg";
+  const bool has_translation = r.raw(translation_key).IsDefined();
+  const bool has_rotation = r.raw(rotation_key).IsDefined();
+  if (!has_translation && !has_rotation) return std::nullopt;
+  if (!has_translation || !has_rotation) {
+    r.fail(key, "expected both translation_m and rotation_rpy_deg, e.g. {translation_m: [0, 0, 1.5], "
+                "rotation_rpy_deg: [0, 0, 0]}");
+  }
+  Eigen::Vector3f translation_m = Eigen::Vector3f::Zero();
+  Eigen::Vector3f rpy_deg = Eigen::Vector3f::Zero();
+  r.vec3(translation_key, translation_m, kMaxCoordinateM);
+  r.vec3(rotation_key, rpy_deg, 360.0F);
+  return pose_from_rpy(translation_m, rpy_deg);
+}
+
+// The simulated camera's true pose and its knock (docs/SIMULATOR.md, "A camera pose hrcsense is
+// not told"). Absent keys leave the effective configuration as it was.
+void read_sim_camera(KeyReader& r, Config& c) {
+  c.sim_camera_T_base_camera = read_optional_pose(r, "sim.camera_T_base_camera");
+  const std::string frame_key = "sim.camera_knock_frame";
+  const std::string pose_key = "sim.camera_knock_T_base_camera";
+  if (r.raw(frame_key).IsDefined()) r.integer(frame_key, c.sim_camera_knock.frame, -1, kMaxSimFrames);
+  const std::optional<Pose> knocked = read_optional_pose(r, pose_key);
+  if (c.sim_camera_knock.frame >= 0 && !knocked) {
+    r.fail_pair(frame_key, pose_key, "a knock needs the pose the camera is knocked to");
+  }
+  if (c.sim_camera_knock.frame < 0 && knocked) {
+    r.fail_pair(frame_key, pose_key, "a knocked pose needs the frame of the knock (an integer >= 0)");
+  }
+  if (knocked) c.sim_camera_knock.T_base_camera = *knocked;
 }
 
 [[noreturn]] void not_implemented(const KeyReader& r, const std::string& key, const std::string& value,
@@ -95,6 +134,7 @@ void read_source_and_sim(KeyReader& r, Config& c) {
     r.fail("sim.baseline_mm", "expected a baseline in [1, 1000] mm, got " + config_detail::float_text(c.sim.baseline_mm));
   }
   config_detail::read_sim_effects(r, c.sim);
+  read_sim_camera(r, c);
 
   const YAML::Node objects = r.raw("scene.objects");
   c.scene = config_detail::read_scene_objects(objects, r.where(), "scene.objects");

@@ -241,6 +241,13 @@ void fill_truth_contacts(const Simulator& sim, const PoseF& T_base_camera, Groun
   truth.analytic_contact = analytic_contact(scratch, robot, T_base_camera.inverse());
 }
 
+PoseF pose_f(const Pose& pose) {
+  PoseF out;
+  out.R = pose.linear().cast<float>();
+  out.t = pose.translation().cast<float>();
+  return out;
+}
+
 /// The colour camera's frame: the same placed shapes cast from the colour camera's pose, flat
 /// colours per object, nothing hit black.
 void render_color(const Simulator& sim, const PoseF& T_base_camera_f, Frame& out) {
@@ -305,9 +312,9 @@ void Simulator::render(int64_t index, Frame& out) const {
   const Intrinsics in = intrinsics();
   sim_detail::ensure_rays(scratch.rays, in);
   place_shapes(*this, index, scratch);
-  PoseF T_base_camera_f;
-  T_base_camera_f.R = T_base_camera.linear().cast<float>();
-  T_base_camera_f.t = T_base_camera.translation().cast<float>();
+  // The true pose: the depth and colour casts and every truth (labels, the camera-frame points
+  // of the contacts) follow where the camera really is; base-frame distances need no pose.
+  const PoseF T_base_camera_f = pose_f(T_base_camera_at(index));
 
   out.index = index;
   out.timestamp_ns = std::llround(static_cast<double>(index) * 1e9 / params.fps);
@@ -339,9 +346,7 @@ Simulator::Hit Simulator::hit_at(int64_t index, int pixel) const {
   if (scratch.label_index != index) {
     sim_detail::ensure_rays(scratch.rays, in);
     place_shapes(*this, index, scratch);
-    PoseF T_base_camera_f;
-    T_base_camera_f.R = T_base_camera.linear().cast<float>();
-    T_base_camera_f.t = T_base_camera.translation().cast<float>();
+    const PoseF T_base_camera_f = pose_f(T_base_camera_at(index));  // as render() casts it
     scratch.label_z_m.resize(n);
     scratch.object_ids.resize(n);
     sim_detail::cast_shapes(scratch.shapes_base, scratch.shape_ids, scratch.rays, T_base_camera_f,

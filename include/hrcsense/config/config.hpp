@@ -199,6 +199,11 @@ struct Config {
   SourceConfig source;
   SimParams sim;                   ///< `sim.*`: the simulated camera; `source.seed` is sim.seed
   Scene scene;                     ///< `scene.objects`: the simulated scene
+  /// `sim.camera_T_base_camera`: where the simulated camera truly is, base ← camera; unset: where
+  /// hrcsense is told it is (pipeline.T_base_camera). The pipeline never reads it.
+  std::optional<Pose> sim_camera_T_base_camera;
+  /// `sim.camera_knock_frame`, `sim.camera_knock_T_base_camera`: the true pose from a frame on.
+  SimCameraKnock sim_camera_knock;
   /// `filters.preset`: none, sdk (default: the RealSense Viewer's) or thesis; the chain itself
   /// is in pipeline.filters.
   FilterPreset filters_preset = FilterPreset::sdk;

@@ -277,12 +277,26 @@ struct SimArm {
   std::shared_ptr<TrajectoryClock> clock;
 };
 
+/// A knock (`sim.camera_knock_frame`, `sim.camera_knock_T_base_camera`): the camera is moved
+/// between two frames, as a bump or a loose mount moves it, and stays there. For tests and
+/// checks of what hrcsense does when the pose it was told goes stale (docs/SIMULATOR.md).
+struct SimCameraKnock {
+  int64_t frame = -1;                     ///< first frame rendered from the knocked pose; < 0: no knock
+  Pose T_base_camera = Pose::Identity();  ///< the true pose from `frame` on, base ← camera
+};
+
 /// Renders frames of a scene. Deterministic: frame i depends only on (params, scene, i), except
 /// for an arm that follows the link (SimArm::clock), which depends on the scales sent.
 struct Simulator {
   SimParams params;
   Scene scene;
+  /// The camera's true pose, base ← camera, which the frames are rendered from and the truth is
+  /// measured with. hrcsense is told its own pose (camera.T_base_camera); the two differ only
+  /// when `sim.camera_T_base_camera` says so (docs/SIMULATOR.md, "A camera pose hrcsense is not
+  /// told").
   Pose T_base_camera = Pose::Identity();
+  /// Moves the true pose from a frame on; default: never.
+  SimCameraKnock camera_knock;
   RobotModel robot;  ///< for the ground-truth contact (without `arm`; with it, the arm's searched capsules)
   /// A moving arm; unset: no moving arm (an arm at a fixed pose is a static scene object).
   /// With it, GroundTruth::contact and analytic_contact measure against the arm's searched
@@ -316,6 +330,11 @@ struct Simulator {
     float z_m = 0.0F;
   };
   Hit hit_at(int64_t index, int pixel) const;
+  /// The true pose frame `index` is rendered from: camera_knock's from its frame on, else
+  /// T_base_camera.
+  const Pose& T_base_camera_at(int64_t index) const {
+    return camera_knock.frame >= 0 && index >= camera_knock.frame ? camera_knock.T_base_camera : T_base_camera;
+  }
   uint16_t label_at(int64_t index, int pixel) const { return hit_at(index, pixel).label; }
   /// A label's name: "static", "robot" (kRobotLabel), or the name of the non-static scene
   /// object with that label; "" for a label no object has.
