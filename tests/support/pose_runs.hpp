@@ -5,6 +5,8 @@
 
 #include "scenes.hpp"
 
+#include <gtest/gtest.h>
+
 #include <cstdint>
 #include <cstdlib>
 #include <fstream>
