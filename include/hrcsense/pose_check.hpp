@@ -3,9 +3,9 @@
 // the arm's visual shapes, placed by the frame's joints and seen through the told camera pose,
 // must be where the camera measures the arm. A sparse grid of rays through the arm's projected
 // silhouette is cast against those shapes; at each ray the predicted depth of the visible surface
-// is compared with the filtered depth. A told pose wrong by a centimetre or a degree moves the
-// arm by pixels and centimetres: its pixels then show the table behind it, or its surface at
-// another depth. Unlike camera_moved it needs no background, so it also sees a pose that was
+// is compared with the measured depth (5×5-pixel means of the source frame). A told pose wrong
+// by a centimetre or a degree moves the arm by pixels and centimetres: its pixels then show the
+// table behind it, or its surface at another depth. Unlike camera_moved it needs no background, so it also sees a pose that was
 // wrong before learning.
 #pragma once
 
@@ -31,7 +31,7 @@ struct PoseCheckParams {
   /// check fires when their mean disagreement exceeds threshold_m and clears when each of them
   /// is at or below it.
   int window_frames = 8;
-  int grid_px = 3;             ///< one ray per this many filtered pixels in u and v
+  int grid_px = 3;             ///< one ray per this many pixels in u and v
   /// A ray counts only where it passes the hit shape's axis within this share of its radius:
   /// away from the silhouette's edge, where depth mixes the arm with what lies behind it.
   float core_share = 0.6F;
@@ -79,8 +79,8 @@ struct ShapeInCamera {
   int pose = 0;  ///< which of the poses given (0: the current one)
 };
 
-/// Compares the filtered `depth` (with its `intrinsics`; pinhole, distortion ignored: D435 depth
-/// has none) with the arm's visual shapes (robot_render_capsules, base frame) seen from
+/// Compares `depth` (the pipeline gives the source frame's, before the filters; with its
+/// `intrinsics`: pinhole, distortion ignored, D435 depth has none) with the arm's visual shapes (robot_render_capsules, base frame) seen from
 /// `T_base_camera`: `poses_base[0]` at this frame's joints, then up to memory_frames − 1 earlier
 /// frames' (newest first; `pose_count` ≥ 1). `shapes` is scratch, reused (no allocation once
 /// sized).
