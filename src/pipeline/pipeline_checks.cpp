@@ -155,7 +155,7 @@ bool Pipeline::camera_pose_agrees(const Frame& frame, const RobotState& robot_st
 bool Pipeline::withhold_pose(Measurement& m) const {
   char text[160];
   std::snprintf(text, sizeof text,
-                "the arm is seen %.1f cm off its shapes on average over %d frames (pose_check_threshold_m %.3f): "
+                "the arm is seen %.2f cm off its shapes on average over %d frames (pose_check_threshold_m %.4f): "
                 "camera pose mismatch, check camera.T_base_camera",
                 100.0 * static_cast<double>(pose_check_.window_mean_m()), params_.pose_check.window_frames,
                 static_cast<double>(params_.pose_check.threshold_m));
