@@ -33,7 +33,7 @@ void BM_PoseCheck(benchmark::State& state) {
   for (auto _ : state) {
     robot_render_capsules(*params.robot.arm, config.robot_state.joints_rad, params.robot.base_frame, visual);
     const PoseDisagreement d =
-        pose_disagreement(params.pose_check, frame.depth, frame.intrinsics, params.T_base_camera, &visual, 1, shapes);
+        pose_disagreement(params.pose_check, frame.depth, frame.intrinsics, params.T_base_camera, visual, shapes);
     samples += d.samples;
     benchmark::DoNotOptimize(check.add(d));
   }

@@ -144,8 +144,7 @@ class Pipeline {
   // The camera pose check: its window, the arm's visual shapes at the frame's joints and their
   // camera-frame scratch (buffers reused).
   PoseCheck pose_check_;
-  std::vector<RobotModel> visual_poses_;  ///< newest first; the first visual_pose_count_ are set
-  size_t visual_pose_count_ = 0;
+  RobotModel visual_;
   std::vector<ShapeInCamera> pose_shapes_;
 
   // The stages of process(), in its order; each that fails withholds `m` with its reason.

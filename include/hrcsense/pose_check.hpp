@@ -42,12 +42,6 @@ struct PoseCheckParams {
   /// (a square): the stereo noise averaged down.
   int patch_px = 2;
   float cap_m = 0.2F;          ///< a sample's disagreement counts at most this much, m
-  /// For an image that remembers past frames (the temporal filter's output), where a moving arm
-  /// is measured where it was: a ray counts only where the visual surface along it lies within
-  /// still_m of the current one at each of the earlier poses given. The pipeline checks the
-  /// source frame, which has no memory: memory_frames 1, only the current pose.
-  float still_m = 0.005F;
-  int memory_frames = 1;       ///< poses compared: the current one and the frames before it
 };
 
 /// One frame's comparison of the measured arm with its shapes.
@@ -76,18 +70,17 @@ struct ShapeInCamera {
   Eigen::Vector3f b_camera = Eigen::Vector3f::Zero();
   float radius_m = 0.0F;
   int u0 = 0, v0 = 0, u1 = -1, v1 = -1;
-  int pose = 0;  ///< which of the poses given (0: the current one)
 };
 
 /// Compares `depth` (the pipeline gives the source frame's, before the filters; with its
-/// `intrinsics`: pinhole, distortion ignored, D435 depth has none) with the arm's visual shapes (robot_render_capsules, base frame) seen from
-/// `T_base_camera`: `poses_base[0]` at this frame's joints, then up to memory_frames − 1 earlier
-/// frames' (newest first; `pose_count` ≥ 1). `shapes` is scratch, reused (no allocation once
+/// `intrinsics`: pinhole, distortion ignored, D435 depth has none) with the arm's visual shapes
+/// `visual_base` (robot_render_capsules at this frame's joints, base frame) seen from
+/// `T_base_camera`. The depth must be of the frame's own moment: an image from the temporal
+/// filter shows a moving arm where it was. `shapes` is scratch, reused (no allocation once
 /// sized).
 PoseDisagreement pose_disagreement(const PoseCheckParams& params, const DepthImage& depth,
                                    const Intrinsics& intrinsics, const Pose& T_base_camera,
-                                   const RobotModel* poses_base, size_t pose_count,
-                                   std::vector<ShapeInCamera>& shapes);
+                                   const RobotModel& visual_base, std::vector<ShapeInCamera>& shapes);
 
 /// The decision over frames: a window of the last in-view frames' disagreements. A frame
 /// without the arm in view leaves it as it was.

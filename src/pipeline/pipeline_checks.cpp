@@ -5,7 +5,6 @@
 
 #include "pipeline_detail.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -128,23 +127,11 @@ bool Pipeline::envelope_seen(const Frame& frame, const RobotPixels* robot_pixels
 // fires nor clears it (PoseCheck::add).
 bool Pipeline::camera_pose_agrees(const Frame& frame, const RobotState& robot_state, Measurement& m) {
   if (!params_.robot.arm || !params_.pose_check.enabled) return true;
-  if (!robot_state.valid || !all_finite(robot_state.q_rad)) {
-    visual_pose_count_ = 0;  // the poses remembered are history
-    return true;
-  }
+  if (!robot_state.valid || !all_finite(robot_state.q_rad)) return true;
   timed_stage(m, "pose_check", [&] {
-    const size_t memory = static_cast<size_t>(std::max(1, params_.pose_check.memory_frames));
-    if (visual_poses_.size() != memory) {
-      visual_poses_.resize(memory);  // the first frame only
-      visual_pose_count_ = 0;
-    }
-    // The oldest pose's buffer becomes the newest's: no allocation once sized.
-    std::rotate(visual_poses_.begin(), visual_poses_.end() - 1, visual_poses_.end());
-    robot_render_capsules(*params_.robot.arm, robot_state.q_rad, params_.robot.base_frame, visual_poses_[0]);
-    visual_pose_count_ = std::min(memory, visual_pose_count_ + 1);
+    robot_render_capsules(*params_.robot.arm, robot_state.q_rad, params_.robot.base_frame, visual_);
     const PoseDisagreement now = pose_disagreement(params_.pose_check, frame.depth, frame.intrinsics,
-                                                   params_.T_base_camera, visual_poses_.data(), visual_pose_count_,
-                                                   pose_shapes_);
+                                                   params_.T_base_camera, visual_, pose_shapes_);
     pose_check_.params = params_.pose_check;
     pose_check_.add(now);
   });

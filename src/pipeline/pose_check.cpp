@@ -49,20 +49,13 @@ void project_bounds(const Intrinsics& in, ShapeInCamera& s) {
 
 int round_up_to(int value, int step) { return (value + step - 1) / step * step; }
 
-bool same_capsules(const RobotModel& x, const RobotModel& y) {
-  return x.capsules.size() == y.capsules.size() &&
-         std::equal(x.capsules.begin(), x.capsules.end(), y.capsules.begin(), [](const Capsule& p, const Capsule& q) {
-           return p.a == q.a && p.b == q.b && p.radius_m == q.radius_m;
-         });
-}
-
-// The nearest entry along `ray` into the shapes of pose `pose` that may cover pixel (u, v);
-// depth 0 when none is hit.
-CapsuleHit nearest_hit(const std::vector<ShapeInCamera>& shapes, int pose, int u, int v, const Eigen::Vector3f& ray) {
+// The nearest entry along `ray` into the shapes that may cover pixel (u, v); depth 0 when none
+// is hit.
+CapsuleHit nearest_hit(const std::vector<ShapeInCamera>& shapes, int u, int v, const Eigen::Vector3f& ray) {
   CapsuleHit nearest;
   nearest.depth_m = 0.0F;
   for (const ShapeInCamera& s : shapes) {
-    if (s.pose != pose || u < s.u0 || u > s.u1 || v < s.v0 || v > s.v1) continue;
+    if (u < s.u0 || u > s.u1 || v < s.v0 || v > s.v1) continue;
     CapsuleHit hit;
     if (!ray_capsule_depth(ray, s.a_camera, s.b_camera, s.radius_m, hit)) continue;
     if (nearest.depth_m == 0.0F || hit.depth_m < nearest.depth_m) nearest = hit;
@@ -138,36 +131,27 @@ bool ray_capsule_depth(const Eigen::Vector3f& ray, const Eigen::Vector3f& a, con
 
 PoseDisagreement pose_disagreement(const PoseCheckParams& params, const DepthImage& depth,
                                    const Intrinsics& intrinsics, const Pose& T_base_camera,
-                                   const RobotModel* poses_base, size_t pose_count,
-                                   std::vector<ShapeInCamera>& shapes) {
+                                   const RobotModel& visual_base, std::vector<ShapeInCamera>& shapes) {
   PoseDisagreement out;
-  if (pose_count == 0 || depth.width != intrinsics.width || depth.height != intrinsics.height ||
-      !(intrinsics.fx > 0.0F) || !(intrinsics.fy > 0.0F)) {
+  if (depth.width != intrinsics.width || depth.height != intrinsics.height || !(intrinsics.fx > 0.0F) ||
+      !(intrinsics.fy > 0.0F)) {
     return out;
   }
   const Eigen::Isometry3f T_camera_base = T_base_camera.inverse().cast<float>();
-  // Earlier poses equal to the current one (an arm at rest) need no ray of their own.
   shapes.clear();  // keeps its capacity
-  int moved_poses = 0;
-  for (size_t p = 0; p < pose_count && p < static_cast<size_t>(std::max(1, params.memory_frames)); ++p) {
-    if (p > 0 && same_capsules(poses_base[p], poses_base[0])) continue;
-    const int pose = p == 0 ? 0 : ++moved_poses;
-    for (const Capsule& c : poses_base[p].capsules) {
-      ShapeInCamera s;
-      s.a_camera = T_camera_base * c.a;
-      s.b_camera = T_camera_base * c.b;
-      s.radius_m = c.radius_m;
-      s.pose = pose;
-      project_bounds(intrinsics, s);
-      if (s.u1 >= s.u0 && s.v1 >= s.v0) shapes.push_back(s);
-    }
+  for (const Capsule& c : visual_base.capsules) {
+    ShapeInCamera s;
+    s.a_camera = T_camera_base * c.a;
+    s.b_camera = T_camera_base * c.b;
+    s.radius_m = c.radius_m;
+    project_bounds(intrinsics, s);
+    if (s.u1 >= s.u0 && s.v1 >= s.v0) shapes.push_back(s);
   }
   int u_min = intrinsics.width;
   int u_max = -1;
   int v_min = intrinsics.height;
   int v_max = -1;
   for (const ShapeInCamera& s : shapes) {
-    if (s.pose != 0) continue;
     u_min = std::min(u_min, s.u0);
     u_max = std::max(u_max, s.u1);
     v_min = std::min(v_min, s.v0);
@@ -184,14 +168,8 @@ PoseDisagreement pose_disagreement(const PoseCheckParams& params, const DepthIma
       if (row[u] == 0) continue;  // no depth: nothing to compare
       const Eigen::Vector3f ray((static_cast<float>(u) - intrinsics.ppx) * inv_fx,
                                 (static_cast<float>(v) - intrinsics.ppy) * inv_fy, 1.0F);
-      const CapsuleHit nearest = nearest_hit(shapes, 0, u, v, ray);
+      const CapsuleHit nearest = nearest_hit(shapes, u, v, ray);
       if (nearest.depth_m == 0.0F || nearest.axis_share > params.core_share) continue;
-      bool still = true;
-      for (int pose = 1; pose <= moved_poses && still; ++pose) {
-        const CapsuleHit then = nearest_hit(shapes, pose, u, v, ray);
-        still = then.depth_m > 0.0F && std::abs(then.depth_m - nearest.depth_m) <= params.still_m;
-      }
-      if (!still) continue;  // the filtered depth there still holds the arm as it was
       const float measured_m = patch_mean_m(depth, u, v, params.patch_px);
       if (!(measured_m > 0.0F)) continue;
       const float diff_m = measured_m - nearest.depth_m;

@@ -93,7 +93,7 @@ TEST(PoseCheck, TheRightPoseAgreesWithinTheDepthUnit) {
   params.patch_px = 0;  // each sample its own pixel, as the depth was rendered
   std::vector<ShapeInCamera> shapes;
   const PoseDisagreement d =
-      pose_disagreement(params, scene.depth, scene.intrinsics, Pose::Identity(), &scene.arm_base, 1, shapes);
+      pose_disagreement(params, scene.depth, scene.intrinsics, Pose::Identity(), scene.arm_base, shapes);
   // The capsule spans about 20 × 7 px; its core (0.6 of the radius) about 4 rows of it.
   EXPECT_GT(d.samples, 40U);
   EXPECT_LE(d.mean_m, 0.0005F);  // rounding to the 1 mm unit only
@@ -110,13 +110,13 @@ TEST(PoseCheck, APoseOffByTwoCentimetresDisagrees) {
   // rows above, and the edge rows of the prediction see the wall.
   Pose told = Pose::Identity();
   told.translation() = Eigen::Vector3d(0, 0.02, 0);
-  const PoseDisagreement moved = pose_disagreement(params, scene.depth, scene.intrinsics, told, &scene.arm_base, 1, shapes);
+  const PoseDisagreement moved = pose_disagreement(params, scene.depth, scene.intrinsics, told, scene.arm_base, shapes);
   const PoseDisagreement right =
-      pose_disagreement(params, scene.depth, scene.intrinsics, Pose::Identity(), &scene.arm_base, 1, shapes);
+      pose_disagreement(params, scene.depth, scene.intrinsics, Pose::Identity(), scene.arm_base, shapes);
   EXPECT_GT(moved.mean_m, right.mean_m + 0.003F);
   // Told 5 cm nearer along z than it is: every sample 5 cm off.
   told.translation() = Eigen::Vector3d(0, 0, 0.05);
-  const PoseDisagreement nearer = pose_disagreement(params, scene.depth, scene.intrinsics, told, &scene.arm_base, 1, shapes);
+  const PoseDisagreement nearer = pose_disagreement(params, scene.depth, scene.intrinsics, told, scene.arm_base, shapes);
   EXPECT_GT(nearer.samples, 40U);
   EXPECT_NEAR(nearer.mean_m, 0.05F, 0.002F);
 }
@@ -132,9 +132,9 @@ TEST(PoseCheck, SomethingInFrontOfTheArmIsNoSample) {
   params.patch_px = 0;  // each sample its own pixel, as the depth was rendered
   std::vector<ShapeInCamera> shapes;
   const PoseDisagreement all = pose_disagreement(params, SmallScene().depth, scene.intrinsics, Pose::Identity(),
-                                                 &scene.arm_base, 1, shapes);
+                                                 scene.arm_base, shapes);
   const PoseDisagreement half =
-      pose_disagreement(params, scene.depth, scene.intrinsics, Pose::Identity(), &scene.arm_base, 1, shapes);
+      pose_disagreement(params, scene.depth, scene.intrinsics, Pose::Identity(), scene.arm_base, shapes);
   EXPECT_LT(half.samples, all.samples * 6 / 10);
   EXPECT_LE(half.mean_m, 0.0005F);
 }
