@@ -141,6 +141,11 @@ class Pipeline {
   ReliableBackground reliable_;
   std::vector<uint32_t> moved_reference_;  ///< moved_reference_pixels of the background in use
   bool moved_reference_ready_ = false;
+  // The camera pose check: its window, the arm's visual shapes at the frame's joints and their
+  // camera-frame scratch (buffers reused).
+  PoseCheck pose_check_;
+  RobotModel visual_;
+  std::vector<ShapeInCamera> pose_shapes_;
 
   // The stages of process(), in its order; each that fails withholds `m` with its reason.
   /// Counts the raw invalid pixels and runs the filters; null when too little depth is left.
@@ -153,6 +158,11 @@ class Pipeline {
   void check_reference(const Frame& frame, const RobotPixels* robot_pixels);
   /// Withholds a learning frame with `background_not_empty` while the last batch was refused.
   void withhold_not_empty(Measurement& m) const;
+  /// The arm's pixels agree with its visual shapes seen from the told pose (or the check has
+  /// nothing to say this frame); withholds with camera_pose_mismatch when they do not.
+  bool camera_pose_agrees(const Frame& frame, const RobotState& robot_state, Measurement& m);
+  /// Withholds `m` with camera_pose_mismatch and the window's disagreement; returns false.
+  bool withhold_pose(Measurement& m) const;
   /// The background fits the frame, a loaded one is checked, and the camera sees the cell.
   bool background_usable(const Frame& frame, Measurement& m);
   /// The robot's capsules at a valid, finite state.

@@ -7,6 +7,7 @@
 
 #include "hrcsense/cell_checks.hpp"
 #include "hrcsense/filters.hpp"
+#include "hrcsense/pose_check.hpp"
 #include "hrcsense/proximity.hpp"
 #include "hrcsense/robot.hpp"
 #include "hrcsense/safety.hpp"
@@ -30,6 +31,7 @@ struct PipelineParams {
   SelfFilterParams self_filter;
   SafetyParams safety;
   CellCheckParams checks;  ///< the image watchdogs (camera blocked or moved, robot envelope invalid)
+  PoseCheckParams pose_check;  ///< the told camera pose against the arm, every frame (arms only)
   ProximityBackend backend = ProximityBackend::brute;  ///< `proximity.backend`
   ProximityParams proximity;  ///< octree height, brute threads
 };

@@ -274,6 +274,9 @@ enum class ReasonCode : uint16_t {
   /// stop: the background learnt at start holds something nearer than background.reference
   /// within S_p at rest (zones: safety.slow_distance_m) of the robot; learning goes on
   background_not_empty = 31,
+  /// stop: the arm's measured pixels disagree with its visual shapes seen from
+  /// camera.T_base_camera (safety.pose_check_threshold_m): the told camera pose is wrong
+  camera_pose_mismatch = 33,
 };
 
 struct Verdict {

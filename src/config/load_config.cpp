@@ -292,6 +292,13 @@ void read_safety_behaviour(KeyReader& r, Config& c) {
   r.number("safety.blocked_share", checks.blocked_share, Bound::positive, 1.0F);
   r.number("safety.max_envelope_invalid_share", checks.max_envelope_invalid_share, Bound::non_negative, 0.99F);
   r.number("safety.moved_share", checks.moved_share, Bound::positive, 1.0F);
+  // The camera pose check (arms only; it does nothing for robot.model points). The threshold
+  // must stay below the disagreement a 1 cm or 1 degree error gives (docs/SAFETY.md).
+  PoseCheckParams& pose = c.pipeline.pose_check;
+  r.flag("safety.pose_check", pose.enabled);
+  r.number("safety.pose_check_threshold_m", pose.threshold_m, Bound::positive, 1.0F);
+  r.integer("safety.pose_check_min_arm_pixels", pose.min_arm_pixels, 1, 100000);
+  r.integer("safety.pose_check_window_frames", pose.window_frames, 1, 30);
   // At least one period (a gap below one period fires between any two frames), at most 100.
   r.number_in("safety.max_frame_gap_periods", safety.max_frame_gap_periods, 1.0, 100.0, " periods");
 }

@@ -254,7 +254,9 @@ void Pipeline::process(const Frame& source_frame, const RobotState& robot_state,
   const Frame* frame = filter(source_frame, m);
   if (frame != nullptr && !background_ready()) {
     learn(*frame, robot_state, m);
-  } else if (frame != nullptr && background_usable(*frame, m) && robot_placed(robot_state, m)) {
+    camera_pose_agrees(source_frame, robot_state, m);  // a wrong pose is the learning frame's reason too
+  } else if (frame != nullptr && camera_pose_agrees(source_frame, robot_state, m) && background_usable(*frame, m) &&
+             robot_placed(robot_state, m)) {
     const std::optional<RobotPixels> robot_pixels = render_robot(*frame, m);
     const RobotPixels* pixels = robot_pixels ? &*robot_pixels : nullptr;
     if (envelope_seen(*frame, pixels, m) && extract(*frame, pixels, m)) {

@@ -14,6 +14,7 @@
 namespace hrcsense {
 namespace {
 
+using pipeline_detail::timed_stage;
 using pipeline_detail::withhold;
 
 bool same_size(const BackgroundModel& model, const DepthImage& depth) {
@@ -117,6 +118,35 @@ bool Pipeline::envelope_seen(const Frame& frame, const RobotPixels* robot_pixels
   std::snprintf(text, sizeof text, "%.0f %% of the robot's envelope without depth (max_envelope_invalid_share %.2f)",
                 100.0 * envelope.share(), static_cast<double>(params_.checks.max_envelope_invalid_share));
   withhold(m, ReasonCode::envelope_invalid, text);
+  return false;
+}
+
+// The arm's visual shapes at the frame's joints, seen from the told pose, against the filtered
+// depth. Without an arm, with the check off or without a usable state (no_robot_state and the
+// others stop then anyway) it says nothing; a frame without enough of the arm in view neither
+// fires nor clears it (PoseCheck::add).
+bool Pipeline::camera_pose_agrees(const Frame& frame, const RobotState& robot_state, Measurement& m) {
+  if (!params_.robot.arm || !params_.pose_check.enabled) return true;
+  if (!robot_state.valid || !all_finite(robot_state.q_rad)) return true;
+  timed_stage(m, "pose_check", [&] {
+    robot_render_capsules(*params_.robot.arm, robot_state.q_rad, params_.robot.base_frame, visual_);
+    const PoseDisagreement now = pose_disagreement(params_.pose_check, frame.depth, frame.intrinsics,
+                                                   params_.T_base_camera, visual_, pose_shapes_);
+    pose_check_.params = params_.pose_check;
+    pose_check_.add(now);
+  });
+  return !pose_check_.mismatch() || withhold_pose(m);
+}
+
+// Always false, so that a caller can return it.
+bool Pipeline::withhold_pose(Measurement& m) const {
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "the arm is seen %.2f cm off its shapes on average over %d frames (pose_check_threshold_m %.4f): "
+                "camera pose mismatch, check camera.T_base_camera",
+                100.0 * static_cast<double>(pose_check_.window_mean_m()), params_.pose_check.window_frames,
+                static_cast<double>(params_.pose_check.threshold_m));
+  withhold(m, ReasonCode::camera_pose_mismatch, text);
   return false;
 }
 

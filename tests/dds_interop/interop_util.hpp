@@ -44,7 +44,7 @@ inline const std::map<std::string, int>& reason_numbers() {
       {"source_ended", 17}, {"frame_limit_reached", 18}, {"stop_requested", 19}, {"source_error", 20},
       {"processing_error", 21}, {"output_error", 22}, {"camera_disconnected", 23}, {"unknown_space", 24},
       {"envelope_invalid", 25}, {"camera_blocked", 26}, {"camera_moved", 27}, {"below_protective_distance", 28},
-      {"speed_limited", 29}, {"holding", 30}, {"background_not_empty", 31}};
+      {"speed_limited", 29}, {"holding", 30}, {"background_not_empty", 31}, {"camera_pose_mismatch", 33}};
   return numbers;
 }
 

@@ -126,9 +126,12 @@ TEST(CellChecks, MovedCountsReferencePixelsFartherThanTheirMargin) {
 
 // The moving cell without noise on the arm's timeline; the background is learnt from its
 // first 100 frames, then frames 100.. are processed with a fault from frame 110 on.
+// `pose_check` false switches the camera pose check off (safety.pose_check).
 struct FaultRig {
-  Config config = load_config(test::scene_path("cell-ur5-moving.yaml"),
-                              {"sim.frames=130"});
+  explicit FaultRig(bool pose_check = true)
+      : config(load_config(test::scene_path("cell-ur5-moving.yaml"),
+                           {"sim.frames=130", pose_check ? "safety.pose_check=true" : "safety.pose_check=false"})) {}
+  Config config;
   Pipeline pipeline{config.pipeline};
   Frame frame;
   FrameResult result;
@@ -205,7 +208,8 @@ TEST(CellCheckFaults, EnvelopeWithoutDepthStopsWithin100ms) {
 }
 
 TEST(CellCheckFaults, CameraMovedStopsWithin100ms) {
-  FaultRig rig;
+  // The camera pose check off: it sees this knock too, and before camera_moved (below).
+  FaultRig rig(false);
   const Simulator clean = make_simulator(rig.config);
   // The camera knocked 0.15 m back along its mount (away from the cell) and tilted 3 degrees.
   const Config moved_config = load_config(test::scene_path("cell-ur5-moving.yaml"),
@@ -216,6 +220,10 @@ TEST(CellCheckFaults, CameraMovedStopsWithin100ms) {
   const int64_t at = rig.first_stop(clean, moved, ReasonCode::camera_moved, [](Frame&) {});
   ASSERT_GE(at, 110);
   EXPECT_LE(at, kWithin100ms);
+  // With the pose check on (the default), the arm seen 15 cm and 3 degrees off its shapes stops
+  // the knock's first frame already, with camera_pose_mismatch.
+  FaultRig checked;
+  EXPECT_EQ(checked.first_stop(clean, moved, ReasonCode::camera_pose_mismatch, [](Frame&) {}), 110);
 }
 
 }  // namespace
