@@ -293,28 +293,40 @@ Ros2OutputParams chain_params() {
   return params;
 }
 
-TEST(Ros2Outputs, CameraNodesOwnChainIsUsedUnderTheLinkOnly) {
-  if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
-  ParticipantScope scope(test::test_domain());
+// Writes one /tf_static message of the edges (parent, child, translation, quaternion x y z w)
+// from a latched writer made on `scope`, as a camera node or a static_transform_publisher does.
+struct TfEdgeText {
+  const char* parent;
+  const char* child;
+  geometry_msgs_msg_dds__Vector3_ translation;
+  geometry_msgs_msg_dds__Quaternion_ rotation;
+};
+void write_tf_static(ParticipantScope& scope, std::vector<TfEdgeText> edges) {
   const dds_entity_t topic = scope.own(
       dds_create_topic(scope.participant(), &tf2_msgs_msg_dds__TFMessage__desc, "rt/tf_static", nullptr, nullptr),
       "topic");
   const QosHandle latched(EndpointQos{true, true, 1});
-  const dds_entity_t camera_node = scope.own(dds_create_writer(scope.participant(), topic, latched.get(), nullptr), "writer");
+  const dds_entity_t writer = scope.own(dds_create_writer(scope.participant(), topic, latched.get(), nullptr), "writer");
+  std::vector<geometry_msgs_msg_dds__TransformStamped_> t(edges.size());
+  for (size_t i = 0; i < edges.size(); ++i) {
+    t[i].header.frame_id = const_cast<char*>(edges[i].parent);
+    t[i].child_frame_id = const_cast<char*>(edges[i].child);
+    t[i].transform.translation = edges[i].translation;
+    t[i].transform.rotation = edges[i].rotation;
+  }
+  tf2_msgs_msg_dds__TFMessage_ msg{};
+  msg.transforms._buffer = t.data();
+  msg.transforms._length = msg.transforms._maximum = static_cast<uint32_t>(t.size());
+  ASSERT_EQ(dds_write(writer, &msg), DDS_RETCODE_OK);
+}
+
+TEST(Ros2Outputs, CameraNodesOwnChainIsUsedUnderTheLinkOnly) {
+  if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
+  ParticipantScope scope(test::test_domain());
   // realsense-ros's chain: camera_link → camera_depth_frame (15 mm to the left) →
   // camera_depth_optical_frame (the optical rotation, written as its quaternion).
-  geometry_msgs_msg_dds__TransformStamped_ t[2]{};
-  t[0].header.frame_id = const_cast<char*>("camera_link");
-  t[0].child_frame_id = const_cast<char*>("camera_depth_frame");
-  t[0].transform.translation.y = 0.015;
-  t[0].transform.rotation.w = 1.0;
-  t[1].header.frame_id = const_cast<char*>("camera_depth_frame");
-  t[1].child_frame_id = const_cast<char*>("camera_depth_optical_frame");
-  t[1].transform.rotation = geometry_msgs_msg_dds__Quaternion_{-0.5, 0.5, -0.5, 0.5};
-  tf2_msgs_msg_dds__TFMessage_ msg{};
-  msg.transforms._buffer = t;
-  msg.transforms._length = msg.transforms._maximum = 2;
-  ASSERT_EQ(dds_write(camera_node, &msg), DDS_RETCODE_OK);
+  write_tf_static(scope, {{"camera_link", "camera_depth_frame", {0.0, 0.015, 0.0}, {0.0, 0.0, 0.0, 1.0}},
+                          {"camera_depth_frame", "camera_depth_optical_frame", {0.0, 0.0, 0.0}, {-0.5, 0.5, -0.5, 0.5}}});
 
   Ros2OutputParams params = chain_params();
   params.camera_tf_wait_s = 10.0;  // a bound: the chain is latched and arrives at once
@@ -336,23 +348,9 @@ TEST(Ros2Outputs, CameraNodesOwnChainIsUsedUnderTheLinkOnly) {
 TEST(Ros2Outputs, ALinkThatHasAParentAlreadyGetsNoSecond) {
   if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
   ParticipantScope scope(test::test_domain());
-  const dds_entity_t topic = scope.own(
-      dds_create_topic(scope.participant(), &tf2_msgs_msg_dds__TFMessage__desc, "rt/tf_static", nullptr, nullptr),
-      "topic");
-  const QosHandle latched(EndpointQos{true, true, 1});
-  const dds_entity_t calibration = scope.own(dds_create_writer(scope.participant(), topic, latched.get(), nullptr), "writer");
   // Someone's static_transform_publisher already places the link; the camera node its optics.
-  geometry_msgs_msg_dds__TransformStamped_ t[2]{};
-  t[0].header.frame_id = const_cast<char*>("world");
-  t[0].child_frame_id = const_cast<char*>("placed_cam_link");
-  t[0].transform.rotation.w = 1.0;
-  t[1].header.frame_id = const_cast<char*>("placed_cam_link");
-  t[1].child_frame_id = const_cast<char*>("placed_cam_depth_optical_frame");
-  t[1].transform.rotation = geometry_msgs_msg_dds__Quaternion_{-0.5, 0.5, -0.5, 0.5};
-  tf2_msgs_msg_dds__TFMessage_ msg{};
-  msg.transforms._buffer = t;
-  msg.transforms._length = msg.transforms._maximum = 2;
-  ASSERT_EQ(dds_write(calibration, &msg), DDS_RETCODE_OK);
+  write_tf_static(scope, {{"world", "placed_cam_link", {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0, 1.0}},
+                          {"placed_cam_link", "placed_cam_depth_optical_frame", {0.0, 0.0, 0.0}, {-0.5, 0.5, -0.5, 0.5}}});
 
   Ros2OutputParams params = chain_params();
   params.camera_name = "placed_cam";
