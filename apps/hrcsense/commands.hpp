@@ -64,6 +64,9 @@ int info_command(const CommandArgs& args);
 /// teach --out PATH: learns the background as a run does and writes it as a reference for
 /// background.reference; exit 1 when the source ends (or --frames) before it is learnt.
 int teach_command(const CommandArgs& args);
+/// calibrate --out POSE.yaml: the camera's pose from the arm's own depth (docs/CALIBRATION.md);
+/// exit 1 when refused (the reason on stderr), nothing written then.
+int calibrate_command(const CommandArgs& args);
 /// devices: the RealSense cameras connected, with their depth profiles (docs/CAMERAS.md); in a
 /// build without the SDK, the error saying how to get it.
 int devices_command();

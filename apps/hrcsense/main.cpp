@@ -35,6 +35,7 @@ struct Subcommands {
   CLI::App* echo = nullptr;
   CLI::App* info = nullptr;
   CLI::App* teach = nullptr;
+  CLI::App* calibrate = nullptr;
   CLI::App* devices = nullptr;
   CLI::App* bench = nullptr;
   CLI::App* eval = nullptr;
@@ -114,6 +115,10 @@ Subcommands add_subcommands(CLI::App& app, CommandArgs& args, hrcsense::app::Eva
       "teach", "learn the background with the cell empty and write it for background.reference (docs/SAFETY.md)");
   add_common_flags(*commands.teach, args);
   commands.teach->add_option("--out", args.out, "the reference background file (the background.path format)")->required();
+  commands.calibrate = app.add_subcommand(
+      "calibrate", "the camera's pose from the arm's own depth while it sweeps the workspace (docs/CALIBRATION.md)");
+  add_common_flags(*commands.calibrate, args);
+  commands.calibrate->add_option("--out", args.out, "the pose file (camera.T_base_camera and the fit's figures)")->required();
   commands.devices = app.add_subcommand("devices", "list the RealSense cameras connected and their depth profiles");
   commands.bench = app.add_subcommand("bench", "time the processing path on pre-rendered frames");
   add_common_flags(*commands.bench, args);
@@ -130,7 +135,7 @@ Subcommands add_subcommands(CLI::App& app, CommandArgs& args, hrcsense::app::Eva
 bool is_unknown_command(const std::string& first) {
   return !first.empty() && first[0] != '-' && first != "run" && first != "record" && first != "publish" &&
          first != "echo" && first != "info" && first != "devices" && first != "bench" && first != "verify-filters" &&
-         first != "eval" && first != "teach";
+         first != "eval" && first != "teach" && first != "calibrate";
 }
 
 // Runs the one subcommand CLI11 parsed (require_subcommand(1)); `bench` is the one left.
@@ -142,6 +147,7 @@ int run_parsed_command(const Subcommands& commands, const CommandArgs& args, con
   if (commands.echo->parsed()) return hrcsense::app::echo_command(echo_args);
   if (commands.info->parsed()) return hrcsense::app::info_command(args);
   if (commands.teach->parsed()) return hrcsense::app::teach_command(args);
+  if (commands.calibrate->parsed()) return hrcsense::app::calibrate_command(args);
   if (commands.devices->parsed()) return hrcsense::app::devices_command();
   if (commands.verify_filters->parsed()) return hrcsense::app::verify_filters_command(args);
   if (commands.eval->parsed()) return hrcsense::app::eval_command(eval_args);
@@ -164,7 +170,7 @@ int main(int argc, char** argv) {
 
   if (is_unknown_command(argc > 1 ? argv[1] : "")) {
     return hrcsense::app::report_error(std::string("unknown command '") + argv[1] +
-                                           "'; expected run, record, publish, echo, info, teach, devices, bench, eval or "
+                                           "'; expected run, record, publish, echo, info, teach, calibrate, devices, bench, eval or "
                                            "verify-filters",
                                        hrcsense::app::kExitUsage);
   }

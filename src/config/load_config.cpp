@@ -303,6 +303,21 @@ void read_safety_behaviour(KeyReader& r, Config& c) {
   r.number_in("safety.max_frame_gap_periods", safety.max_frame_gap_periods, 1.0, 100.0, " periods");
 }
 
+// `calibration.*`: how `hrcsense calibrate` reads the sweep and when it refuses
+// (docs/CALIBRATION.md). No value may turn a refusal off: the limits are bounded.
+void read_calibration(KeyReader& r, Config& c) {
+  CalibrationParams& cal = c.calibration;
+  r.integer("calibration.grid_px", cal.grid_px, 1, 16);
+  r.number("calibration.candidate_margin_m", cal.candidate_margin_m, Bound::positive, 1.0F);
+  r.number("calibration.inlier_gate_m", cal.inlier_gate_m, Bound::positive, 0.2F);
+  r.integer("calibration.max_keyframes", cal.max_keyframes, 8, 100000);
+  r.integer("calibration.min_arm_samples", cal.min_arm_samples, 100, 100000000);
+  r.integer("calibration.min_poses", cal.min_poses, 3, 100000);
+  r.number("calibration.max_residual_rms_m", cal.max_residual_rms_m, Bound::positive, 0.1F);
+  r.number_in("calibration.max_sigma_translation_m", cal.max_sigma_translation_m, 1e-6, 0.05, " m");
+  r.number_in("calibration.max_sigma_rotation_deg", cal.max_sigma_rotation_deg, 1e-6, 2.0, " deg");
+}
+
 // `link.*`: the verdict to the controller (docs/SAFETY.md, "The link").
 void read_link(KeyReader& r, Config& c) {
   LinkConfig& link = c.link;
@@ -422,6 +437,7 @@ void read_all(KeyReader& r, Config& c) {
   read_link(r, c);
   read_record(r, c);
   read_ros2(r, c);
+  read_calibration(r, c);
   config_detail::check_ssm_mode(r, c);  // after every key: it weighs keys of several sections
 }
 

@@ -4,6 +4,7 @@
 // an unknown or ill-typed key is an error that names the key and the file.
 #pragma once
 
+#include "hrcsense/calibration.hpp"
 #include "hrcsense/pipeline_params.hpp"
 #include "hrcsense/robot.hpp"
 #include "hrcsense/robot_state_history.hpp"
@@ -223,6 +224,7 @@ struct Config {
   PublishConfig publish;                 ///< `publish.*`
   Ros2Config ros2;                       ///< `ros2.*`
   LinkConfig link;                       ///< `link.*`
+  CalibrationParams calibration;         ///< `calibration.*`: `hrcsense calibrate` (docs/CALIBRATION.md)
   std::string canonical_yaml;      ///< the effective configuration, for the hash in the header
   /// What a person starting the run must hear about this configuration (e.g. ssm without the
   /// robot's stopping data); logged as warnings at the start, one line each.

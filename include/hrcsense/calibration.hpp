@@ -1,0 +1,155 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — the camera's pose from the arm's own depth (`hrcsense calibrate`,
+// docs/CALIBRATION.md). The arm is the calibration target: its joints say where each of its
+// visual shapes is in the base frame, the depth image says where the camera sees it.
+//
+//   ArmSamples samples(params, intrinsics, robot);
+//   for each frame with its joints: samples.add(frame.depth, q_rad);   // keyframes, farthest depth
+//   CameraCalibration fit = calibrate_camera(params, samples, T_base_camera_told);
+//
+// 1. The background is the farthest depth each pixel saw over the sweep: the arm only ever
+//    makes a pixel nearer, so a pixel nearer than it by candidate_margin_m shows the arm (or
+//    something else that moved: a person, the robust fit's outliers).
+// 2. A coarse alignment from the told pose (off by up to 0.2 m and 15°): per keyframe, the
+//    centroid of the candidates against the centroid of the arm's surface as the told pose
+//    would see it, solved for the rigid motion over the keyframes (Kabsch), a few rounds.
+// 3. A robust point-to-surface refinement over every keyframe: Gauss–Newton on the signed
+//    distance of each candidate to its frame's visual shapes, with a shrinking gate and Huber
+//    weights, the pose's update in the camera frame.
+// 4. Its spread: a jackknife over groups of keyframes (what the poses disagree on, the
+//    kinematic model's errors included), not the far smaller formal covariance of correlated
+//    pixels.
+#pragma once
+
+#include "hrcsense/robot.hpp"
+#include "hrcsense/types.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace hrcsense {
+
+/// How the calibration reads and fits (defaults and why: docs/CALIBRATION.md).
+struct CalibrationParams {
+  int grid_px = 4;                    ///< one sample per this many pixels in u and v
+  /// A sample whose 5×5 mean is nearer than the farthest such mean it saw by more than this (m),
+  /// or by 6 σ of that mean's stereo noise where that is more (D435: 1.7 cm at 2 m, 5 cm at
+  /// 3.4 m), is an arm candidate.
+  float candidate_margin_m = 0.05F;
+  /// A frame becomes a keyframe when some link origin or the flange moved this far (m) since
+  /// the last keyframe: a held arm adds nothing new.
+  double keyframe_motion_m = 0.02;
+  int max_keyframes = 1200;           ///< keyframes kept at most (the oldest are thinned)
+  /// The fit's final gate (m): a candidate farther than this from the arm's surface is not the
+  /// arm (a person, a cable, a mixed edge pixel).
+  float inlier_gate_m = 0.03F;
+  /// Refusals (exit 1): fewer inlier samples than this over all keyframes...
+  int min_arm_samples = 2000;
+  /// ...fewer keyframes with the arm seen (each at least min_samples_per_pose inliers)...
+  int min_poses = 4;
+  int min_samples_per_pose = 50;
+  /// ...an RMS point-to-surface residual over the inliers above this (m)...
+  float max_residual_rms_m = 0.02F;
+  /// ...or a spread (the jackknife's standard error, per axis, worst) above these: the poses do
+  /// not pin every degree of freedom down.
+  double max_sigma_translation_m = 0.002;
+  double max_sigma_rotation_deg = 0.05;
+  int jackknife_groups = 8;           ///< groups of keyframes the spread is computed over
+};
+
+/// One keyframe: the depth samples of the grid (raw units, 0 no depth) and the joints.
+struct ArmKeyframe {
+  int64_t frame_index = 0;
+  JointAngles q_rad{};
+  /// The median valid depth of the 5×5 pixels about each sample (0: fewer than half valid):
+  /// the point's depth. grid_width × grid_height, row-major.
+  std::vector<uint16_t> depth_grid;
+  /// The mean valid depth of the same pixels: the background and the candidate test compare
+  /// these, whose noise is a fifth of a pixel's.
+  std::vector<uint16_t> mean_grid;
+};
+
+/// What the sweep showed: the farthest depth per grid sample and the keyframes.
+class ArmSamples {
+ public:
+  /// `visual` is the arm's description; its visual shapes (robot_render_capsules) are the
+  /// target, in `base_frame`.
+  ArmSamples(const CalibrationParams& params, const Intrinsics& intrinsics, const RobotDescription& arm,
+             BaseFrame base_frame);
+  /// Adds one frame: its depth (of `intrinsics`' size; another size throws std::invalid_argument)
+  /// and the arm's joints at its capture. `stereo_baseline_mm` scales the noise margin (0:
+  /// the D435's). Returns whether it became a keyframe.
+  bool add(int64_t frame_index, const DepthImage& depth, const JointAngles& q_rad, float stereo_baseline_mm = 0.0F);
+
+  const CalibrationParams& params() const { return params_; }
+  const Intrinsics& intrinsics() const { return intrinsics_; }
+  const RobotDescription& arm() const { return arm_; }
+  BaseFrame base_frame() const { return base_frame_; }
+  int grid_width() const { return grid_width_; }
+  int grid_height() const { return grid_height_; }
+  float depth_scale_m() const { return depth_scale_m_; }
+  int64_t frames() const { return frames_; }
+  const std::vector<ArmKeyframe>& keyframes() const { return keyframes_; }
+  /// Farthest 5×5 mean depth (raw) each grid sample saw (0: never a depth).
+  const std::vector<uint16_t>& farthest() const { return farthest_; }
+  /// Grid samples whose farthest depth grew by more than candidate_margin_m since the last
+  /// call (the background still being uncovered); resets the count.
+  int64_t take_background_changes();
+  /// The candidate margin (raw depth units) against a farthest mean of `farthest_raw`.
+  int margin_raw(uint16_t farthest_raw) const;
+
+ private:
+  CalibrationParams params_;
+  Intrinsics intrinsics_;
+  RobotDescription arm_;
+  BaseFrame base_frame_;
+  int grid_width_ = 0;
+  int grid_height_ = 0;
+  float depth_scale_m_ = 0.001F;
+  float baseline_mm_ = 0.0F;
+  int64_t frames_ = 0;
+  int64_t background_changes_ = 0;
+  std::vector<uint16_t> farthest_;
+  std::vector<ArmKeyframe> keyframes_;
+  std::vector<Eigen::Vector3d> last_key_origins_base_;
+};
+
+/// The arm candidates of one keyframe: camera-frame points (at the median depth) of the grid
+/// samples whose 5×5 mean and median both stand nearer than the farthest mean by margin_raw.
+std::vector<Eigen::Vector3f> arm_candidates(const ArmSamples& samples, const ArmKeyframe& keyframe);
+
+/// Signed distance (m) from `point_base` to the surface of the nearest of `shapes` (negative
+/// inside), and that surface's outward normal there (unit; any unit vector on an axis).
+float distance_to_shapes(const std::vector<Capsule>& shapes, const Eigen::Vector3f& point_base,
+                         Eigen::Vector3f& normal_base);
+
+/// The result of calibrate_camera.
+struct CameraCalibration {
+  bool ok = false;                 ///< false: refused; `problem` says why
+  std::string problem;             ///< for people: what is missing and what to do
+  Pose T_base_camera = Pose::Identity();
+  Pose T_base_camera_coarse = Pose::Identity();  ///< after the coarse alignment
+  double residual_rms_m = 0.0;     ///< RMS signed distance of the inliers to the shapes
+  double sigma_translation_m = 0.0;  ///< jackknife standard error of the camera's position, worst axis
+  double sigma_rotation_deg = 0.0;   ///< ...of its orientation, worst axis (camera frame)
+  size_t inliers = 0;              ///< samples within the final gate
+  size_t candidates = 0;           ///< arm candidates over all keyframes
+  int poses = 0;                   ///< keyframes with at least min_samples_per_pose inliers
+  /// Keyframes left out whole: more than a tenth of their candidates lie 10 cm or more off the
+  /// fitted arm (a person or another moving thing in view).
+  size_t keyframes_left_out = 0;
+  int iterations = 0;              ///< Gauss–Newton steps of the refinement
+};
+
+/// Fits the camera pose to the samples, starting from `T_base_camera_told` (the configured
+/// pose), and checks it against the refusal limits of the params.
+CameraCalibration calibrate_camera(const ArmSamples& samples, const Pose& T_base_camera_told);
+
+/// The rotation angle (deg) and translation (m) between two poses: how far a calibration is
+/// from another.
+double rotation_between_deg(const Pose& a, const Pose& b);
+double translation_between_m(const Pose& a, const Pose& b);
+
+}  // namespace hrcsense

@@ -1,0 +1,177 @@
+// SPDX-License-Identifier: Apache-2.0
+// hrcsense — what a calibration sweep showed: the farthest depth per grid sample and the
+// keyframes, and each keyframe's arm candidates (calibration.hpp).
+#include "hrcsense/calibration.hpp"
+
+#include "hrcsense/camera.hpp"
+
+#include <algorithm>
+#include <array>
+#include <stdexcept>
+
+namespace hrcsense {
+namespace {
+
+// The pixel of grid sample (gx, gy): the middle of its cell.
+int grid_pixel(int g, int step) { return g * step + step / 2; }
+
+// Where the arm is, as few points as say it: every link frame's origin (the flange included).
+void link_origins(const RobotDescription& arm, const JointAngles& q_rad, std::vector<Eigen::Vector3d>& out) {
+  const LinkFrames frames = forward_kinematics(arm, q_rad);
+  out.clear();
+  for (const Pose& T : frames.T_base_link) out.push_back(T.translation());
+}
+
+// The mean and the median of the valid raw depths of the 5×5 pixels about (u, v); both 0 when
+// fewer than half are valid. The mean is the background's statistic (its noise a fifth of a
+// pixel's); the median is the point's depth: as quiet, but a patch that is mostly arm keeps the
+// arm's depth at the silhouette, where a mean mixes in what lies behind it.
+struct PatchDepth {
+  uint16_t mean = 0;
+  uint16_t median = 0;
+};
+PatchDepth patch_depth(const DepthImage& depth, int u, int v) {
+  constexpr int kHalf = 2;
+  const int u0 = std::max(0, u - kHalf);
+  const int u1 = std::min(depth.width - 1, u + kHalf);
+  const int v0 = std::max(0, v - kHalf);
+  const int v1 = std::min(depth.height - 1, v + kHalf);
+  std::array<uint16_t, (2 * kHalf + 1) * (2 * kHalf + 1)> valid{};
+  size_t n = 0;
+  uint32_t sum = 0;
+  for (int y = v0; y <= v1; ++y) {
+    for (int x = u0; x <= u1; ++x) {
+      const uint16_t d = depth.at(x, y);
+      if (d == 0) continue;
+      valid[n++] = d;
+      sum += d;
+    }
+  }
+  PatchDepth out;
+  if (n == 0 || 2 * static_cast<int>(n) < (u1 - u0 + 1) * (v1 - v0 + 1)) return out;
+  out.mean = static_cast<uint16_t>((sum + static_cast<uint32_t>(n) / 2) / static_cast<uint32_t>(n));
+  const auto middle = valid.begin() + static_cast<std::ptrdiff_t>(n / 2);
+  std::nth_element(valid.begin(), middle, valid.begin() + static_cast<std::ptrdiff_t>(n));
+  out.median = *middle;
+  return out;
+}
+
+}  // namespace
+
+ArmSamples::ArmSamples(const CalibrationParams& params, const Intrinsics& intrinsics, const RobotDescription& arm,
+                       BaseFrame base_frame)
+    : params_(params), intrinsics_(intrinsics), arm_(arm), base_frame_(base_frame) {
+  const int step = std::max(1, params_.grid_px);
+  params_.grid_px = step;
+  grid_width_ = (intrinsics.width + step - 1) / step;
+  grid_height_ = (intrinsics.height + step - 1) / step;
+  // The last cell's middle may fall off a size that is not a multiple of the step.
+  if (grid_width_ > 0 && grid_pixel(grid_width_ - 1, step) >= intrinsics.width) --grid_width_;
+  if (grid_height_ > 0 && grid_pixel(grid_height_ - 1, step) >= intrinsics.height) --grid_height_;
+  farthest_.assign(static_cast<size_t>(std::max(0, grid_width_ * grid_height_)), 0);
+}
+
+bool ArmSamples::add(int64_t frame_index, const DepthImage& depth, const JointAngles& q_rad, float stereo_baseline_mm) {
+  if (depth.width != intrinsics_.width || depth.height != intrinsics_.height) {
+    throw std::invalid_argument("calibration: frame " + std::to_string(frame_index) + " is " +
+                                std::to_string(depth.width) + "x" + std::to_string(depth.height) +
+                                ", the source said " + std::to_string(intrinsics_.width) + "x" +
+                                std::to_string(intrinsics_.height));
+  }
+  ++frames_;
+  depth_scale_m_ = depth.depth_scale_m;
+  baseline_mm_ = stereo_baseline_mm > 0.0F ? stereo_baseline_mm : kD435BaselineMm;
+  const int step = params_.grid_px;
+  std::vector<uint16_t> grid(farthest_.size());
+  std::vector<uint16_t> means(farthest_.size());
+  for (int gy = 0; gy < grid_height_; ++gy) {
+    for (int gx = 0; gx < grid_width_; ++gx) {
+      const size_t i = static_cast<size_t>(gy) * static_cast<size_t>(grid_width_) + static_cast<size_t>(gx);
+      const int u = grid_pixel(gx, step);
+      const int v = grid_pixel(gy, step);
+      const PatchDepth patch = patch_depth(depth, u, v);
+      grid[i] = patch.median;
+      const uint16_t mean = patch.mean;
+      means[i] = mean;
+      if (mean > farthest_[i]) {
+        if (farthest_[i] != 0 && mean - farthest_[i] > margin_raw(farthest_[i])) ++background_changes_;
+        farthest_[i] = mean;
+      }
+    }
+  }
+  std::vector<Eigen::Vector3d> origins;
+  link_origins(arm_, q_rad, origins);
+  double moved_m = keyframes_.empty() ? params_.keyframe_motion_m : 0.0;
+  for (size_t i = 0; i < origins.size() && i < last_key_origins_base_.size(); ++i) {
+    moved_m = std::max(moved_m, (origins[i] - last_key_origins_base_[i]).norm());
+  }
+  if (moved_m < params_.keyframe_motion_m) return false;
+  last_key_origins_base_ = origins;
+  if (static_cast<int>(keyframes_.size()) >= std::max(2, params_.max_keyframes)) {
+    // Full: every second keyframe goes, so that those kept still span the whole sweep.
+    size_t kept = 0;
+    for (size_t i = 0; i < keyframes_.size(); i += 2) keyframes_[kept++] = std::move(keyframes_[i]);
+    keyframes_.resize(kept);
+  }
+  keyframes_.push_back(ArmKeyframe{frame_index, q_rad, std::move(grid), std::move(means)});
+  return true;
+}
+
+int ArmSamples::margin_raw(uint16_t farthest_raw) const {
+  // A 5×5 mean's noise is a fifth of one pixel's (independent pixels): 6 σ of it. A test of a
+  // single noisy pixel against a margin would keep the arm's pixels that noise brought nearer
+  // and drop those it took farther: a bias towards the camera.
+  const double z_m = static_cast<double>(farthest_raw) * static_cast<double>(depth_scale_m_);
+  const double sigma_m = stereo_depth_sigma_m(z_m, intrinsics_.fx, baseline_mm_, kD435SubpixelRmsPx);
+  const double margin_m = std::max(static_cast<double>(params_.candidate_margin_m), 6.0 * sigma_m / 5.0);
+  return static_cast<int>(margin_m / static_cast<double>(depth_scale_m_));
+}
+
+int64_t ArmSamples::take_background_changes() {
+  const int64_t changes = background_changes_;
+  background_changes_ = 0;
+  return changes;
+}
+
+std::vector<Eigen::Vector3f> arm_candidates(const ArmSamples& samples, const ArmKeyframe& keyframe) {
+  std::vector<Eigen::Vector3f> points_camera;
+  const float scale = samples.depth_scale_m();
+  const int step = samples.params().grid_px;
+  const std::vector<uint16_t>& farthest = samples.farthest();
+  for (int gy = 0; gy < samples.grid_height(); ++gy) {
+    for (int gx = 0; gx < samples.grid_width(); ++gx) {
+      const size_t i = static_cast<size_t>(gy) * static_cast<size_t>(samples.grid_width()) + static_cast<size_t>(gx);
+      const uint16_t d = keyframe.depth_grid[i];
+      const uint16_t mean = keyframe.mean_grid[i];
+      // Both the mean and the median must stand off the background: beside the arm's silhouette
+      // the mean takes in arm pixels while most of the patch shows what lies behind.
+      const int margin = samples.margin_raw(farthest[i]);
+      if (d == 0 || mean == 0 || farthest[i] - mean <= margin || farthest[i] - d <= margin) continue;
+      const Eigen::Vector2f pixel(static_cast<float>(grid_pixel(gx, step)), static_cast<float>(grid_pixel(gy, step)));
+      if (const auto p = deproject(samples.intrinsics(), pixel, static_cast<float>(d) * scale)) {
+        points_camera.push_back(*p);
+      }
+    }
+  }
+  return points_camera;
+}
+
+float distance_to_shapes(const std::vector<Capsule>& shapes, const Eigen::Vector3f& point_base,
+                         Eigen::Vector3f& normal_base) {
+  float best = std::numeric_limits<float>::infinity();
+  for (const Capsule& c : shapes) {
+    const Eigen::Vector3f e = c.b - c.a;
+    const float ee = e.squaredNorm();
+    const float t = ee > 0.0F ? std::clamp((point_base - c.a).dot(e) / ee, 0.0F, 1.0F) : 0.0F;
+    const Eigen::Vector3f off = point_base - (c.a + t * e);
+    const float norm = off.norm();
+    const float d = norm - c.radius_m;
+    if (d < best) {
+      best = d;
+      normal_base = norm > 1e-9F ? Eigen::Vector3f(off / norm) : Eigen::Vector3f::UnitZ();
+    }
+  }
+  return best;
+}
+
+}  // namespace hrcsense
