@@ -248,6 +248,9 @@ NormalEquations accumulate(const std::vector<KeyframeFit>& keys, const std::vect
   return eq;
 }
 
+constexpr double kMaxStepRad = 2.0 / kDegPerRad;
+constexpr double kMaxStepM = 0.05;
+
 // Gauss–Newton with each gate in turn until the step is below a micrometre and a microradian.
 Pose refine(const std::vector<KeyframeFit>& keys, const std::vector<char>& use, Pose T,
             const std::vector<float>& gates_m, int& iterations) {
@@ -259,8 +262,12 @@ Pose refine(const std::vector<KeyframeFit>& keys, const std::vector<char>& use, 
       // direction does not feel it.
       Eigen::Matrix<double, 6, 6> H = eq.H;
       H.diagonal().array() += 1e-9 * H.trace();
-      const Eigen::Matrix<double, 6, 1> xi = H.ldlt().solve(-eq.g);
+      Eigen::Matrix<double, 6, 1> xi = H.ldlt().solve(-eq.g);
       if (!xi.allFinite()) return T;
+      // A trust region: far from the answer, with few points inside the gate, a full step can
+      // overshoot into a place with none; at most 2 degrees and 5 cm a step.
+      const double shrink = std::max({1.0, xi.head<3>().norm() / kMaxStepRad, xi.tail<3>().norm() / kMaxStepM});
+      xi /= shrink;
       T = apply_camera_step(T, xi);
       ++iterations;
       if (xi.head<3>().norm() < 1e-6 && xi.tail<3>().norm() < 1e-6) break;
@@ -322,7 +329,7 @@ CameraCalibration calibrate_camera(const ArmSamples& samples, const Pose& T_base
     size_t best_inliers = 0;
     for (const Pose& start : {T_base_camera_told, out.T_base_camera_coarse}) {
       int iterations = 0;
-      const Pose fitted = refine(keys, every, start, {0.2F, 0.1F, 0.05F, gate}, iterations);
+      const Pose fitted = refine(keys, every, start, {0.4F, 0.2F, 0.1F, 0.05F, gate}, iterations);
       const size_t inliers = accumulate(keys, every, fitted, gate).inliers;
       out.iterations += iterations;
       if (inliers > best_inliers) {
