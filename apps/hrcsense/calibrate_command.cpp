@@ -133,10 +133,11 @@ int calibrate_command(const CommandArgs& args) {
     if (++new_keyframes < kCheckEveryKeyframes) continue;
     new_keyframes = 0;
     if (samples.take_background_changes() > settled_changes) continue;
-    const CameraCalibration fit = calibrate_camera(samples, last && last->ok ? last->T_base_camera : T_told);
-    spdlog::info("calibrate: frame {}, {} keyframes: {} (residual {:.1f} mm, spread {:.2f} mm / {:.3f} deg)",
+    // The progress fits skip the spread; the final one below computes it.
+    const CameraCalibration fit = calibrate_camera(samples, last && last->ok ? last->T_base_camera : T_told, false);
+    spdlog::info("calibrate: frame {}, {} keyframes: {} (residual {:.1f} mm over {} arm samples in {} poses)",
                  frame.index, samples.keyframes().size(), fit.ok ? "fitted" : "not yet: " + fit.problem,
-                 fit.residual_rms_m * 1000.0, fit.sigma_translation_m * 1000.0, fit.sigma_rotation_deg);
+                 fit.residual_rms_m * 1000.0, fit.inliers, fit.poses);
     converged = fit.ok && last && last->ok &&
                 translation_between_m(fit.T_base_camera, last->T_base_camera) < kConvergedTranslationM &&
                 rotation_between_deg(fit.T_base_camera, last->T_base_camera) < kConvergedRotationDeg;
@@ -148,8 +149,9 @@ int calibrate_command(const CommandArgs& args) {
   if (without_joints > 0) {
     spdlog::warn("calibrate: {} of {} frames had no joint state and were not used", without_joints, frames);
   }
-  // Not converged: one last fit over everything read.
-  const CameraCalibration fit = converged ? *last : calibrate_camera(samples, T_told);
+  // The final fit over everything read, with its spread: from the converged pose, or from the
+  // told one when the source ended first.
+  const CameraCalibration fit = calibrate_camera(samples, converged ? last->T_base_camera : T_told);
   if (!fit.ok) {
     return report_error("calibrate: refused after " + std::to_string(frames) + " frames: " + fit.problem +
                             "; nothing written to " + args.out,

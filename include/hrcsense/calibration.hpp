@@ -64,11 +64,12 @@ struct ArmKeyframe {
   int64_t frame_index = 0;
   JointAngles q_rad{};
   /// The median valid depth of the 5×5 pixels about each sample (0: fewer than half valid):
-  /// the point's depth. grid_width × grid_height, row-major.
+  /// what the candidate test compares with the background (its noise about a fifth of a
+  /// pixel's). grid_width × grid_height, row-major.
   std::vector<uint16_t> depth_grid;
-  /// The mean valid depth of the same pixels: the background and the candidate test compare
-  /// these, whose noise is a fifth of a pixel's.
-  std::vector<uint16_t> mean_grid;
+  /// Which pixel of the patch holds that median, (du + 2) + 5 (dv + 2): the point is deprojected
+  /// there, a real pixel at its own depth.
+  std::vector<uint8_t> median_at;
 };
 
 /// What the sweep showed: the farthest depth per grid sample and the keyframes.
@@ -99,6 +100,8 @@ class ArmSamples {
   int64_t take_background_changes();
   /// The candidate margin (raw depth units) against a farthest mean of `farthest_raw`.
   int margin_raw(uint16_t farthest_raw) const;
+  /// `sigmas` times one pixel's stereo depth noise at `depth_raw` (raw units).
+  int noise_raw(uint16_t depth_raw, double sigmas) const;
 
  private:
   CalibrationParams params_;
@@ -116,8 +119,8 @@ class ArmSamples {
   std::vector<Eigen::Vector3d> last_key_origins_base_;
 };
 
-/// The arm candidates of one keyframe: camera-frame points (at the median depth) of the grid
-/// samples whose 5×5 mean and median both stand nearer than the farthest mean by margin_raw.
+/// The arm candidates of one keyframe: for the grid samples whose 5×5 median stands nearer than
+/// the farthest mean by margin_raw, the camera-frame point of the pixel holding that median.
 std::vector<Eigen::Vector3f> arm_candidates(const ArmSamples& samples, const ArmKeyframe& keyframe);
 
 /// Signed distance (m) from `point_base` to the surface of the nearest of `shapes` (negative
@@ -144,8 +147,9 @@ struct CameraCalibration {
 };
 
 /// Fits the camera pose to the samples, starting from `T_base_camera_told` (the configured
-/// pose), and checks it against the refusal limits of the params.
-CameraCalibration calibrate_camera(const ArmSamples& samples, const Pose& T_base_camera_told);
+/// pose), and checks it against the refusal limits of the params. Without `with_spread` the
+/// jackknife is skipped (sigma_* stay 0 and cannot refuse): the quicker fit of a progress check.
+CameraCalibration calibrate_camera(const ArmSamples& samples, const Pose& T_base_camera_told, bool with_spread = true);
 
 /// The rotation angle (deg) and translation (m) between two poses: how far a calibration is
 /// from another.

@@ -292,7 +292,7 @@ double rotation_between_deg(const Pose& a, const Pose& b) {
 
 double translation_between_m(const Pose& a, const Pose& b) { return (a.translation() - b.translation()).norm(); }
 
-CameraCalibration calibrate_camera(const ArmSamples& samples, const Pose& T_base_camera_told) {
+CameraCalibration calibrate_camera(const ArmSamples& samples, const Pose& T_base_camera_told, bool with_spread) {
   const CalibrationParams& params = samples.params();
   CameraCalibration out;
   out.T_base_camera = T_base_camera_told;
@@ -380,7 +380,9 @@ CameraCalibration calibrate_camera(const ArmSamples& samples, const Pose& T_base
     for (size_t k = 0; k < keys.size(); ++k) {
       if (all[k] && final_eq.inliers_per_key[k] >= min_per_pose) group_of[k] = seen++ % groups;
     }
-    if (seen >= groups) {
+    if (!with_spread) {
+      // Only the fit: the spread and its refusal are left to the final call.
+    } else if (seen >= groups) {
       std::vector<Eigen::Matrix<double, 6, 1>> thetas;
       for (int g = 0; g < groups; ++g) {
         std::vector<char> use(keys.size(), 0);
