@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // The camera calibration (`hrcsense calibrate`, issue H3 part 1) on config/cell-ur5-moving.yaml
 // (the D435 at 848x480 with its noise, the arm's pick-and-place sweep):
-//   Calibration/add_frame/848x480  one frame into the samples: the 5×5 mean and median at every
-//                                  grid sample, the farthest depth, the keyframe test
+//   Calibration/add_frame/848x480/keyframe  one frame into the samples as a keyframe: the 5×5
+//                                  mean and median at every grid sample, the farthest depth
+//   Calibration/add_frame/848x480/held  the same frame when it is no keyframe (the arm held):
+//                                  the means and the farthest depth only
 //   Calibration/fit/200_frames     the whole fit (coarse alignment, robust refinement, the
 //                                  keyframes left out, the jackknife's spread) over the samples of
 //                                  the first 200 frames, from a told pose 0.2 m and 15 degrees off
@@ -34,25 +36,27 @@ CalibrationBenchCell calibration_bench_cell() {
   return cell;
 }
 
+// One frame into the samples; state.range(0): 1 when every frame is a keyframe (the patch
+// medians too), 0 when the arm holds still (the means and the farthest depth only).
 void BM_CalibrationAddFrame(benchmark::State& state) {
   const CalibrationBenchCell cell = calibration_bench_cell();
+  const bool keyframes = state.range(0) != 0;
+  CalibrationParams params = cell.config.calibration;
+  params.keyframe_motion_m = keyframes ? 0.0 : 1e9;
+  params.max_keyframes = 64;  // bounded memory over long runs (every second one dropped when full)
   std::vector<Frame> frames(30);
   for (size_t i = 0; i < frames.size(); ++i) cell.sim.render(static_cast<int64_t>(i), frames[i]);
-  ArmSamples samples(cell.config.calibration, cell.sim.intrinsics(), *cell.config.pipeline.robot.arm, BaseFrame::base);
+  ArmSamples samples(params, cell.sim.intrinsics(), *cell.config.pipeline.robot.arm, BaseFrame::base);
+  const JointAngles q = cell.sim.arm_joints(0).q_rad;
   int64_t index = 0;
   for (auto _ : state) {
     const Frame& frame = frames[static_cast<size_t>(index) % frames.size()];
-    benchmark::DoNotOptimize(samples.add(index, frame.depth, cell.sim.arm_joints(index % 30).q_rad));
+    benchmark::DoNotOptimize(samples.add(index, frame.depth, q));
     ++index;
-    if (samples.keyframes().size() > 200) {  // bounded memory over long runs
-      state.PauseTiming();
-      samples = ArmSamples(cell.config.calibration, cell.sim.intrinsics(), *cell.config.pipeline.robot.arm,
-                           BaseFrame::base);
-      state.ResumeTiming();
-    }
   }
 }
-BENCHMARK(BM_CalibrationAddFrame)->Name("Calibration/add_frame/848x480")->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_CalibrationAddFrame)->Name("Calibration/add_frame/848x480/keyframe")->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_CalibrationAddFrame)->Name("Calibration/add_frame/848x480/held")->Arg(0)->Unit(benchmark::kMicrosecond);
 
 void BM_CalibrationFit(benchmark::State& state) {
   const CalibrationBenchCell cell = calibration_bench_cell();

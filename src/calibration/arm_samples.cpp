@@ -34,30 +34,46 @@ struct PatchDepth {
   uint16_t median = 0;
   uint8_t median_at = 0;  ///< the median pixel: (du + 2) + 5 (dv + 2)
 };
-PatchDepth patch_depth(const DepthImage& depth, int u, int v) {
-  constexpr int kHalf = 2;
-  constexpr int kSide = 2 * kHalf + 1;
-  std::array<uint32_t, kSide * kSide> valid{};  // depth << 8 | pixel in the patch
+constexpr int kPatchHalf = 2;
+constexpr int kPatchSide = 2 * kPatchHalf + 1;
+
+// The patch's valid depths, each as depth << 8 | its pixel in the patch; returns how many, and
+// the count of the patch's pixels inside the image in `inside` and their sum in `sum`.
+size_t patch_values(const DepthImage& depth, int u, int v, std::array<uint32_t, kPatchSide * kPatchSide>& values,
+                    int& inside, uint32_t& sum) {
   size_t n = 0;
-  int inside = 0;
-  uint32_t sum = 0;
-  for (int dv = -kHalf; dv <= kHalf; ++dv) {
-    for (int du = -kHalf; du <= kHalf; ++du) {
+  inside = 0;
+  sum = 0;
+  for (int dv = -kPatchHalf; dv <= kPatchHalf; ++dv) {
+    const int y = v + dv;
+    if (y < 0 || y >= depth.height) continue;
+    for (int du = -kPatchHalf; du <= kPatchHalf; ++du) {
       const int x = u + du;
-      const int y = v + dv;
-      if (x < 0 || y < 0 || x >= depth.width || y >= depth.height) continue;
+      if (x < 0 || x >= depth.width) continue;
       ++inside;
       const uint16_t d = depth.at(x, y);
       if (d == 0) continue;
-      valid[n++] = static_cast<uint32_t>(d) << 8 | static_cast<uint32_t>((du + kHalf) + kSide * (dv + kHalf));
+      values[n++] = static_cast<uint32_t>(d) << 8 |
+                    static_cast<uint32_t>((du + kPatchHalf) + kPatchSide * (dv + kPatchHalf));
       sum += d;
     }
   }
+  return n;
+}
+
+// The mean always (the background's statistic); the median and its pixel only when `median`
+// (a keyframe's): the selection is most of a frame's cost.
+PatchDepth patch_depth(const DepthImage& depth, int u, int v, bool median) {
+  std::array<uint32_t, kPatchSide * kPatchSide> values{};
+  int inside = 0;
+  uint32_t sum = 0;
+  const size_t n = patch_values(depth, u, v, values, inside, sum);
   PatchDepth out;
   if (n == 0 || 2 * static_cast<int>(n) < inside) return out;
   out.mean = static_cast<uint16_t>((sum + static_cast<uint32_t>(n) / 2) / static_cast<uint32_t>(n));
-  const auto middle = valid.begin() + static_cast<std::ptrdiff_t>(n / 2);
-  std::nth_element(valid.begin(), middle, valid.begin() + static_cast<std::ptrdiff_t>(n));
+  if (!median) return out;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(n / 2);
+  std::nth_element(values.begin(), middle, values.begin() + static_cast<std::ptrdiff_t>(n));
   out.median = static_cast<uint16_t>(*middle >> 8);
   out.median_at = static_cast<uint8_t>(*middle & 0xFFU);
   return out;
@@ -88,31 +104,32 @@ bool ArmSamples::add(int64_t frame_index, const DepthImage& depth, const JointAn
   ++frames_;
   depth_scale_m_ = depth.depth_scale_m;
   baseline_mm_ = stereo_baseline_mm > 0.0F ? stereo_baseline_mm : kD435BaselineMm;
-  const int step = params_.grid_px;
-  std::vector<uint16_t> grid(farthest_.size());
-  std::vector<uint8_t> grid_at(farthest_.size());
-  for (int gy = 0; gy < grid_height_; ++gy) {
-    for (int gx = 0; gx < grid_width_; ++gx) {
-      const size_t i = static_cast<size_t>(gy) * static_cast<size_t>(grid_width_) + static_cast<size_t>(gx);
-      const int u = grid_pixel(gx, step);
-      const int v = grid_pixel(gy, step);
-      const PatchDepth patch = patch_depth(depth, u, v);
-      grid[i] = patch.median;
-      grid_at[i] = patch.median_at;
-      const uint16_t mean = patch.mean;
-      if (mean > farthest_[i]) {
-        if (farthest_[i] != 0 && mean - farthest_[i] > margin_raw(farthest_[i])) ++background_changes_;
-        farthest_[i] = mean;
-      }
-    }
-  }
+  // A keyframe when some link origin or the flange moved far enough since the last one.
   std::vector<Eigen::Vector3d> origins;
   link_origins(arm_, q_rad, origins);
   double moved_m = keyframes_.empty() ? params_.keyframe_motion_m : 0.0;
   for (size_t i = 0; i < origins.size() && i < last_key_origins_base_.size(); ++i) {
     moved_m = std::max(moved_m, (origins[i] - last_key_origins_base_[i]).norm());
   }
-  if (moved_m < params_.keyframe_motion_m) return false;
+  const bool keyframe = moved_m >= params_.keyframe_motion_m;
+  const int step = params_.grid_px;
+  std::vector<uint16_t> grid(keyframe ? farthest_.size() : 0);
+  std::vector<uint8_t> grid_at(keyframe ? farthest_.size() : 0);
+  for (int gy = 0; gy < grid_height_; ++gy) {
+    for (int gx = 0; gx < grid_width_; ++gx) {
+      const size_t i = static_cast<size_t>(gy) * static_cast<size_t>(grid_width_) + static_cast<size_t>(gx);
+      const PatchDepth patch = patch_depth(depth, grid_pixel(gx, step), grid_pixel(gy, step), keyframe);
+      if (keyframe) {
+        grid[i] = patch.median;
+        grid_at[i] = patch.median_at;
+      }
+      if (patch.mean > farthest_[i]) {
+        if (farthest_[i] != 0 && patch.mean - farthest_[i] > margin_raw(farthest_[i])) ++background_changes_;
+        farthest_[i] = patch.mean;
+      }
+    }
+  }
+  if (!keyframe) return false;
   last_key_origins_base_ = origins;
   if (static_cast<int>(keyframes_.size()) >= std::max(2, params_.max_keyframes)) {
     // Full: every second keyframe goes, so that those kept still span the whole sweep.
