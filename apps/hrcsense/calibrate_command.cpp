@@ -8,15 +8,14 @@
 #include "common/app_errors.hpp"
 #include "common/cell.hpp"
 #include "common/record_setup.hpp"
+#include "common/stop_signals.hpp"
 
 #include "hrcsense/calibration.hpp"
 #include "hrcsense/config/config.hpp"
 
 #include <spdlog/spdlog.h>
 
-#include <atomic>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -25,13 +24,6 @@
 
 namespace hrcsense::app {
 namespace {
-
-std::atomic<bool> g_calibrate_stop{false};
-
-extern "C" void on_calibrate_stop(int signal) {
-  g_calibrate_stop.store(true);
-  std::signal(signal, SIG_DFL);  // a second one kills
-}
 
 // A fit is tried after this many new keyframes (about 1.5 s of a sweep at 30 frames/s)...
 constexpr int kCheckEveryKeyframes = 40;
@@ -91,7 +83,7 @@ int calibrate_command(const CommandArgs& args) {
   options.measure = false;
   options.unpaced = true;
   options.follow_link = false;
-  options.stop_requested = &g_calibrate_stop;
+  options.stop_requested = &StopSignals::flag();
   const std::unique_ptr<Cell> cell = assemble_cell(config, options);
   Source& source = *cell->source;
   const SourceInfo info = source.info();
@@ -104,8 +96,7 @@ int calibrate_command(const CommandArgs& args) {
                info.type, info.intrinsics.width, info.intrinsics.height,
                robot_state_origin_name(cell->robot_states->origin()));
 
-  g_calibrate_stop.store(false);
-  for (int signal : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal, on_calibrate_stop);
+  std::optional<StopSignals> signals(std::in_place);
   Frame frame;
   int64_t frames = 0;
   int64_t without_joints = 0;
@@ -115,7 +106,7 @@ int calibrate_command(const CommandArgs& args) {
   bool converged = false;
   const auto settled_changes =
       static_cast<int64_t>(kSettledBackgroundShare * static_cast<double>(samples.farthest().size()));
-  while (!g_calibrate_stop.load() && (args.frames < 0 || frames < args.frames)) {
+  while (!StopSignals::stop_requested() && (args.frames < 0 || frames < args.frames)) {
     const Source::Status status = source.next(frame);
     if (status == Source::Status::end) break;
     if (status == Source::Status::idle) continue;
@@ -144,7 +135,7 @@ int calibrate_command(const CommandArgs& args) {
     last = fit;
     if (converged) break;
   }
-  for (int signal : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal, SIG_DFL);
+  signals.reset();
   if (!source_error.empty()) spdlog::warn("calibrate: the source ended with an error: {}", source_error);
   if (without_joints > 0) {
     spdlog::warn("calibrate: {} of {} frames had no joint state and were not used", without_joints, frames);

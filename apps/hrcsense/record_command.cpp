@@ -5,6 +5,7 @@
 #include "common/app_errors.hpp"
 #include "common/cell.hpp"
 #include "common/record_setup.hpp"
+#include "common/stop_signals.hpp"
 
 #include "hrcsense/config/config.hpp"
 #include "hrcsense/recordings/recorder.hpp"
@@ -13,19 +14,11 @@
 
 #include <atomic>
 #include <cmath>
-#include <csignal>
 #include <filesystem>
 #include <optional>
 
 namespace hrcsense::app {
 namespace {
-
-std::atomic<bool> g_record_stop{false};
-
-extern "C" void on_record_stop(int signal) {
-  g_record_stop.store(true);
-  std::signal(signal, SIG_DFL);  // a second one kills
-}
 
 // How long push_wait gives the writer before a frame counts as dropped: a disk that stalls
 // this long is failing anyway.
@@ -39,7 +32,7 @@ int record_command(const CommandArgs& args) {
   check_record_output(config, args.out, args.overwrite);
   CellOptions options;
   options.measure = false;
-  options.stop_requested = &g_record_stop;
+  options.stop_requested = &StopSignals::flag();
   options.with_color = true;  // a recording keeps what the source has: a folder's or bag's colour frames too
   const std::unique_ptr<Cell> cell = assemble_cell(config, options);
   Source& source = *cell->source;
@@ -50,14 +43,13 @@ int record_command(const CommandArgs& args) {
   const RecordStateLookup lookup = record_state_lookup(config, source, *cell->robot_states, false, recorder_states);
   Recorder recorder(recorder_params(config, args.out, info));
 
-  g_record_stop.store(false);
-  for (int signal : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal, on_record_stop);
+  std::optional<StopSignals> signals(std::in_place);
   Frame frame;
   int64_t frames = 0;
   int64_t first_ns = 0;
   std::string source_error;
   const auto duration_ns = static_cast<int64_t>(args.duration_s * 1e9);
-  while (!g_record_stop.load() && (args.frames < 0 || frames < args.frames) && !recorder.failed()) {
+  while (!StopSignals::stop_requested() && (args.frames < 0 || frames < args.frames) && !recorder.failed()) {
     const Source::Status status = source.next(frame);
     if (status == Source::Status::end) break;
     if (status == Source::Status::error) {
@@ -77,7 +69,7 @@ int record_command(const CommandArgs& args) {
     recorder.push_wait(frame, kRecordWaitMs, robot_state_for_recording(frame, lookup));
     ++frames;
   }
-  for (int signal : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal, SIG_DFL);
+  signals.reset();
   const RecorderStats stats = recorder.close();
   log_recording(stats);
   if (!stats.error.empty()) return report_error("recording: " + stats.error, kExitRuntime);
