@@ -2,8 +2,8 @@
 // hrcsense CLI — `hrcsense calibrate --config FILE --out POSE.yaml`: the camera's pose from the
 // arm's own depth while it sweeps the workspace (docs/CALIBRATION.md). Reads the configured
 // source and its joint states as `hrcsense record` does (live, a recording with joint states,
-// the simulator), fits every check_every keyframes once the background has settled, and stops
-// when two fits in a row agree or the source ends.
+// the simulator), fits every kCheckEveryKeyframes keyframes once the background has settled,
+// and stops when two fits in a row agree or the source ends.
 #include "commands.hpp"
 #include "common/app_errors.hpp"
 #include "common/cell.hpp"
@@ -15,6 +15,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -25,7 +26,7 @@
 namespace hrcsense::app {
 namespace {
 
-// A fit is tried after this many new keyframes (about 1.5 s of a sweep at 30 frames/s)...
+// A fit is tried after this many new keyframes (a new one each 2 cm of arm motion: 0.8 m)...
 constexpr int kCheckEveryKeyframes = 40;
 // ...once fewer than this share of the grid's samples found a farther background since the
 // last try (the sweep is still uncovering the background behind the arm's first poses).
@@ -135,8 +136,13 @@ int calibrate_command(const CommandArgs& args) {
     last = fit;
     if (converged) break;
   }
+  const bool stopped_by_signal = StopSignals::stop_requested();
   signals.reset();
-  if (!source_error.empty()) spdlog::warn("calibrate: the source ended with an error: {}", source_error);
+  if (!source_error.empty()) {
+    // A source that failed before the arm was seen leaves nothing to fit: its error is the answer.
+    if (samples.keyframes().empty()) return report_error("calibrate: " + source_error, kExitRuntime);
+    spdlog::warn("calibrate: the source ended with an error: {}", source_error);
+  }
   if (without_joints > 0) {
     spdlog::warn("calibrate: {} of {} frames had no joint state and were not used", without_joints, frames);
   }
@@ -149,11 +155,21 @@ int calibrate_command(const CommandArgs& args) {
                         kExitRuntime);
   }
   write_pose(args.out, where, fit, samples);
+  std::string ended = "source ended";
+  if (converged) {
+    ended = "converged";
+  } else if (stopped_by_signal) {
+    ended = "stopped by a signal";
+  } else if (args.frames >= 0 && frames >= args.frames) {
+    ended = "--frames reached";
+  } else if (!source_error.empty()) {
+    ended = "source failed";
+  }
   const Eigen::Vector3d t = fit.T_base_camera.translation();
   const Eigen::Vector3d rpy = rpy_deg(fit.T_base_camera);
   std::printf("camera pose written to %s (%s after %lld frames): residual %.1f mm RMS over %zu arm samples in %d "
               "poses, spread %.2f mm and %.3f deg; %.1f mm and %.2f deg from the configured pose\n",
-              args.out.c_str(), converged ? "converged" : "source ended", static_cast<long long>(frames),
+              args.out.c_str(), ended.c_str(), static_cast<long long>(frames),
               fit.residual_rms_m * 1000.0, fit.inliers, fit.poses, fit.sigma_translation_m * 1000.0,
               fit.sigma_rotation_deg, translation_between_m(fit.T_base_camera, T_told) * 1000.0,
               rotation_between_deg(fit.T_base_camera, T_told));

@@ -3,19 +3,20 @@
 // docs/CALIBRATION.md). The arm is the calibration target: its joints say where each of its
 // visual shapes is in the base frame, the depth image says where the camera sees it.
 //
-//   ArmSamples samples(params, intrinsics, robot);
-//   for each frame with its joints: samples.add(frame.depth, q_rad);   // keyframes, farthest depth
-//   CameraCalibration fit = calibrate_camera(params, samples, T_base_camera_told);
+//   ArmSamples samples(params, intrinsics, arm, base_frame);
+//   for each frame with its joints: samples.add(index, frame.depth, q_rad);  // keyframes, farthest depth
+//   CameraCalibration fit = calibrate_camera(samples, T_base_camera_told);
 //
-// 1. The background is the farthest depth each pixel saw over the sweep: the arm only ever
-//    makes a pixel nearer, so a pixel nearer than it by candidate_margin_m shows the arm (or
-//    something else that moved: a person, the robust fit's outliers).
+// 1. The background is the farthest depth each grid sample's 5×5 patch saw over the sweep: the
+//    arm only ever makes a pixel nearer, so a patch nearer than it by candidate_margin_m shows
+//    the arm (or something else that moved: a person, the robust fit's outliers).
 // 2. A coarse alignment from the told pose (off by up to 0.2 m and 15°): per keyframe, the
-//    centroid of the candidates against the centroid of the arm's surface as the told pose
+//    centroid of the candidates against the centroid of the arm's surface as the current pose
 //    would see it, solved for the rigid motion over the keyframes (Kabsch), a few rounds.
-// 3. A robust point-to-surface refinement over every keyframe: Gauss–Newton on the signed
-//    distance of each candidate to its frame's visual shapes, with a shrinking gate and Huber
-//    weights, the pose's update in the camera frame.
+// 3. A robust point-to-surface refinement over every keyframe, from the told pose and from the
+//    coarse one: Gauss–Newton on the signed distance of each candidate to its frame's visual
+//    shapes, with a shrinking gate, Huber weights and a trust region, the pose's update in the
+//    camera frame; keyframes with something else in view are then left out whole.
 // 4. Its spread: a jackknife over groups of keyframes (what the poses disagree on, the
 //    kinematic model's errors included), not the far smaller formal covariance of correlated
 //    pixels.
