@@ -37,7 +37,7 @@ struct CalibrationParams {
   int grid_px = 4;                    ///< one sample per this many pixels in u and v
   /// A sample whose 5×5 mean is nearer than the farthest such mean it saw by more than this (m),
   /// or by 6 σ of that mean's stereo noise where that is more (D435: 1.7 cm at 2 m, 5 cm at
-  /// 3.4 m), is an arm candidate.
+  /// about 3.3 m at 848x480), is an arm candidate.
   float candidate_margin_m = 0.05F;
   /// A frame becomes a keyframe when some link origin or the flange moved this far (m) since
   /// the last keyframe: a held arm adds nothing new.
