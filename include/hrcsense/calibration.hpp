@@ -35,7 +35,7 @@ namespace hrcsense {
 /// How the calibration reads and fits (defaults and why: docs/CALIBRATION.md).
 struct CalibrationParams {
   int grid_px = 4;                    ///< one sample per this many pixels in u and v
-  /// A sample whose 5×5 mean is nearer than the farthest such mean it saw by more than this (m),
+  /// A sample whose 5×5 median is nearer than the farthest 5×5 mean it saw by more than this (m),
   /// or by 6 σ of that mean's stereo noise where that is more (D435: 1.7 cm at 2 m, 5 cm at
   /// about 3.3 m at 848x480), is an arm candidate.
   float candidate_margin_m = 0.05F;
