@@ -12,6 +12,7 @@
 
 #include "hrcsense/calibration.hpp"
 #include "hrcsense/config/config.hpp"
+#include "hrcsense/number_text.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -35,14 +36,9 @@ constexpr double kSettledBackgroundShare = 0.002;
 constexpr double kConvergedTranslationM = 0.0005;
 constexpr double kConvergedRotationDeg = 0.01;
 
-std::string number(double value, int digits) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.*f", digits, value);
-  return text;
-}
-
 std::string vec3_text(const Eigen::Vector3d& v, int digits) {
-  return "[" + number(v.x(), digits) + ", " + number(v.y(), digits) + ", " + number(v.z(), digits) + "]";
+  return "[" + fixed_digits_text(v.x(), digits) + ", " + fixed_digits_text(v.y(), digits) + ", " +
+         fixed_digits_text(v.z(), digits) + "]";
 }
 
 // CONFIG.md's convention, R = Rz(yaw)·Ry(pitch)·Rx(roll), read back from the matrix.
@@ -64,9 +60,9 @@ void write_pose(const std::string& path, const std::string& config_path, const C
       << " arm samples (docs/CALIBRATION.md)\n"
       << "camera:\n  T_base_camera: {translation_m: " << vec3_text(fit.T_base_camera.translation(), 6)
       << ", rotation_rpy_deg: " << vec3_text(rpy_deg(fit.T_base_camera), 5) << "}\n"
-      << "residual_rms_m: " << number(fit.residual_rms_m, 6) << "\n"
-      << "sigma_translation_m: " << number(fit.sigma_translation_m, 6) << "\n"
-      << "sigma_rotation_deg: " << number(fit.sigma_rotation_deg, 5) << "\n";
+      << "residual_rms_m: " << fixed_digits_text(fit.residual_rms_m, 6) << "\n"
+      << "sigma_translation_m: " << fixed_digits_text(fit.sigma_translation_m, 6) << "\n"
+      << "sigma_rotation_deg: " << fixed_digits_text(fit.sigma_rotation_deg, 5) << "\n";
   out.flush();
   if (!out) throw std::runtime_error(path + ": cannot write the calibration");
 }

@@ -18,4 +18,12 @@ inline std::string float_digits_text(double value) {
   return text;
 }
 
+/// `value` with `digits` digits after the point (%.*f): figures for people, and poses written
+/// to a set precision (`hrcsense calibrate`).
+inline std::string fixed_digits_text(double value, int digits) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", digits, value);
+  return text;
+}
+
 }  // namespace hrcsense

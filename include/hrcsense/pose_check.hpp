@@ -64,13 +64,23 @@ bool ray_capsule_depth(const Eigen::Vector3f& ray_camera, const Eigen::Vector3f&
                        const Eigen::Vector3f& b_camera, float radius_m, CapsuleHit& hit);
 
 /// A visual shape in the camera frame and the pixels its projection may cover,
-/// [u0, u1] × [v0, v1] (pose_disagreement's scratch).
+/// [u0, u1] × [v0, v1] (pose_disagreement's scratch; the calibration's predicted arm).
 struct ShapeInCamera {
   Eigen::Vector3f a_camera = Eigen::Vector3f::Zero();
   Eigen::Vector3f b_camera = Eigen::Vector3f::Zero();
   float radius_m = 0.0F;
   int u0 = 0, v0 = 0, u1 = -1, v1 = -1;
 };
+
+/// The visual shapes `visual_base` (base frame) mapped into the camera with `T_base_camera`, each
+/// with the pixels its projection may cover; shapes too near or behind the camera, or outside
+/// the image, are left out. Reuses `shapes` (no allocation once sized).
+void shapes_in_camera(const Intrinsics& intrinsics, const Pose& T_base_camera, const RobotModel& visual_base,
+                      std::vector<ShapeInCamera>& shapes);
+
+/// The nearest entry along `ray_camera` (z = 1) through pixel (u, v) into those of `shapes` that
+/// may cover it; depth 0 when none is hit.
+CapsuleHit nearest_shape_hit(const std::vector<ShapeInCamera>& shapes, int u, int v, const Eigen::Vector3f& ray_camera);
 
 /// Compares `depth` (the pipeline gives the source frame's, before the filters; with its
 /// `intrinsics`: pinhole, distortion ignored, D435 depth has none) with the arm's visual shapes

@@ -3,6 +3,7 @@
 // alignment by keyframe centroids, the robust point-to-surface refinement and its jackknife.
 #include "hrcsense/calibration.hpp"
 
+#include "hrcsense/number_text.hpp"
 #include "hrcsense/pose_check.hpp"
 
 #include <Eigen/Cholesky>
@@ -10,10 +11,7 @@
 #include <Eigen/SVD>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <cstdio>
-#include <limits>
 
 namespace hrcsense {
 namespace {
@@ -57,53 +55,29 @@ size_t predicted_arm(const ArmSamples& samples, const KeyframeFit& key, const Po
                      Eigen::Vector3d& centroid_camera) {
   const Intrinsics& in = samples.intrinsics();
   const int step = samples.params().grid_px;
-  const Eigen::Isometry3f T_camera_base = T_base_camera.inverse().cast<float>();
-  std::vector<std::array<Eigen::Vector3f, 2>> ends;
-  std::vector<float> radii;
-  // The grid cells the shapes may cover: their ends projected, grown by the nearer radius.
-  float u_min = std::numeric_limits<float>::max();
-  float u_max = std::numeric_limits<float>::lowest();
-  float v_min = u_min;
-  float v_max = u_max;
-  for (const Capsule& c : key.shapes_base) {
-    const Eigen::Vector3f a = T_camera_base * c.a;
-    const Eigen::Vector3f b = T_camera_base * c.b;
-    const float z_near = std::min(a.z(), b.z()) - c.radius_m;
-    if (!(z_near > 0.1F)) continue;  // nothing of an arm stands that near a mounted camera
-    ends.push_back({a, b});
-    radii.push_back(c.radius_m);
-    const float grow = c.radius_m * std::max(in.fx, in.fy) / z_near + 1.0F;
-    for (const Eigen::Vector3f& p : {a, b}) {
-      const float u = in.fx * p.x() / p.z() + in.ppx;
-      const float v = in.fy * p.y() / p.z() + in.ppy;
-      u_min = std::min(u_min, u - grow);
-      u_max = std::max(u_max, u + grow);
-      v_min = std::min(v_min, v - grow);
-      v_max = std::max(v_max, v + grow);
-    }
-  }
+  std::vector<ShapeInCamera> shapes;
+  shapes_in_camera(in, T_base_camera, RobotModel{key.shapes_base}, shapes);
   centroid_camera.setZero();
-  if (ends.empty()) return 0;
-  const auto cell = [&](float pixel, int cells) {
-    return std::clamp(static_cast<int>(std::floor(pixel / static_cast<float>(step))), 0, cells - 1);
-  };
-  const int gx0 = cell(u_min, samples.grid_width());
-  const int gx1 = cell(u_max, samples.grid_width());
-  const int gy0 = cell(v_min, samples.grid_height());
-  const int gy1 = cell(v_max, samples.grid_height());
+  if (shapes.empty()) return 0;
+  int u_min = in.width;
+  int u_max = -1;
+  int v_min = in.height;
+  int v_max = -1;
+  for (const ShapeInCamera& s : shapes) {
+    u_min = std::min(u_min, s.u0);
+    u_max = std::max(u_max, s.u1);
+    v_min = std::min(v_min, s.v0);
+    v_max = std::max(v_max, s.v1);
+  }
+  const auto cell = [step](int pixel, int cells) { return std::clamp(pixel / step, 0, cells - 1); };
   const float scale = samples.depth_scale_m();
   size_t count = 0;
-  for (int gy = gy0; gy <= gy1; ++gy) {
-    for (int gx = gx0; gx <= gx1; ++gx) {
-      const float u = static_cast<float>(gx * step + step / 2);
-      const float v = static_cast<float>(gy * step + step / 2);
-      const Eigen::Vector3f ray((u - in.ppx) / in.fx, (v - in.ppy) / in.fy, 1.0F);
-      float nearest_m = 0.0F;
-      for (size_t s = 0; s < ends.size(); ++s) {
-        CapsuleHit hit;
-        if (!ray_capsule_depth(ray, ends[s][0], ends[s][1], radii[s], hit)) continue;
-        if (nearest_m == 0.0F || hit.depth_m < nearest_m) nearest_m = hit.depth_m;
-      }
+  for (int gy = cell(v_min, samples.grid_height()); gy <= cell(v_max, samples.grid_height()); ++gy) {
+    for (int gx = cell(u_min, samples.grid_width()); gx <= cell(u_max, samples.grid_width()); ++gx) {
+      const int u = gx * step + step / 2;
+      const int v = gy * step + step / 2;
+      const Eigen::Vector3f ray((static_cast<float>(u) - in.ppx) / in.fx, (static_cast<float>(v) - in.ppy) / in.fy, 1.0F);
+      const float nearest_m = nearest_shape_hit(shapes, u, v, ray).depth_m;
       if (nearest_m == 0.0F) continue;
       const uint16_t farthest =
           samples.farthest()[static_cast<size_t>(gy) * static_cast<size_t>(samples.grid_width()) + static_cast<size_t>(gx)];
@@ -278,12 +252,6 @@ Pose refine(const std::vector<KeyframeFit>& keys, const std::vector<char>& use, 
 
 const char* axis_name(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
 
-std::string fixed(double value, int digits) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.*f", digits, value);
-  return text;
-}
-
 }  // namespace
 
 double rotation_between_deg(const Pose& a, const Pose& b) {
@@ -409,11 +377,11 @@ CameraCalibration calibrate_camera(const ArmSamples& samples, const Pose& T_base
         out.problem = "the poses do not pin the camera down: its " +
                       (out.sigma_rotation_deg > params.max_sigma_rotation_deg
                            ? "rotation about its " + std::string(axis_name(worst_rotation)) + " axis varies by " +
-                                 fixed(out.sigma_rotation_deg, 3) + " deg (at most " +
-                                 fixed(params.max_sigma_rotation_deg, 3) + ")"
+                                 fixed_digits_text(out.sigma_rotation_deg, 3) + " deg (at most " +
+                                 fixed_digits_text(params.max_sigma_rotation_deg, 3) + ")"
                            : "position along its " + std::string(axis_name(worst_translation)) + " axis varies by " +
-                                 fixed(out.sigma_translation_m * 1000.0, 2) + " mm (at most " +
-                                 fixed(params.max_sigma_translation_m * 1000.0, 2) + ")") +
+                                 fixed_digits_text(out.sigma_translation_m * 1000.0, 2) + " mm (at most " +
+                                 fixed_digits_text(params.max_sigma_translation_m * 1000.0, 2) + ")") +
                       " between groups of poses; sweep the arm through more of the workspace, in depth and across "
                       "the image" + sweep_hint;
       }
@@ -432,12 +400,12 @@ CameraCalibration calibrate_camera(const ArmSamples& samples, const Pose& T_base
                   sweep_hint;
   } else if (out.inliers < static_cast<size_t>(params.min_arm_samples)) {
     out.problem = "only " + std::to_string(out.inliers) + " arm samples lie within " +
-                  fixed(params.inlier_gate_m * 1000.0, 0) + " mm of the arm's shapes (at least " +
+                  fixed_digits_text(params.inlier_gate_m * 1000.0, 0) + " mm of the arm's shapes (at least " +
                   std::to_string(params.min_arm_samples) + " needed): bring the arm nearer the camera or into view" +
                   sweep_hint;
   } else if (out.residual_rms_m > params.max_residual_rms_m) {
-    out.problem = "the arm's pixels lie " + fixed(out.residual_rms_m * 1000.0, 1) +
-                  " mm RMS from its shapes (at most " + fixed(params.max_residual_rms_m * 1000.0, 1) +
+    out.problem = "the arm's pixels lie " + fixed_digits_text(out.residual_rms_m * 1000.0, 1) +
+                  " mm RMS from its shapes (at most " + fixed_digits_text(params.max_residual_rms_m * 1000.0, 1) +
                   " mm): a wrong robot.model or base_frame, a tool or dress pack that is not described, or a told "
                   "pose beyond the coarse alignment's reach (0.2 m, 15 deg)";
   }

@@ -49,20 +49,6 @@ void project_bounds(const Intrinsics& in, ShapeInCamera& s) {
 
 int round_up_to(int value, int step) { return (value + step - 1) / step * step; }
 
-// The nearest entry along `ray` into the shapes that may cover pixel (u, v); depth 0 when none
-// is hit.
-CapsuleHit nearest_hit(const std::vector<ShapeInCamera>& shapes, int u, int v, const Eigen::Vector3f& ray) {
-  CapsuleHit nearest;
-  nearest.depth_m = 0.0F;
-  for (const ShapeInCamera& s : shapes) {
-    if (u < s.u0 || u > s.u1 || v < s.v0 || v > s.v1) continue;
-    CapsuleHit hit;
-    if (!ray_capsule_depth(ray, s.a_camera, s.b_camera, s.radius_m, hit)) continue;
-    if (nearest.depth_m == 0.0F || hit.depth_m < nearest.depth_m) nearest = hit;
-  }
-  return nearest;
-}
-
 // The mean valid depth (m) in the square of half-size `half_px` about (u, v), 0 when fewer than
 // half of its pixels are valid: the single pixel's stereo noise averaged down without reaching
 // across the arm's edge.
@@ -129,14 +115,8 @@ bool ray_capsule_depth(const Eigen::Vector3f& ray, const Eigen::Vector3f& a, con
   return true;
 }
 
-PoseDisagreement pose_disagreement(const PoseCheckParams& params, const DepthImage& depth,
-                                   const Intrinsics& intrinsics, const Pose& T_base_camera,
-                                   const RobotModel& visual_base, std::vector<ShapeInCamera>& shapes) {
-  PoseDisagreement out;
-  if (depth.width != intrinsics.width || depth.height != intrinsics.height || !(intrinsics.fx > 0.0F) ||
-      !(intrinsics.fy > 0.0F)) {
-    return out;
-  }
+void shapes_in_camera(const Intrinsics& intrinsics, const Pose& T_base_camera, const RobotModel& visual_base,
+                      std::vector<ShapeInCamera>& shapes) {
   const Eigen::Isometry3f T_camera_base = T_base_camera.inverse().cast<float>();
   shapes.clear();  // keeps its capacity
   for (const Capsule& c : visual_base.capsules) {
@@ -147,6 +127,29 @@ PoseDisagreement pose_disagreement(const PoseCheckParams& params, const DepthIma
     project_bounds(intrinsics, s);
     if (s.u1 >= s.u0 && s.v1 >= s.v0) shapes.push_back(s);
   }
+}
+
+CapsuleHit nearest_shape_hit(const std::vector<ShapeInCamera>& shapes, int u, int v, const Eigen::Vector3f& ray) {
+  CapsuleHit nearest;
+  nearest.depth_m = 0.0F;
+  for (const ShapeInCamera& s : shapes) {
+    if (u < s.u0 || u > s.u1 || v < s.v0 || v > s.v1) continue;
+    CapsuleHit hit;
+    if (!ray_capsule_depth(ray, s.a_camera, s.b_camera, s.radius_m, hit)) continue;
+    if (nearest.depth_m == 0.0F || hit.depth_m < nearest.depth_m) nearest = hit;
+  }
+  return nearest;
+}
+
+PoseDisagreement pose_disagreement(const PoseCheckParams& params, const DepthImage& depth,
+                                   const Intrinsics& intrinsics, const Pose& T_base_camera,
+                                   const RobotModel& visual_base, std::vector<ShapeInCamera>& shapes) {
+  PoseDisagreement out;
+  if (depth.width != intrinsics.width || depth.height != intrinsics.height || !(intrinsics.fx > 0.0F) ||
+      !(intrinsics.fy > 0.0F)) {
+    return out;
+  }
+  shapes_in_camera(intrinsics, T_base_camera, visual_base, shapes);
   int u_min = intrinsics.width;
   int u_max = -1;
   int v_min = intrinsics.height;
@@ -168,7 +171,7 @@ PoseDisagreement pose_disagreement(const PoseCheckParams& params, const DepthIma
       if (row[u] == 0) continue;  // no depth: nothing to compare
       const Eigen::Vector3f ray((static_cast<float>(u) - intrinsics.ppx) * inv_fx,
                                 (static_cast<float>(v) - intrinsics.ppy) * inv_fy, 1.0F);
-      const CapsuleHit nearest = nearest_hit(shapes, u, v, ray);
+      const CapsuleHit nearest = nearest_shape_hit(shapes, u, v, ray);
       if (nearest.depth_m == 0.0F || nearest.axis_share > params.core_share) continue;
       const float measured_m = patch_mean_m(depth, u, v, params.patch_px);
       if (!(measured_m > 0.0F)) continue;
