@@ -274,6 +274,10 @@ enum class ReasonCode : uint16_t {
   /// stop: the background learnt at start holds something nearer than background.reference
   /// within S_p at rest (zones: safety.slow_distance_m) of the robot; learning goes on
   background_not_empty = 31,
+  /// stop (fused cells): a camera's newest valid measurement is older than
+  /// safety.max_frame_gap_periods of its periods, or its session changed and no valid
+  /// measurement of the new one came yet (verdict_reason names the camera)
+  camera_stale = 32,
   /// stop: the arm's measured pixels disagree with its visual shapes seen from
   /// camera.T_base_camera (safety.pose_check_threshold_m): the told camera pose is wrong
   camera_pose_mismatch = 33,
@@ -291,6 +295,30 @@ struct Verdict {
 struct StageTiming {
   const char* stage = "";  ///< static name, e.g. "background", "foreground", "proximity"
   double us = 0.0;    ///< microseconds
+};
+
+/// The seen-free grid of a cell with several cameras (seen_free_grid.hpp), one bit per cube: bit i % 8 of bytes[i / 8] is cube i. 1: seen free this frame.
+struct SeenFreeGrid {
+  std::vector<uint8_t> bytes;
+  size_t cells = 0;
+  bool test(size_t i) const { return (bytes[i >> 3] >> (i & 7)) & 1U; }
+  void set(size_t i) { bytes[i >> 3] = static_cast<uint8_t>(bytes[i >> 3] | (1U << (i & 7))); }
+  /// `cells` cubes, none free.
+  void reset(size_t cell_count) {
+    cells = cell_count;
+    bytes.assign((cell_count + 7) / 8, 0);
+  }
+};
+
+/// One camera of a fused cell as a fused frame reports it (`cameras` in the JSON Lines).
+struct CameraStatus {
+  std::string name;
+  /// The fused instant's time less the capture of the camera's newest measurement, ms; NaN
+  /// when none came.
+  double age_ms = std::numeric_limits<double>::quiet_NaN();
+  bool valid = false;             ///< its newest measurement could be decided on
+  ReasonCode reason_code = ReasonCode::no_frame;  ///< clear when valid, else why not
+  uint32_t session = 0;           ///< its session; 0 before the first measurement
 };
 
 /// One robot link's closest foreground point and what the decision needs of it
@@ -349,6 +377,14 @@ struct Measurement {
   /// The proximity backend that searched this frame (static name, e.g. "octree" when `auto`
   /// picked it); null when no search ran.
   const char* backend = nullptr;
+  /// A camera of a cell with several (`hrcsense run --camera`): the cubes of the shared grid it
+  /// saw free; cells 0 when no grid is configured. Fused (`hrcsense fuse`): the union.
+  SeenFreeGrid seen_free;
+  /// Fused cells only: each configured camera's state at this instant (`cameras`) and the
+  /// name of the camera that measured the governing contact (`closest_camera_name`; empty:
+  /// no contact). Empty for a single camera's measurement.
+  std::vector<CameraStatus> cameras;
+  std::string closest_camera_name;
   /// Static text when the frame's source timestamp was out of order (backwards, repeated, a
   /// gap or a jump; RunSummary::timestamps counts them); null when in order.
   const char* timestamp_warning = nullptr;

@@ -279,6 +279,7 @@ const char* reason_code_name(ReasonCode code) {
     case ReasonCode::speed_limited: return "speed_limited";
     case ReasonCode::holding: return "holding";
     case ReasonCode::background_not_empty: return "background_not_empty";
+    case ReasonCode::camera_stale: return "camera_stale";
     case ReasonCode::camera_pose_mismatch: return "camera_pose_mismatch";
   }
   return "unknown";

@@ -8,8 +8,10 @@
 #include "hrcsense/pipeline_params.hpp"
 #include "hrcsense/robot.hpp"
 #include "hrcsense/robot_state_history.hpp"
+#include "hrcsense/seen_free_grid.hpp"
 #include "hrcsense/sim/sim.hpp"
 
+#include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -195,6 +197,26 @@ struct LinkConfig {
   bool rtde_slider_unguarded_ok = false;
 };
 
+/// One entry of the scene's `cameras:` list (H2, docs/MULTICAMERA.md): a camera of a cell with
+/// several. `hrcsense run --camera NAME` measures with the entry's keys laid over the top-level
+/// ones; the fuser reads the list for the names it accepts, their poses and rates.
+struct CameraEntry {
+  std::string name;                       ///< `name`: a ROS name token ([A-Za-z][A-Za-z0-9_]*)
+  Pose T_base_camera = Pose::Identity();  ///< `T_base_camera`: where the camera is told it is
+  double fps = 30.0;                      ///< `fps`: its nominal rate (the stale rule's period)
+  SourceType source_type = SourceType::sim;  ///< its `source.type` (the top-level one unless it says)
+  /// The depth intrinsics where the configuration alone fixes them (simulated cameras); unset
+  /// for cameras, which report theirs with each measurement.
+  std::optional<Intrinsics> intrinsics;
+};
+
+/// `cell.*`: what every process of a cell with several cameras shares.
+struct CellConfig {
+  /// `cell.workspace_base` (default `foreground.workspace_base`'s box) and `cell.voxel_m`
+  /// (0.05 m); enabled when the configuration has `cameras:`.
+  SeenFreeGridSpec grid;
+};
+
 struct Config {
   std::string file;                ///< where it was read from ("" for defaults only)
   SourceConfig source;
@@ -225,6 +247,16 @@ struct Config {
   Ros2Config ros2;                       ///< `ros2.*`
   LinkConfig link;                       ///< `link.*`
   CalibrationParams calibration;         ///< `calibration.*`: `hrcsense calibrate` (docs/CALIBRATION.md)
+  /// `cameras:`: the cell's cameras (empty: a cell of one camera, the top-level keys).
+  std::vector<CameraEntry> cameras;
+  /// `--camera NAME`: the entry this configuration was loaded for (its keys laid over the
+  /// top-level ones); empty: none.
+  std::string camera;
+  CellConfig cell;                       ///< `cell.*`
+  /// `sim.epoch`: the shared scene clock's frame 0, CLOCK_REALTIME ns (frame i is due at
+  /// epoch + i / fps); unset: a simulated camera of a cell takes it from `<ns>/cell_clock`,
+  /// any other simulated run starts at frame 0 when it starts.
+  std::optional<int64_t> sim_epoch_ns;
   std::string canonical_yaml;      ///< the effective configuration, for the hash in the header
   /// What a person starting the run must hear about this configuration (e.g. ssm without the
   /// robot's stopping data); logged as warnings at the start, one line each.
@@ -237,7 +269,10 @@ inline constexpr double kCameraLatencyS = 0.033;
 
 /// Reads `path` (may be empty: defaults only) and applies `overrides` ("key.sub=value",
 /// value in YAML syntax) in order. Throws ConfigError naming file and key.
-Config load_config(const std::string& path, const std::vector<std::string>& overrides);
+/// `camera` non-empty: the `cameras:` entry of that name is laid over the top-level keys
+/// (docs/MULTICAMERA.md); an unknown name is a ConfigError listing the entries.
+Config load_config(const std::string& path, const std::vector<std::string>& overrides,
+                   const std::string& camera = {});
 
 /// Reads a robot description file (docs/ROBOT.md); throws ConfigError naming the file and the
 /// field, e.g. "arm.yaml: key 'links.forearm[1].radius_m': expected a number >= 0".
