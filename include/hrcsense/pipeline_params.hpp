@@ -11,6 +11,7 @@
 #include "hrcsense/proximity.hpp"
 #include "hrcsense/robot.hpp"
 #include "hrcsense/safety.hpp"
+#include "hrcsense/seen_free_grid.hpp"
 #include "hrcsense/segmentation.hpp"
 #include "hrcsense/self_filter.hpp"
 #include "hrcsense/types.hpp"
@@ -34,6 +35,9 @@ struct PipelineParams {
   PoseCheckParams pose_check;  ///< the told camera pose against the arm, every frame (arms only)
   ProximityBackend backend = ProximityBackend::brute;  ///< `proximity.backend`
   ProximityParams proximity;  ///< octree height, brute threads
+  /// A camera of a cell with several (`hrcsense run --camera`): the shared grid whose cubes it
+  /// marks seen free each frame (Measurement::seen_free); disabled otherwise.
+  SeenFreeGridSpec seen_free_grid;
 };
 
 /// What may change while the cell runs, between two frames (hrcsense-view's panels): the
