@@ -206,28 +206,33 @@ TEST(CellFusion, AGridOfAnotherSizeIsRejected) {
 TEST(CellFusion, InSsmAFartherButLessCertainContactGovernsItsLink) {
   FusionParams params;
   params.safety.mode = SafetyParams::Mode::ssm;
-  CellFusion fusion({{"front", 30.0}, {"left", 30.0}}, params);
-  // Link 4: front at 1.00 m with Z_d 0.05 m, left at 1.02 m with Z_d 0.30 m; the arm moves
-  // towards both at 0.5 m/s. S_p differs only by Z_d, so left's d − S_p is 0.23 m smaller.
-  fusion.add(measured("front", kT0, {link_at(4, 1.00F, 0.05F, 0.5F)}), kT0);
-  fusion.add(measured("left", kT0, {link_at(4, 1.02F, 0.30F, 0.5F)}), kT0);
-  Measurement out;
-  fusion.fuse(kT0, 1, kT0, out);
-  ASSERT_TRUE(out.valid);
-  ASSERT_EQ(out.links.size(), 1U);
-  EXPECT_FLOAT_EQ(out.links[0].contact.distance_m, 1.02F);
-  EXPECT_FLOAT_EQ(out.links[0].distance_uncertainty_m, 0.30F);
-  EXPECT_EQ(fusion.camera_of_link(4), "left");
-  // The fused decision is the stricter of the two cameras' own.
-  Decision fused, front_alone, left_alone;
-  decide_measurement(params.safety, out, 0.0, 1.0, fused);
-  Measurement one = out;
-  one.links = {link_at(4, 1.00F, 0.05F, 0.5F)};
-  decide_measurement(params.safety, one, 0.0, 1.0, front_alone);
-  one.links = {link_at(4, 1.02F, 0.30F, 0.5F)};
-  decide_measurement(params.safety, one, 0.0, 1.0, left_alone);
-  EXPECT_LT(left_alone.verdict.speed_scale, front_alone.verdict.speed_scale);
-  EXPECT_FLOAT_EQ(fused.verdict.speed_scale, left_alone.verdict.speed_scale);
+  // Link 4: front at d with Z_d 0.05 m, left at d + 0.02 m with Z_d 0.30 m; the arm moves towards
+  // both at 0.5 m/s. S_p differs only by Z_d, so left's d − S_p is 0.23 m smaller at every d;
+  // where that changes the speed scale, left's contact must govern.
+  bool compared = false;
+  for (float d = 1.0F; d < 5.0F && !compared; d += 0.25F) {
+    CellFusion fusion({{"front", 30.0}, {"left", 30.0}}, params);
+    fusion.add(measured("front", kT0, {link_at(4, d, 0.05F, 0.5F)}), kT0);
+    fusion.add(measured("left", kT0, {link_at(4, d + 0.02F, 0.30F, 0.5F)}), kT0);
+    Measurement out;
+    fusion.fuse(kT0, 1, kT0, out);
+    ASSERT_TRUE(out.valid);
+    ASSERT_EQ(out.links.size(), 1U);
+    EXPECT_FLOAT_EQ(out.links[0].contact.distance_m, d + 0.02F) << "at d = " << d;
+    EXPECT_FLOAT_EQ(out.links[0].distance_uncertainty_m, 0.30F);
+    EXPECT_EQ(fusion.camera_of_link(4), "left");
+    // The fused decision is the stricter of the two cameras' own.
+    Decision fused, front_alone, left_alone;
+    decide_measurement(params.safety, out, 0.0, 1.0, fused);
+    Measurement one = out;
+    one.links = {link_at(4, d, 0.05F, 0.5F)};
+    decide_measurement(params.safety, one, 0.0, 1.0, front_alone);
+    one.links = {link_at(4, d + 0.02F, 0.30F, 0.5F)};
+    decide_measurement(params.safety, one, 0.0, 1.0, left_alone);
+    EXPECT_FLOAT_EQ(fused.verdict.speed_scale, left_alone.verdict.speed_scale);
+    compared = left_alone.verdict.speed_scale < front_alone.verdict.speed_scale;
+  }
+  EXPECT_TRUE(compared) << "no distance in 1-5 m where the two contacts' speed scales differ";
 }
 
 TEST(CellFusion, WithoutGridsTheUnknownDistanceIsTheLargestOfTheCamerasOwn) {
