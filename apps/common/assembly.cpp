@@ -62,6 +62,7 @@ Simulator make_simulator(const Config& config, std::shared_ptr<TrajectoryClock> 
   // The true pose renders; the pipeline keeps the one it is told (they differ only on request).
   simulator.T_base_camera = config.sim_camera_T_base_camera.value_or(config.pipeline.T_base_camera);
   simulator.camera_knock = config.sim_camera_knock;
+  simulator.params.epoch_ns = config.sim_epoch_ns;  // the shared scene clock (sim.epoch)
   simulator.robot = fixed_robot_model(config);
   if (config.robot_state.trajectory) {
     // A moving arm: rendered at each frame's time with its own label (robot.trajectory).
@@ -219,6 +220,7 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
     params.seed = config.sim.seed;  // source.seed
     params.history = robot_state_history_params(config);
     params.clock = std::move(trajectory_clock);
+    params.epoch_ns = config.sim_epoch_ns;  // the frames' host times are on the scene clock then
     return std::make_unique<SimRobotState>(*config.robot_state.trajectory, params);
   }
   // Arrival times on the run's clock: the steady clock, run_pipeline's default (RunOptions::clock
