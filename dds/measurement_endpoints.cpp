@@ -72,14 +72,16 @@ void MeasurementSink::frame(const FrameResult& result) {
   to_camera_measurement(result, realtime_minus_steady_ns(), out_);
   if (!result.source_frame) {
     // The run's own stop with no new frame (its watchdog, or its end): the fuser hears why at
-    // once, stamped now, instead of waiting for the stale rule.
+    // once instead of waiting for the stale rule. It is stamped just after the last frame sent,
+    // so that a frame captured before the watchdog fired but delivered after it still counts.
     out_.valid = false;
     out_.reason_code = result.verdict.code;
     out_.reason = result.verdict.reason;
-    out_.capture_ns = std::max(out_.capture_ns + 1, shared_clock_ns());
+    out_.capture_ns = last_capture_ns_ > 0 ? last_capture_ns_ + 1 : shared_clock_ns();
     out_.links.clear();
     out_.contact = Contact{};
   }
+  last_capture_ns_ = out_.capture_ns;
   ++out_.sequence;
   const hrcsense_msgs_msg_dds__Measurement_ msg = measurement_message(out_, params_.base_frame, buffers_);
   const dds_return_t ret = dds_write(dds_->writer, &msg);

@@ -63,6 +63,7 @@ class MeasurementSink final : public Sink {
   std::unique_ptr<Dds> dds_;
   CameraMeasurement out_;
   MeasurementBuffers buffers_;
+  int64_t last_capture_ns_ = 0;  ///< the capture of the last measurement sent
   int64_t written_ = 0;
   int64_t failed_writes_ = 0;
   int failed_in_a_row_ = 0;

@@ -135,7 +135,7 @@ void put_header_cameras(Members& m, const std::vector<RunHeader::Camera>& camera
     put_double(line, t.y());
     line += ',';
     put_double(line, t.z());
-    line += "],";
+    line += ']';
     put_key(line, "quaternion_xyzw");
     line += '[';
     put_double(line, q.x());

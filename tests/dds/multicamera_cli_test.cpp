@@ -27,7 +27,8 @@ namespace {
 using nlohmann::json;
 using test::ChildProcess;
 
-// Two cameras of the moving UR5 cell, 424x240 at 30 frames/s, 30 learning frames.
+// Two cameras of the moving UR5 cell, 424x240 at 30 frames/s; the arm swings 0.6 rad and back in
+// 1 s, so that the 30 learning frames see a whole cycle.
 constexpr const char* kTwoCameraCell = R"(
 source: {type: sim, seed: 1}
 sim: {width: 424, height: 240, fps: 30, frames: 100000, noise: true, color: false}
@@ -62,8 +63,8 @@ robot:
     loop: true
     waypoints:
       - {t_s: 0.0, joints_rad: [-2.741593, -1.0, 1.6, -2.1708, -1.5708, 0.0]}
-      - {t_s: 1.35, joints_rad: [-4.511593, -1.0, 1.6, -2.1708, -1.5708, 0.0]}
-      - {t_s: 2.7, joints_rad: [-2.741593, -1.0, 1.6, -2.1708, -1.5708, 0.0]}
+      - {t_s: 0.5, joints_rad: [-3.341593, -1.0, 1.6, -2.1708, -1.5708, 0.0]}
+      - {t_s: 1.0, joints_rad: [-2.741593, -1.0, 1.6, -2.1708, -1.5708, 0.0]}
 safety: {mode: zones}
 )";
 
@@ -105,7 +106,7 @@ TEST(MultiCameraCell, TheCellCommandRunsBothCamerasAndTheFuserAndEndsWithThem) {
   if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
   const Cell cell = make_cell("cell");
   const std::string out = (cell.dir / "fused.jsonl").string();
-  ChildProcess run({HRCSENSE_CLI, "cell", "--config", cell.config, "--set", cell.domain_set, "--frames", "90", "--out", out});
+  ChildProcess run({HRCSENSE_CLI, "cell", "--config", cell.config, "--set", cell.domain_set, "--frames", "120", "--out", out});
   EXPECT_EQ(exit_code(run.wait(60.0)), 0);
   const std::vector<json> lines = read_lines(out);
   ASSERT_GE(lines.size(), 3U);
@@ -120,18 +121,20 @@ TEST(MultiCameraCell, TheCellCommandRunsBothCamerasAndTheFuserAndEndsWithThem) {
     ASSERT_EQ(line["cameras"].size(), 2U);
     if (line["verdict"] == "run") ++run_frames;
   }
-  // 90 frames each, 30 learning: most of the last 60 instants fuse to run (nobody in the cell).
-  EXPECT_GE(run_frames, 30) << out;
+  // 120 frames each, 30 learning: many of the last 90 instants fuse to run (nobody in the cell;
+  // the others are slow for the stereo noise near the arm).
+  EXPECT_GE(run_frames, 20) << out;
   const json& summary = lines.back();
   ASSERT_EQ(summary["type"], "summary");
   EXPECT_EQ(summary["end_reason_code"], "source_ended");
   ASSERT_EQ(summary["cameras"].size(), 2U);
-  EXPECT_GE(summary["cameras"][1]["accepted"].get<int>(), 60);
+  EXPECT_GE(summary["cameras"][1]["accepted"].get<int>(), 90);
+  EXPECT_EQ(summary["cameras"][1]["out_of_order"], 0);
   EXPECT_EQ(summary["cameras"][1]["malformed"], 0);
   // Each camera's own run beside the fused output: what it alone would have decided.
   for (const char* camera : {"front", "left"}) {
     const std::vector<json> own = read_lines(cell.dir / (std::string("fused.") + camera + ".jsonl"));
-    ASSERT_GE(own.size(), 90U) << camera;
+    ASSERT_GE(own.size(), 120U) << camera;
     EXPECT_EQ(own.front()["type"], "header");
   }
   std::filesystem::remove_all(cell.dir);
