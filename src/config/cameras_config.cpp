@@ -120,7 +120,7 @@ void check_camera_entries(const YAML::Node& root, const std::string& where, cons
   std::vector<std::string> names;
   for (size_t i = 0; i < list.size(); ++i) {
     const std::string key = entry_key(i);
-    const YAML::Node entry = list[i];
+    const YAML::Node entry = camera_entry(root, i);
     tree.only_keys(entry, key, {"name", "T_base_camera", "fps", "source", "sim"});
     const YAML::Node name_node = tree.required(entry, key, "name");
     const std::string name = name_node.IsScalar() ? name_node.Scalar() : std::string();
