@@ -81,6 +81,10 @@ void MeasurementSink::frame(const FrameResult& result) {
     out_.links.clear();
     out_.contact = Contact{};
   }
+  // What the fuser's added latency is measured against: this camera's capture to its publication.
+  if (result.source_frame) {
+    out_.latency_us = std::max(out_.latency_us, static_cast<double>(shared_clock_ns() - out_.capture_ns) * 1e-3);
+  }
   last_capture_ns_ = out_.capture_ns;
   ++out_.sequence;
   const hrcsense_msgs_msg_dds__Measurement_ msg = measurement_message(out_, params_.base_frame, buffers_);

@@ -48,7 +48,8 @@ struct CameraMeasurement {
   /// The robot state the capsules were built from (its sample time on the shared clock).
   RobotState robot_state;
   double robot_state_age_ms = 0.0;
-  /// Processing time, frame in to measurement out, µs (the fused latency's camera part).
+  /// The frame's capture to the measurement's publication, µs (MeasurementSink; processing alone
+  /// for a measurement not yet sent): the fused latency's camera part.
   double latency_us = 0.0;
   /// Simulated cameras: the truth for this camera's pixels (GroundTruth::contact, ::links).
   std::optional<Contact> truth;
@@ -166,6 +167,7 @@ class CellFusion {
   std::vector<int> link_ids_;     ///< per out.links entry: its link
   int contact_camera_ = -1;
   RobotModel robot_model_;           ///< scratch: the capsules at the fused state
+  std::vector<float> block_bounds_m_;  ///< scratch of unknown_cells_distance_m
   std::string empty_;
 };
 

@@ -99,8 +99,13 @@ void unite(SeenFreeGrid& into, const SeenFreeGrid& other);
 /// centre, m. Cubes whose centre lies inside a capsule are the robot's own volume and left out;
 /// 0 only for a centre on a capsule's surface. NaN when no cube is left (every cube free, or
 /// inside the robot), when the robot has no capsules, or when `union_bits` has another cell
-/// count than the spec. Exact: blocks of 4×4×4 cubes are visited in order of a lower bound
-/// and the search stops when the best found is below the next block's bound.
+/// count than the spec. Exact: each block of 4×4×4 cubes with an unknown cube gets a lower bound
+/// once (kept in `block_bounds_m`, reused between calls: no allocation once sized), the block
+/// with the lowest is measured first, and then only the blocks whose bound is below the best
+/// found so far.
+float unknown_cells_distance_m(const SeenFreeGridSpec& spec, const SeenFreeGrid& union_bits, const RobotModel& robot,
+                               std::vector<float>& block_bounds_m);
+/// The same with a buffer of its own (allocates each call).
 float unknown_cells_distance_m(const SeenFreeGridSpec& spec, const SeenFreeGrid& union_bits, const RobotModel& robot);
 
 }  // namespace hrcsense

@@ -247,26 +247,32 @@ void CellFusion::fuse(int64_t instant_ns, int64_t frame, int64_t now_ns, Measure
     const double allowed_ms = params_.safety.max_frame_gap_periods / fps * 1e3;
     char text[192] = {};
     ReasonCode code = ReasonCode::clear;
+    const double newest_age_ms = slot.have ? static_cast<double>(now_ns - slot.newest.capture_ns) / kNsPerMs : 0.0;
+    const double valid_age_ms =
+        slot.have_valid ? static_cast<double>(now_ns - slot.newest_valid_capture_ns) / kNsPerMs : 0.0;
     if (!slot.have) {
       code = ReasonCode::camera_stale;
       std::snprintf(text, sizeof text, "camera '%s': no measurement yet", status.name.c_str());
-    } else if (!slot.have_valid && slot.restarted) {
+    } else if (newest_age_ms > allowed_ms) {
+      // Silent: whatever it said last is no longer news.
       code = ReasonCode::camera_stale;
-      std::snprintf(text, sizeof text, "camera '%s': restarted (session %08x after %08x), no valid measurement yet",
-                    status.name.c_str(), slot.newest.session, slot.previous_session);
-    } else if (!slot.have_valid) {
-      code = slot.newest.reason_code;
-      std::snprintf(text, sizeof text, "camera '%s': %s", status.name.c_str(),
-                    slot.newest.reason.empty() ? reason_code_name(code) : slot.newest.reason.c_str());
-    } else if (const double valid_age_ms = static_cast<double>(now_ns - slot.newest_valid_capture_ns) / kNsPerMs;
-               valid_age_ms > allowed_ms) {
-      code = ReasonCode::camera_stale;
-      std::snprintf(text, sizeof text, "camera '%s': newest valid measurement %.0f ms old (max_frame_gap_periods %g at %g frames/s)",
-                    status.name.c_str(), valid_age_ms, params_.safety.max_frame_gap_periods, fps);
+      std::snprintf(text, sizeof text, "camera '%s': no measurement for %.0f ms (max_frame_gap_periods %g at %g frames/s)",
+                    status.name.c_str(), newest_age_ms, params_.safety.max_frame_gap_periods, fps);
     } else if (!slot.newest.valid) {
-      code = slot.newest.reason_code;
-      std::snprintf(text, sizeof text, "camera '%s': %s", status.name.c_str(),
-                    slot.newest.reason.empty() ? reason_code_name(code) : slot.newest.reason.c_str());
+      // Its own stop, at once and with its own code (the camera knows why better than a
+      // timeout); a restarted camera is stale until its new session's first valid measurement.
+      const char* why = slot.newest.reason.empty() ? reason_code_name(slot.newest.reason_code) : slot.newest.reason.c_str();
+      if (slot.restarted) {
+        code = ReasonCode::camera_stale;
+        std::snprintf(text, sizeof text, "camera '%s': restarted (session %08x after %08x), no valid measurement yet: %s",
+                      status.name.c_str(), slot.newest.session, slot.previous_session, why);
+      } else {
+        code = slot.newest.reason_code;
+        std::snprintf(text, sizeof text, "camera '%s': %s", status.name.c_str(), why);
+      }
+    } else if (!slot.have_valid || valid_age_ms > allowed_ms) {
+      code = ReasonCode::camera_stale;  // not reached: a valid newest is the newest valid
+      std::snprintf(text, sizeof text, "camera '%s': no valid measurement", status.name.c_str());
     }
     status.reason_code = code;
     if (code == ReasonCode::clear) continue;
@@ -365,7 +371,7 @@ void CellFusion::fuse(int64_t instant_ns, int64_t frame, int64_t now_ns, Measure
     seen = slots_[0].newest.seen_free;
     for (size_t i = 1; i < cameras_.size(); ++i) unite(seen, slots_[i].newest.seen_free);
     robot_model_at(params_.robot, base.robot_state.q_rad, robot_model_);
-    out.unknown_distance_m = unknown_cells_distance_m(params_.grid, seen, robot_model_);
+    out.unknown_distance_m = unknown_cells_distance_m(params_.grid, seen, robot_model_, block_bounds_m_);
   } else {
     // Without every camera's grid: the largest per-ray distance. Space unknown to the cell is
     // unknown to every camera, so its distance is at least each camera's: this never says more

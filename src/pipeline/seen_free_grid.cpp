@@ -290,7 +290,8 @@ void unite(SeenFreeGrid& into, const SeenFreeGrid& other) {
 // Two passes over the blocks with an unknown cube, so that nothing is allocated: the first
 // measures the block with the lowest bound (usually holding the answer or near it), the second
 // measures every block whose bound is below the best found so far.
-float unknown_cells_distance_m(const SeenFreeGridSpec& spec, const SeenFreeGrid& union_bits, const RobotModel& robot) {
+float unknown_cells_distance_m(const SeenFreeGridSpec& spec, const SeenFreeGrid& union_bits, const RobotModel& robot,
+                               std::vector<float>& block_bounds_m) {
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
   const size_t cells = spec.cell_count();
   if (cells == 0 || robot.capsules.empty() || union_bits.cells != cells ||
@@ -301,33 +302,42 @@ float unknown_cells_distance_m(const SeenFreeGridSpec& spec, const SeenFreeGrid&
   // Every cube centre of a block lies within this of the middle of its centres.
   const float radius_m = 0.5F * static_cast<float>(seen_free::kBlock - 1) * std::sqrt(3.0F) * spec.voxel_m;
   const auto for_each_block = [&](auto&& visit) {
+    size_t index = 0;
     for (int z = 0; z < n.z(); z += seen_free::kBlock) {
       for (int y = 0; y < n.y(); y += seen_free::kBlock) {
-        for (int x = 0; x < n.x(); x += seen_free::kBlock) {
-          const seen_free::Block block = seen_free::block_at(spec, n, union_bits, Eigen::Vector3i(x, y, z));
-          if (block.unknown != 0) visit(block);
-        }
+        for (int x = 0; x < n.x(); x += seen_free::kBlock) visit(index++, Eigen::Vector3i(x, y, z));
       }
     }
   };
+  // One pass for every block's bound (+inf: no unknown cube in it), one to measure the blocks
+  // that can still hold a nearer cube.
+  const Eigen::Vector3i blocks = (n.array() + seen_free::kBlock - 1) / seen_free::kBlock;
+  block_bounds_m.resize(static_cast<size_t>(blocks.prod()));
   float lowest_bound_m = std::numeric_limits<float>::infinity();
   Eigen::Vector3i lowest_first(-1, -1, -1);
-  for_each_block([&](const seen_free::Block& block) {
-    const float bound_m = seen_free::robot_block_bound(block, robot, radius_m);
+  for_each_block([&](size_t index, const Eigen::Vector3i& first) {
+    const seen_free::Block block = seen_free::block_at(spec, n, union_bits, first);
+    float& bound_m = block_bounds_m[index];
+    bound_m = block.unknown != 0 ? seen_free::robot_block_bound(block, robot, radius_m)
+                                 : std::numeric_limits<float>::infinity();
     if (bound_m < lowest_bound_m) {
       lowest_bound_m = bound_m;
-      lowest_first = block.first;
+      lowest_first = first;
     }
   });
   if (lowest_first.x() < 0) return kNaN;  // every cube free
   float best_m = std::numeric_limits<float>::infinity();
   seen_free::measure_block(spec, seen_free::block_at(spec, n, union_bits, lowest_first), robot, radius_m, best_m);
-  for_each_block([&](const seen_free::Block& block) {
-    if (block.first == lowest_first) return;
-    if (seen_free::robot_block_bound(block, robot, radius_m) > best_m + seen_free::kBoundSlack_m) return;
-    seen_free::measure_block(spec, block, robot, radius_m, best_m);
+  for_each_block([&](size_t index, const Eigen::Vector3i& first) {
+    if (first == lowest_first || block_bounds_m[index] > best_m + seen_free::kBoundSlack_m) return;
+    seen_free::measure_block(spec, seen_free::block_at(spec, n, union_bits, first), robot, radius_m, best_m);
   });
   return std::isfinite(best_m) ? best_m : kNaN;
+}
+
+float unknown_cells_distance_m(const SeenFreeGridSpec& spec, const SeenFreeGrid& union_bits, const RobotModel& robot) {
+  std::vector<float> block_bounds_m;
+  return unknown_cells_distance_m(spec, union_bits, robot, block_bounds_m);
 }
 
 }  // namespace hrcsense

@@ -178,6 +178,18 @@ void put_frame_cameras(Members& m, const FrameResult& result) {
   m.text_or_null("closest_camera_name", result.closest_camera_name);
 }
 
+// A camera of a cell with several, and a fused cell: the shared grid's cubes and how many of
+// them no camera saw free this frame (`seen_free`); nothing without a grid.
+void put_seen_free(Members& m, const SeenFreeGrid& grid) {
+  if (grid.cells == 0) return;
+  size_t free_cubes = 0;
+  for (const uint8_t byte : grid.bytes) free_cubes += static_cast<size_t>(__builtin_popcount(byte));
+  m.open("seen_free");
+  m.integer("cubes", static_cast<int64_t>(grid.cells));
+  m.integer("unknown", static_cast<int64_t>(grid.cells - std::min(free_cubes, grid.cells)));
+  m.close();
+}
+
 // `ssm`: S_p's terms (safety.mode ssm, a frame with a contact); null otherwise.
 void put_ssm(Members& m, const std::optional<SsmTerms>& ssm) {
   if (!ssm) {
@@ -392,6 +404,7 @@ void JsonLinesSink::frame(const FrameResult& result) {
   for (const StageTiming& timing : result.timings) m.number(timing.stage, timing.us);
   m.close();
   put_frame_cameras(m, result);
+  put_seen_free(m, result.seen_free);
   const bool labelled = result.truth && result.contact.valid && extras_.contact_label;
   put_truth(m, result, labelled ? extras_.contact_label(result) : nullptr);
   line_ += "}\n";
