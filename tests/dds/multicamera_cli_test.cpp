@@ -3,8 +3,11 @@
 // both and the fuser and ends with them; a camera process killed is a fused stop naming it
 // (camera_stale), and the same camera started again (a new session) brings the cell back to run
 // without restarting the fuser. The scene is small (424x240, a bare UR5 at work, nobody in the
-// cell) so that both cameras keep their rate on two cores. Every wait is bounded.
+// cell) so that both cameras keep their rate on two cores; under the sanitizers they cannot (each
+// process is several times slower), and the tests skip there: the fusion's code runs under them in
+// test_safety's CellFusion tests and in the fuzz target. Every wait is bounded.
 #include "../support/child_process.hpp"
+#include "../support/sanitized.hpp"
 #include "dds_test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -104,6 +107,7 @@ std::string epoch_in(double seconds) {
 
 TEST(MultiCameraCell, TheCellCommandRunsBothCamerasAndTheFuserAndEndsWithThem) {
   if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
+  if (test::kSanitized) GTEST_SKIP() << "two cameras at 30 frames/s and a fuser cannot keep their rate under the sanitizers";
   const Cell cell = make_cell("cell");
   const std::string out = (cell.dir / "fused.jsonl").string();
   ChildProcess run({HRCSENSE_CLI, "cell", "--config", cell.config, "--set", cell.domain_set, "--frames", "120", "--out", out});
@@ -156,6 +160,7 @@ json next_line_where(ChildProcess& fuser, double timeout_s, Wanted wanted) {
 
 TEST(MultiCameraCell, AKilledCameraStopsTheCellByNameAndItsRestartRecoversWithoutTheFuser) {
   if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
+  if (test::kSanitized) GTEST_SKIP() << "two cameras at 30 frames/s and a fuser cannot keep their rate under the sanitizers";
   const Cell cell = make_cell("restart");
   const std::string epoch = epoch_in(1.0);
   ChildProcess fuser({HRCSENSE_CLI, "fuse", "--config", cell.config, "--set", cell.domain_set});
