@@ -11,6 +11,7 @@
 #include "hrcsense/net/udp_json.hpp"
 
 #if HRCSENSE_HAVE_DDS
+#include "dds/measurement_endpoints.hpp"
 #include "dds/ros2_camera_source.hpp"
 #include "dds/ros2_joint_state_source.hpp"
 #include "dds/ros2_outputs.hpp"
@@ -61,6 +62,7 @@ Simulator make_simulator(const Config& config, std::shared_ptr<TrajectoryClock> 
   // The true pose renders; the pipeline keeps the one it is told (they differ only on request).
   simulator.T_base_camera = config.sim_camera_T_base_camera.value_or(config.pipeline.T_base_camera);
   simulator.camera_knock = config.sim_camera_knock;
+  simulator.params.epoch_ns = config.sim_epoch_ns;  // the shared scene clock (sim.epoch)
   simulator.robot = fixed_robot_model(config);
   if (config.robot_state.trajectory) {
     // A moving arm: rendered at each frame's time with its own label (robot.trajectory).
@@ -218,6 +220,7 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
     params.seed = config.sim.seed;  // source.seed
     params.history = robot_state_history_params(config);
     params.clock = std::move(trajectory_clock);
+    params.epoch_ns = config.sim_epoch_ns;  // the frames' host times are on the scene clock then
     return std::make_unique<SimRobotState>(*config.robot_state.trajectory, params);
   }
   // Arrival times on the run's clock: the steady clock, run_pipeline's default (RunOptions::clock
@@ -382,6 +385,32 @@ Ros2Outputs make_ros2_output_sink(const Config& config) {
   return outputs;
 #else
   throw ConfigError(config_where(config) + ": ros2.publish: this hrcsense was built without Cyclone DDS; install "
+                    "cyclonedds-dev and cyclonedds-tools (scripts/setup does) and rebuild");
+#endif
+}
+
+std::unique_ptr<Sink> make_measurement_sink(const Config& config) {
+#if HRCSENSE_HAVE_DDS
+  ros2::MeasurementWriterParams params;
+  params.domain_id = static_cast<uint32_t>(config.ros2.domain_id);
+  params.node_namespace = config.ros2.node_namespace;
+  params.camera_name = config.camera;
+  params.base_frame = ros2::base_frame_id(config.pipeline.robot.base_frame);
+  params.T_base_camera = config.pipeline.T_base_camera;
+  params.max_frame_gap_periods = config.pipeline.safety.max_frame_gap_periods;
+  for (const CameraEntry& entry : config.cameras) {
+    if (entry.name == config.camera) params.nominal_fps = entry.fps;
+  }
+  try {
+    auto sink = std::make_unique<ros2::MeasurementSink>(params);
+    spdlog::info("camera '{}': measurements on {} (domain {}); no verdict is sent from here", config.camera, sink->topic(),
+                 config.ros2.domain_id);
+    return sink;
+  } catch (const ros2::Ros2Error& e) {
+    throw ConfigError(config_where(config) + ": --camera " + config.camera + ": " + e.what());
+  }
+#else
+  throw ConfigError(config_where(config) + ": --camera: this hrcsense was built without Cyclone DDS; install "
                     "cyclonedds-dev and cyclonedds-tools (scripts/setup does) and rebuild");
 #endif
 }

@@ -139,6 +139,11 @@ struct Ros2Outputs {
 /// Empty without ros2.publish; throws ConfigError in a build without Cyclone DDS, saying so.
 Ros2Outputs make_ros2_output_sink(const Config& config);
 
+/// `hrcsense run --camera NAME` (config.camera set): the camera's measurements on
+/// `<ros2.namespace>/measurement/<NAME>` (dds/measurement_endpoints.hpp, docs/MULTICAMERA.md),
+/// with the entry's rate and pose. Throws ConfigError in a build without Cyclone DDS.
+std::unique_ptr<Sink> make_measurement_sink(const Config& config);
+
 /// What an RTDE link did, as one line for the log.
 std::string describe_link_counters(const RtdeLinkSink& link);
 

@@ -135,7 +135,10 @@ std::unique_ptr<Cell> assemble_cell(const Config& config, const CellOptions& opt
   cell->pipeline = std::make_unique<Pipeline>(config.pipeline);
   if (options.background_files) cell->background = start_background(config, info, *cell->pipeline);
   std::function<void(const Frame&, const Pipeline&, const FrameResult&)> ros2_tap;
-  if (options.links) {
+  if (options.links && !config.camera.empty()) {
+    // One camera of several: it measures for the fuser, which alone decides and sends.
+    cell->measurements = make_measurement_sink(config);
+  } else if (options.links) {
     add_links(*cell, config);
     ros2_tap = add_ros2_outputs(*cell, config);
   }

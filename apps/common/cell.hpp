@@ -77,6 +77,9 @@ struct Cell {
   /// (make_ros2_output_sink); its cloud tap is in run_options.on_processed.
   std::unique_ptr<Sink> ros2_outputs;
   std::function<Ros2OutputsStatus()> ros2_status;  ///< what ros2_outputs did (null without it)
+  /// A camera of a cell with several (config.camera): its measurements for the fuser, in place
+  /// of every link and ROS 2 output (make_measurement_sink).
+  std::unique_ptr<Sink> measurements;
   /// Simulated runs: the simulator that labels each result's truth (TruthLabeller).
   std::optional<Simulator> truth;
   RunHeader header;
@@ -89,7 +92,9 @@ struct Cell {
   /// What run_pipeline reads: the recording when there is one, else the source.
   Source& frames() { return recording ? static_cast<Source&>(*recording) : *source; }
   /// The links in the order they get each result: the controller first, then the ROS 2 outputs.
-  std::vector<Sink*> link_sinks() const { return {udp_link.get(), rtde_link.get(), follow.get(), ros2_outputs.get()}; }
+  std::vector<Sink*> link_sinks() const {
+    return {udp_link.get(), rtde_link.get(), follow.get(), ros2_outputs.get(), measurements.get()};
+  }
 };
 
 /// Builds the cell `config` describes. Throws ConfigError for what the configuration gets

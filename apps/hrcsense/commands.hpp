@@ -23,6 +23,7 @@ struct CommandArgs {
   std::string record;               ///< run --record FILE.bag; empty: no recording
   double duration_s = -1.0;         ///< record --duration-s S; < 0: until --frames or the source's end
   bool overwrite = false;           ///< record / run --record: --overwrite replaces an existing recording
+  std::string camera;               ///< run / calibrate --camera NAME: one entry of the scene's cameras:
 };
 
 /// `hrcsense eval`'s flags (docs/EVALUATION.md).
@@ -50,6 +51,10 @@ struct EchoArgs {
 };
 
 int run_command(const CommandArgs& args);
+/// fuse: the decision of a cell with several cameras from their measurements over DDS.
+int fuse_command(const CommandArgs& args);
+/// cell: a cell with several cameras on one host (a `run --camera` per camera and a `fuse`).
+int cell_command(const CommandArgs& args);
 /// echo TOPIC: the samples of one of hrcsense's ROS 2 topics (or /joint_states) as JSON lines.
 int echo_command(const EchoArgs& args);
 /// eval: the thesis's measures over a sweep (results.csv in --out, resumable).

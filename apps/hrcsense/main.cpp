@@ -30,6 +30,8 @@ void add_common_flags(CLI::App& command, CommandArgs& args) {
 // The subcommands in the order `--help` lists them; CLI11's `app` owns them.
 struct Subcommands {
   CLI::App* run = nullptr;
+  CLI::App* fuse = nullptr;
+  CLI::App* cell = nullptr;
   CLI::App* record = nullptr;
   CLI::App* publish = nullptr;
   CLI::App* echo = nullptr;
@@ -48,7 +50,18 @@ CLI::App* add_run_command(CLI::App& app, CommandArgs& args) {
   run->add_option("--out", args.out, "JSON Lines output file (default: stdout)");
   run->add_option("--record", args.record, "also record the source's frames to this RealSense .bag (docs/RECORDINGS.md)");
   run->add_flag("--overwrite", args.overwrite, "with --record: replace an existing recording (never the source itself)");
+  run->add_option("--camera", args.camera,
+                  "measure one camera of the scene's cameras: and publish its measurements for `hrcsense fuse` "
+                  "(docs/MULTICAMERA.md)");
   return run;
+}
+
+// `fuse` and `cell`: a cell with several cameras (docs/MULTICAMERA.md), flags as `run`'s.
+CLI::App* add_fused_command(CLI::App& app, CommandArgs& args, const char* name, const char* help) {
+  CLI::App* command = app.add_subcommand(name, help);
+  add_common_flags(*command, args);
+  command->add_option("--out", args.out, "JSON Lines output file (default: stdout)");
+  return command;
 }
 
 CLI::App* add_record_command(CLI::App& app, CommandArgs& args) {
@@ -103,6 +116,12 @@ Subcommands add_subcommands(CLI::App& app, CommandArgs& args, hrcsense::app::Eva
                             hrcsense::app::EchoArgs& echo_args) {
   Subcommands commands;
   commands.run = add_run_command(app, args);
+  commands.fuse = add_fused_command(app, args, "fuse",
+                                    "decide for a cell with several cameras from their measurements over DDS "
+                                    "(docs/MULTICAMERA.md)");
+  commands.cell = add_fused_command(app, args, "cell",
+                                    "run a cell with several cameras on this host: a measuring process per camera "
+                                    "and the fuser (docs/MULTICAMERA.md)");
   commands.record = add_record_command(app, args);
   commands.publish = app.add_subcommand(
       "publish", "publish the configured source as a realsense-ros camera's ROS 2 topics (docs/CAMERAS.md)");
@@ -133,7 +152,7 @@ Subcommands add_subcommands(CLI::App& app, CommandArgs& args, hrcsense::app::Eva
 
 // CLI11 would only say "a subcommand is required" for a misspelt one; main names it instead.
 bool is_unknown_command(const std::string& first) {
-  return !first.empty() && first[0] != '-' && first != "run" && first != "record" && first != "publish" &&
+  return !first.empty() && first[0] != '-' && first != "run" && first != "fuse" && first != "cell" && first != "record" && first != "publish" &&
          first != "echo" && first != "info" && first != "devices" && first != "bench" && first != "verify-filters" &&
          first != "eval" && first != "teach" && first != "calibrate";
 }
@@ -142,6 +161,8 @@ bool is_unknown_command(const std::string& first) {
 int run_parsed_command(const Subcommands& commands, const CommandArgs& args, const hrcsense::app::EvalArgs& eval_args,
                        const hrcsense::app::EchoArgs& echo_args) {
   if (commands.run->parsed()) return hrcsense::app::run_command(args);
+  if (commands.fuse->parsed()) return hrcsense::app::fuse_command(args);
+  if (commands.cell->parsed()) return hrcsense::app::cell_command(args);
   if (commands.record->parsed()) return hrcsense::app::record_command(args);
   if (commands.publish->parsed()) return hrcsense::app::publish_command(args);
   if (commands.echo->parsed()) return hrcsense::app::echo_command(echo_args);
@@ -170,7 +191,7 @@ int main(int argc, char** argv) {
 
   if (is_unknown_command(argc > 1 ? argv[1] : "")) {
     return hrcsense::app::report_error(std::string("unknown command '") + argv[1] +
-                                           "'; expected run, record, publish, echo, info, teach, calibrate, devices, bench, eval or "
+                                           "'; expected run, fuse, cell, record, publish, echo, info, teach, calibrate, devices, bench, eval or "
                                            "verify-filters",
                                        hrcsense::app::kExitUsage);
   }

@@ -8,7 +8,7 @@
 namespace hrcsense::app {
 
 int run_command(const CommandArgs& args) {
-  const Config config = load_config(args.config_path, args.sets);
+  const Config config = load_config(args.config_path, args.sets, args.camera);
   SessionOptions options;
   options.frames = args.frames;
   options.out = args.out;

@@ -13,6 +13,7 @@
 #include "hrcsense/robot.hpp"
 #include "hrcsense/robot_state.hpp"
 #include "hrcsense/safety.hpp"
+#include "hrcsense/seen_free_grid.hpp"
 #include "hrcsense/segmentation.hpp"
 #include "hrcsense/self_filter.hpp"
 #include "hrcsense/sink.hpp"
@@ -139,6 +140,7 @@ class Pipeline {
   int64_t background_changes_ = 0;
   int64_t reliable_prepared_at_ = -1;
   ReliableBackground reliable_;
+  SeenFreeProjection seen_free_projection_;  ///< the grid's cubes in this camera (seen_free_grid.enabled)
   std::vector<uint32_t> moved_reference_;  ///< moved_reference_pixels of the background in use
   bool moved_reference_ready_ = false;
   // The camera pose check: its window, the arm's visual shapes at the frame's joints and their
@@ -174,6 +176,7 @@ class Pipeline {
   /// Measurement::links and the overall contact.
   void search_links(Measurement& m);
   void find_unknown_space(const Frame& frame, const RobotPixels* robot_pixels, Measurement& m);
+  void mark_seen_free_grid(const Frame& frame, const RobotPixels* robot_pixels, Measurement& m);
   /// v_i and Z_d of every link's contact.
   void measure_links(const Frame& frame, const RobotState& robot_state, Measurement& m);
   PreviousContact& previous_link_contact(int link);

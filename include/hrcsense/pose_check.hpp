@@ -21,9 +21,15 @@ struct PoseCheckParams {
   /// `safety.pose_check`: check the told pose against the arm each frame (arms only; the check
   /// does nothing for robot.model points, which have no body to see).
   bool enabled = true;
-  /// `safety.pose_check_threshold_m`: the mean disagreement over the window above which the
-  /// pose is wrong, m (a sample's disagreement is |measured − predicted| depth, at most cap_m).
-  float threshold_m = 0.0065F;
+  /// `safety.pose_check_threshold_m`: the mean disagreement beyond the stereo noise's own over
+  /// the window above which the pose is wrong, m (a sample's disagreement is |measured −
+  /// predicted| depth, at most cap_m; the noise's share is PoseDisagreement::noise_floor_m).
+  float threshold_m = 0.004F;
+  /// The depth camera's disparity noise, σ in pixels (the D435's subpixel RMS): with the frame's
+  /// stereo baseline it gives each sample's expected |disagreement| from noise alone, which
+  /// grows as z² (a 5×5 mean: 2.7 mm at 2.1 m, 6 mm at 3.2 m) and is taken off before the
+  /// threshold. 0, or a frame without a baseline: no noise is taken off.
+  float noise_px = 0.08F;
   /// `safety.pose_check_min_arm_pixels`: fewer usable samples in a frame: the arm is not in
   /// view and the frame says nothing (neither fires nor clears).
   int min_arm_pixels = 100;
@@ -49,6 +55,9 @@ struct PoseDisagreement {
   size_t samples = 0;          ///< usable samples: valid depth, inside the core, not occluded
   float mean_m = 0.0F;         ///< mean of min(|measured − predicted|, cap_m) over them, m
   float signed_mean_m = 0.0F;  ///< mean of measured − predicted (clamped to ±cap_m), m
+  /// The part of mean_m stereo noise alone gives with the pose right: the mean over the samples
+  /// of E|N(0, σ)| = σ·√(2/π), σ = z²·noise_px / (fx·B) / √(valid pixels of the patch), m.
+  float noise_floor_m = 0.0F;
 };
 
 /// Nearest depth (camera z, m) at which the ray through the camera-frame direction
@@ -86,11 +95,12 @@ CapsuleHit nearest_shape_hit(const std::vector<ShapeInCamera>& shapes, int u, in
 /// `intrinsics`: pinhole, distortion ignored, D435 depth has none) with the arm's visual shapes
 /// `visual_base` (robot_render_capsules at this frame's joints, base frame) seen from
 /// `T_base_camera`. The depth must be of the frame's own moment: an image from the temporal
-/// filter shows a moving arm where it was. `shapes` is scratch, reused (no allocation once
-/// sized).
+/// filter shows a moving arm where it was. `stereo_baseline_m` (0: unknown) sets the noise
+/// floor. `shapes` is scratch, reused (no allocation once sized).
 PoseDisagreement pose_disagreement(const PoseCheckParams& params, const DepthImage& depth,
                                    const Intrinsics& intrinsics, const Pose& T_base_camera,
-                                   const RobotModel& visual_base, std::vector<ShapeInCamera>& shapes);
+                                   const RobotModel& visual_base, std::vector<ShapeInCamera>& shapes,
+                                   float stereo_baseline_m = 0.0F);
 
 /// The decision over frames: a window of the last in-view frames' disagreements. A frame
 /// without the arm in view leaves it as it was.
@@ -99,7 +109,7 @@ struct PoseCheck {
   /// Adds one frame's comparison; returns whether the pose is now judged wrong.
   bool add(const PoseDisagreement& frame);
   bool mismatch() const { return mismatch_; }
-  /// The mean disagreement over the window (m), 0 before the window is full.
+  /// The mean disagreement beyond the noise floor over the window (m), 0 before the window is full.
   float window_mean_m() const { return window_mean_m_; }
   /// Forgets every frame (a new run).
   void reset();

@@ -44,6 +44,15 @@ struct RunHeader {
     std::string note;      ///< e.g. why there is no disparity domain; empty for none
     Intrinsics intrinsics; ///< of the filtered image (background, Contact::pixel)
   } filters;
+  /// A fused cell (`hrcsense fuse`, `hrcsense cell`): each configured camera's name, pose and,
+  /// where known, intrinsics (`cameras` in the header). Empty for a single camera's run.
+  struct Camera {
+    std::string name;
+    Pose T_base_camera = Pose::Identity();
+    double nominal_fps = 0.0;
+    Intrinsics intrinsics;  ///< width 0: not known before the camera reports (written as null)
+  };
+  std::vector<Camera> cameras;
 };
 
 /// Source timestamps out of order, counted over a run (each frame against the one before).
@@ -78,6 +87,19 @@ struct RunSummary {
   RobotStateStats robot_state;    ///< the robot state source's counters
   RobotStatusCounts robot_status; ///< the controller's status over the frames written
   double unknown_background_share = -1.0;  ///< Pipeline::unknown_background_share at the end; < 0: no background
+  /// A fused cell: what came of each camera's measurements (`cameras` in the summary).
+  struct CameraIntake {
+    std::string name;
+    int64_t accepted = 0;
+    int64_t malformed = 0;     ///< unreadable, or values measurement_problem() refuses
+    int64_t out_of_order = 0;
+    int64_t clock_ahead = 0;
+    int64_t grid_mismatch = 0;
+    int64_t name_mismatch = 0; ///< another camera's name on this camera's topic
+    int64_t sessions = 0;
+    std::string last_problem;
+  };
+  std::vector<CameraIntake> cameras;
 };
 
 /// A consumer of results. One of the four virtual interfaces of hrcsense (listed at the top of source.hpp).

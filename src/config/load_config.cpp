@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense config — load_config: the YAML file, then --set overrides, then one typed read
 // per key into the stages' parameter structs (the table is read_all below).
+#include "cameras_config.hpp"
 #include "key_reader.hpp"
 #include "robot_config.hpp"
 #include "yaml_tree.hpp"
@@ -438,6 +439,7 @@ void read_all(KeyReader& r, Config& c) {
   read_record(r, c);
   read_ros2(r, c);
   read_calibration(r, c);
+  config_detail::read_cell(r, c);  // src/config/cameras_config.cpp; after foreground.workspace_base
   config_detail::check_ssm_mode(r, c);  // after every key: it weighs keys of several sections
 }
 
@@ -503,14 +505,9 @@ void apply_override(YAML::Node& root, const std::string& text) {
   config_detail::set_path(root, key, value);
 }
 
-}  // namespace
-
-Config load_config(const std::string& path, const std::vector<std::string>& overrides) {
-  YAML::Node root = load_file(path);
-  for (const std::string& text : overrides) apply_override(root, text);
-  const std::string where = path.empty() ? std::string("<defaults>") : path;
+// The typed read of a whole tree: the unknown-key check, then the table.
+Config read_tree(const YAML::Node& root, const std::string& path, const std::string& where) {
   check_keys(root, "", where);
-
   Config config;
   config.file = path;
   KeyReader reader(root, where);
@@ -524,6 +521,32 @@ Config load_config(const std::string& path, const std::vector<std::string>& over
   emitter << reader.effective();
   config.canonical_yaml = emitter.c_str();
   config.canonical_yaml += '\n';
+  return config;
+}
+
+}  // namespace
+
+Config load_config(const std::string& path, const std::vector<std::string>& overrides, const std::string& camera) {
+  const YAML::Node file = load_file(path);
+  // The file with the overrides: the top-level keys, and the cameras: list the entries come from.
+  YAML::Node root = camera.empty() ? file : YAML::Clone(file);
+  for (const std::string& text : overrides) apply_override(root, text);
+  const std::string where = path.empty() ? std::string("<defaults>") : path;
+  config_detail::check_camera_entries(root, where, known_keys());
+  Config config = read_tree(root, path, where);
+  const auto read_entry = [&](const YAML::Node& tree) { return read_tree(tree, path, where); };
+  std::vector<CameraEntry> cameras = config_detail::read_camera_entries(root, where, read_entry);
+  if (!camera.empty()) {
+    // The entry over the file's keys, then the overrides again, so that a --set wins over the entry.
+    YAML::Node selected = YAML::Clone(file);
+    config_detail::lay_camera_over(selected, root, camera, where);
+    for (const std::string& text : overrides) apply_override(selected, text);
+    config = read_tree(selected, path, where);
+    config.camera = camera;
+    config.pipeline.seen_free_grid = config.cell.grid;
+    config.pipeline.seen_free_grid.enabled = true;
+  }
+  config.cameras = std::move(cameras);
   return config;
 }
 

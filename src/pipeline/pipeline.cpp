@@ -4,6 +4,7 @@
 // Measurement; the verdict is decided later, by the output thread's SafetyMonitor.
 
 #include "hrcsense/pipeline.hpp"
+#include "hrcsense/seen_free_grid.hpp"
 #include "hrcsense/unknown_space.hpp"
 
 #include "pipeline_detail.hpp"
@@ -251,6 +252,7 @@ const BackgroundModel& Pipeline::background() const {
 void Pipeline::process(const Frame& source_frame, const RobotState& robot_state, Measurement& m) {
   const Clock::time_point start = Clock::now();
   begin_measurement(source_frame, robot_state, m);
+  m.seen_free.reset(params_.seen_free_grid.cell_count());  // every cube unknown until marked; 0 cubes when disabled
   const Frame* frame = filter(source_frame, m);
   if (frame != nullptr && !background_ready()) {
     learn(*frame, robot_state, m);
@@ -262,6 +264,7 @@ void Pipeline::process(const Frame& source_frame, const RobotState& robot_state,
     if (envelope_seen(*frame, pixels, m) && extract(*frame, pixels, m)) {
       timed(m, "proximity", [&] { search_links(m); });
       timed(m, "unknown_space", [&] { find_unknown_space(*frame, pixels, m); });
+      if (params_.seen_free_grid.enabled) timed(m, "seen_free_grid", [&] { mark_seen_free_grid(*frame, pixels, m); });
       timed(m, "safety", [&] { measure_links(*frame, robot_state, m); });
       m.valid = true;
     }
@@ -362,6 +365,19 @@ void Pipeline::find_unknown_space(const Frame& frame, const RobotPixels* robot_p
                                              robot_pixels, params_.T_base_camera, robot_,
                                              frame.stereo_baseline_mm * 1e-3F, no_depth_frames_, params);
   m.unknown_distance_m = unknown.distance_m;
+}
+
+// The cubes this camera sees free (docs/SAFETY.md, "Unknown space with several cameras"), with
+// unknown space's inputs; the projection is prepared again only when the pose, the image or
+// the grid changed (its first frame, a live retune).
+void Pipeline::mark_seen_free_grid(const Frame& frame, const RobotPixels* robot_pixels, Measurement& m) {
+  const UnknownSpaceParams params;
+  if (!seen_free_projection_.matches(params_.seen_free_grid, frame.intrinsics, params_.T_base_camera, params.near_m)) {
+    seen_free_projection_ = prepare_seen_free(params_.seen_free_grid, frame.intrinsics, params_.T_base_camera,
+                                              params.near_m);
+  }
+  mark_seen_free(seen_free_projection_, frame.depth, background(), reliable_, foreground_.mask, robot_pixels,
+                 frame.stereo_baseline_mm * 1e-3F, no_depth_frames_, params, m.seen_free);
 }
 
 // Per link: v_i of its closest point towards its contact and Z_d of that contact.

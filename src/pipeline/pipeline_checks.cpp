@@ -131,7 +131,8 @@ bool Pipeline::camera_pose_agrees(const Frame& frame, const RobotState& robot_st
   timed_stage(m, "pose_check", [&] {
     robot_render_capsules(*params_.robot.arm, robot_state.q_rad, params_.robot.base_frame, visual_);
     const PoseDisagreement now = pose_disagreement(params_.pose_check, frame.depth, frame.intrinsics,
-                                                   params_.T_base_camera, visual_, pose_shapes_);
+                                                   params_.T_base_camera, visual_, pose_shapes_,
+                                                   frame.stereo_baseline_mm * 1e-3F);
     pose_check_.params = params_.pose_check;
     pose_check_.add(now);
   });
@@ -140,9 +141,10 @@ bool Pipeline::camera_pose_agrees(const Frame& frame, const RobotState& robot_st
 
 // Always false, so that a caller can return it.
 bool Pipeline::withhold_pose(Measurement& m) const {
-  char text[160];
+  char text[200];
   std::snprintf(text, sizeof text,
-                "the arm is seen %.2f cm off its shapes on average over %d frames (pose_check_threshold_m %.4f): "
+                "the arm is seen %.2f cm off its shapes beyond the depth noise on average over %d frames "
+                "(pose_check_threshold_m %.4f): "
                 "camera pose mismatch, check camera.T_base_camera",
                 100.0 * static_cast<double>(pose_check_.window_mean_m()), params_.pose_check.window_frames,
                 static_cast<double>(params_.pose_check.threshold_m));

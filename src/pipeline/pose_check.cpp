@@ -52,7 +52,7 @@ int round_up_to(int value, int step) { return (value + step - 1) / step * step; 
 // The mean valid depth (m) in the square of half-size `half_px` about (u, v), 0 when fewer than
 // half of its pixels are valid: the single pixel's stereo noise averaged down without reaching
 // across the arm's edge.
-float patch_mean_m(const DepthImage& depth, int u, int v, int half_px) {
+float patch_mean_m(const DepthImage& depth, int u, int v, int half_px, int& valid_pixels) {
   const int u0 = std::max(0, u - half_px);
   const int u1 = std::min(depth.width - 1, u + half_px);
   const int v0 = std::max(0, v - half_px);
@@ -67,6 +67,7 @@ float patch_mean_m(const DepthImage& depth, int u, int v, int half_px) {
     }
   }
   const int pixels = (u1 - u0 + 1) * (v1 - v0 + 1);
+  valid_pixels = valid;
   if (2 * valid < pixels || valid == 0) return 0.0F;
   return static_cast<float>(sum) / static_cast<float>(valid) * depth.depth_scale_m;
 }
@@ -143,7 +144,8 @@ CapsuleHit nearest_shape_hit(const std::vector<ShapeInCamera>& shapes, int u, in
 
 PoseDisagreement pose_disagreement(const PoseCheckParams& params, const DepthImage& depth,
                                    const Intrinsics& intrinsics, const Pose& T_base_camera,
-                                   const RobotModel& visual_base, std::vector<ShapeInCamera>& shapes) {
+                                   const RobotModel& visual_base, std::vector<ShapeInCamera>& shapes,
+                                   float stereo_baseline_m) {
   PoseDisagreement out;
   if (depth.width != intrinsics.width || depth.height != intrinsics.height || !(intrinsics.fx > 0.0F) ||
       !(intrinsics.fy > 0.0F)) {
@@ -165,6 +167,13 @@ PoseDisagreement pose_disagreement(const PoseCheckParams& params, const DepthIma
   const float inv_fy = 1.0F / intrinsics.fy;
   double sum_m = 0.0;
   double signed_m = 0.0;
+  double floor_m = 0.0;
+  // σ of one pixel's depth is z²·σ_d/(fx·B); E|N(0, σ)| = σ·√(2/π).
+  const double noise_per_z2 = stereo_baseline_m > 0.0F && params.noise_px > 0.0F
+                                  ? static_cast<double>(params.noise_px) /
+                                        (static_cast<double>(intrinsics.fx) * static_cast<double>(stereo_baseline_m)) *
+                                        std::sqrt(2.0 / kPi)
+                                  : 0.0;
   for (int v = round_up_to(std::max(0, v_min), step); v <= v_max; v += step) {
     const uint16_t* row = depth.pixels.data() + static_cast<size_t>(v) * static_cast<size_t>(depth.width);
     for (int u = round_up_to(std::max(0, u_min), step); u <= u_max; u += step) {
@@ -173,18 +182,22 @@ PoseDisagreement pose_disagreement(const PoseCheckParams& params, const DepthIma
                                 (static_cast<float>(v) - intrinsics.ppy) * inv_fy, 1.0F);
       const CapsuleHit nearest = nearest_shape_hit(shapes, u, v, ray);
       if (nearest.depth_m == 0.0F || nearest.axis_share > params.core_share) continue;
-      const float measured_m = patch_mean_m(depth, u, v, params.patch_px);
+      int valid_pixels = 0;
+      const float measured_m = patch_mean_m(depth, u, v, params.patch_px, valid_pixels);
       if (!(measured_m > 0.0F)) continue;
       const float diff_m = measured_m - nearest.depth_m;
       if (diff_m < -params.occlusion_m) continue;  // something in front of the arm
       sum_m += std::min(std::abs(diff_m), params.cap_m);
       signed_m += std::clamp(diff_m, -params.cap_m, params.cap_m);
+      const double z = nearest.depth_m;
+      floor_m += noise_per_z2 * z * z / std::sqrt(static_cast<double>(valid_pixels));
       ++out.samples;
     }
   }
   if (out.samples > 0) {
     out.mean_m = static_cast<float>(sum_m / static_cast<double>(out.samples));
     out.signed_mean_m = static_cast<float>(signed_m / static_cast<double>(out.samples));
+    out.noise_floor_m = static_cast<float>(floor_m / static_cast<double>(out.samples));
   }
   return out;
 }
@@ -197,7 +210,7 @@ bool PoseCheck::add(const PoseDisagreement& frame) {
     next_ = 0;
     filled_ = 0;
   }
-  window_m_[next_] = frame.mean_m;
+  window_m_[next_] = frame.mean_m - frame.noise_floor_m;
   next_ = (next_ + 1) % window;
   filled_ = std::min(window, filled_ + 1);
   if (filled_ < window) return mismatch_;

@@ -49,6 +49,17 @@ int64_t SimRobotState::raw_known_ns(int64_t k) const {
 }
 
 bool SimRobotState::state_at(int64_t time_ns, RobotState& out) {
+  if (!params_.epoch_ns) return state_on_timeline(time_ns, out);
+  // A host (steady) time → the scene time it is on the shared scene clock, and the state's
+  // stamps back onto the host clock, where the frame's host time is.
+  const int64_t steady_to_scene_ns = realtime_minus_steady_ns() - *params_.epoch_ns;
+  const bool valid = state_on_timeline(time_ns + steady_to_scene_ns, out);
+  out.host_time_ns -= steady_to_scene_ns;
+  if (out.sample_time_ns != 0) out.sample_time_ns -= steady_to_scene_ns;
+  return valid;
+}
+
+bool SimRobotState::state_on_timeline(int64_t time_ns, RobotState& out) {
   if (params_.latency_s <= 0.0 && params_.jitter_s <= 0.0) {
     out = sample_state(trajectory_, params_.clock.get(), time_ns);
     return true;

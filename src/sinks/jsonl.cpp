@@ -111,6 +111,85 @@ void put_intrinsics(Members& m, const Intrinsics& in) {
 }
 
 
+// A fused cell's header `cameras`: name, nominal rate, pose (translation and a quaternion
+// x, y, z, w, base ← camera optical) and intrinsics (null until the camera reported them).
+void put_header_cameras(Members& m, const std::vector<RunHeader::Camera>& cameras) {
+  if (cameras.empty()) return;
+  std::string& line = m.line;
+  put_key(line, "cameras");
+  line += '[';
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    const RunHeader::Camera& c = cameras[i];
+    if (i > 0) line += ',';
+    line += '{';
+    m.text("name", c.name);
+    m.number("nominal_fps", c.nominal_fps);
+    const Eigen::Vector3d t = c.T_base_camera.translation();
+    const Eigen::Quaterniond q(c.T_base_camera.linear());
+    put_key(line, "T_base_camera");
+    line += "{";
+    put_key(line, "translation_m");
+    line += '[';
+    put_double(line, t.x());
+    line += ',';
+    put_double(line, t.y());
+    line += ',';
+    put_double(line, t.z());
+    line += ']';
+    put_key(line, "quaternion_xyzw");
+    line += '[';
+    put_double(line, q.x());
+    line += ',';
+    put_double(line, q.y());
+    line += ',';
+    put_double(line, q.z());
+    line += ',';
+    put_double(line, q.w());
+    line += "]}";
+    if (c.intrinsics.width > 0) {
+      put_intrinsics(m, c.intrinsics);
+    } else {
+      m.null("intrinsics");
+    }
+    line += '}';
+  }
+  line += ']';
+}
+
+// A fused frame's `cameras` (each camera's age, validity, reason and session at this instant)
+// and `closest_camera_name`; nothing for a single camera's frame.
+void put_frame_cameras(Members& m, const FrameResult& result) {
+  if (result.cameras.empty()) return;
+  std::string& line = m.line;
+  put_key(line, "cameras");
+  line += '[';
+  for (size_t i = 0; i < result.cameras.size(); ++i) {
+    const CameraStatus& c = result.cameras[i];
+    if (i > 0) line += ',';
+    line += '{';
+    m.text("name", c.name);
+    m.number_or_null("age_ms", std::isfinite(c.age_ms), c.age_ms);
+    m.boolean("valid", c.valid);
+    m.text("reason_code", reason_code_name(c.reason_code));
+    m.integer("session", c.session);
+    line += '}';
+  }
+  line += ']';
+  m.text_or_null("closest_camera_name", result.closest_camera_name);
+}
+
+// A camera of a cell with several, and a fused cell: the shared grid's cubes and how many of
+// them no camera saw free this frame (`seen_free`); nothing without a grid.
+void put_seen_free(Members& m, const SeenFreeGrid& grid) {
+  if (grid.cells == 0) return;
+  size_t free_cubes = 0;
+  for (const uint8_t byte : grid.bytes) free_cubes += static_cast<size_t>(__builtin_popcount(byte));
+  m.open("seen_free");
+  m.integer("cubes", static_cast<int64_t>(grid.cells));
+  m.integer("unknown", static_cast<int64_t>(grid.cells - std::min(free_cubes, grid.cells)));
+  m.close();
+}
+
 // `ssm`: S_p's terms (safety.mode ssm, a frame with a contact); null otherwise.
 void put_ssm(Members& m, const std::optional<SsmTerms>& ssm) {
   if (!ssm) {
@@ -276,6 +355,7 @@ void JsonLinesSink::header(const RunHeader& header) {
   put_source(m, header.source);
   put_intrinsics(m, header.source.intrinsics);
   put_filters(m, header.filters);
+  put_header_cameras(m, header.cameras);
   line_ += "}\n";
   write_line();
 }
@@ -323,6 +403,8 @@ void JsonLinesSink::frame(const FrameResult& result) {
   m.open("timings_us");
   for (const StageTiming& timing : result.timings) m.number(timing.stage, timing.us);
   m.close();
+  put_frame_cameras(m, result);
+  put_seen_free(m, result.seen_free);
   const bool labelled = result.truth && result.contact.valid && extras_.contact_label;
   put_truth(m, result, labelled ? extras_.contact_label(result) : nullptr);
   line_ += "}\n";
@@ -363,6 +445,26 @@ void JsonLinesSink::summary(const RunSummary& summary) {
   m.integer("timestamp_jumps", summary.timestamps.jumps);
   m.number_or_null("unknown_background_share", summary.unknown_background_share >= 0.0,
                    summary.unknown_background_share);
+  if (!summary.cameras.empty()) {
+    put_key(line_, "cameras");
+    line_ += '[';
+    for (size_t c = 0; c < summary.cameras.size(); ++c) {
+      const RunSummary::CameraIntake& in = summary.cameras[c];
+      if (c > 0) line_ += ',';
+      line_ += '{';
+      m.text("name", in.name);
+      m.integer("accepted", in.accepted);
+      m.integer("malformed", in.malformed);
+      m.integer("out_of_order", in.out_of_order);
+      m.integer("clock_ahead", in.clock_ahead);
+      m.integer("grid_mismatch", in.grid_mismatch);
+      m.integer("name_mismatch", in.name_mismatch);
+      m.integer("sessions", in.sessions);
+      m.text_or_null("last_problem", in.last_problem);
+      line_ += '}';
+    }
+    line_ += ']';
+  }
   put_robot_state_counters(m, summary.robot_state, summary.robot_status);
   put_record_counters(m, app.record);
   line_ += "}\n";

@@ -153,6 +153,11 @@ struct SimParams {
   /// Depth → colour translation, metres (the colour camera's extrinsics, rotation identity).
   /// Default: the test D435i of specs/d435-sensor-model.md §2.
   Eigen::Vector3f color_translation_m{0.01508F, 0.0000046F, 0.00017F};
+  /// The shared scene clock (`sim.epoch`, Config::sim_epoch_ns, set by the app when it builds the
+  /// simulator): frame 0's time, CLOCK_REALTIME ns. Set: SimSource plays in scene time, frame i
+  /// due at epoch + i / fps, joining at the current frame (docs/SIMULATOR.md, "The shared scene
+  /// clock"). Unset: frames 0, 1, ... as fast as asked for, stamped i / fps.
+  std::optional<int64_t> epoch_ns;
 };
 
 /// The name `sim.sensor` gives `sensor`: "d435" or "structured_light" (the configuration parses
@@ -374,6 +379,10 @@ class SimRobotState final : public RobotStateSource {
     RobotStateHistoryParams history;  ///< `robot.state.max_age_s`
     /// follow_link: the simulator's clock (the same object its SimArm has); null: open loop.
     std::shared_ptr<TrajectoryClock> clock;
+    /// The shared scene clock (SimParams::epoch_ns): set, state_at is asked at host times (the
+    /// steady clock, as SimSource stamps Frame::host_time_ns) and answers for the scene time
+    /// they map to (realtime − epoch), stamped back on the steady clock. Unset: the timeline.
+    std::optional<int64_t> epoch_ns;
   };
   SimRobotState(RobotTrajectory trajectory, Params params);
   RobotStateOrigin origin() const override { return RobotStateOrigin::sim; }
@@ -384,6 +393,8 @@ class SimRobotState final : public RobotStateSource {
  private:
   /// When sample k would become known before the in-order rule, nanoseconds.
   int64_t raw_known_ns(int64_t k) const;
+  /// state_at on the simulator's timeline (the scene time with an epoch).
+  bool state_on_timeline(int64_t time_ns, RobotState& out);
 
   RobotTrajectory trajectory_;
   Params params_;
@@ -406,19 +417,43 @@ std::optional<Intrinsics> d435_color_intrinsics(int width, int height);
 /// frames first .. first+count-1 of the simulator. count ≥ 1.
 double sim_fill_rate(const Simulator& sim, int64_t first, int64_t count);
 
-/// The simulator as a source, ending after params.frames frames.
+/// CLOCK_REALTIME minus CLOCK_MONOTONIC (std::chrono's system and steady clocks) now, ns: a
+/// realtime instant t is the steady instant t − offset. Read afresh at each use, so that a
+/// stepped or slewed wall clock is followed.
+int64_t realtime_minus_steady_ns();
+
+/// The simulator as a source, ending after params.frames frames (frame index >= frames).
+/// Without params.epoch_ns: frames 0, 1, ... each when asked for, stamped index / fps. With it
+/// (the shared scene clock, docs/SIMULATOR.md): live, paced by itself on CLOCK_REALTIME: frame i
+/// is due at epoch + i / fps; the first frame is the next one due when next() is first called
+/// (a camera started late joins the scene where it is); a frame already late by more than one
+/// period is skipped for the newest one due, never delivered in a burst; Frame::index is the
+/// scene frame, timestamp_ns its due time (realtime ns) and host_time_ns that instant on the
+/// steady clock.
 class SimSource : public Source {
  public:
   explicit SimSource(Simulator simulator) : sim_(std::move(simulator)) {}
   SourceInfo info() const override;
+  /// With an epoch: waits until the frame is due, but at most kSceneWaitNs; a frame due later
+  /// (an epoch in the future) gives `idle`, so that a stop request ends the wait.
   Status next(Frame& out) override;
   /// follow_link in lockstep: frames rendered without the previous frame's scale (the wait ran out).
   int64_t lockstep_timeouts() const { return lockstep_timeouts_; }
+  /// Scene frames skipped because they were late by more than a period (with an epoch).
+  int64_t frames_dropped_camera() const override { return scene_frames_skipped_; }
+
+  /// The longest wait in one next() call with an epoch, ns.
+  static constexpr int64_t kSceneWaitNs = 200'000'000;
 
  private:
+  /// next() with an epoch: the scene frame due now (the index to render), or a status.
+  Status next_scene_frame(Frame& out);
+
   Simulator sim_;
   int64_t next_index_ = 0;
   int64_t lockstep_timeouts_ = 0;
+  bool scene_joined_ = false;       ///< with an epoch: the first frame's index was chosen
+  int64_t scene_frames_skipped_ = 0;
 };
 
 }  // namespace hrcsense

@@ -1,0 +1,164 @@
+// SPDX-License-Identifier: Apache-2.0
+// `hrcsense fuse` fed 16 synthetic cameras at 90 frames/s over loopback DDS (issue H2's scaling
+// figure; docs/BENCHMARKS.md, "Cells with several cameras"). This process publishes, the fuser is
+// the real command in a child process, configured with the 16 cameras, a UR5 and the default
+// 3 × 3 × 2 m grid at 0.05 m (144 000 cubes, 18 kB of bits in every measurement). Each camera's
+// measurement is a valid one with three link contacts, stamped now; the fuser ends by itself
+// after --frames instants. Reported: the fuser's CPU (its own user + system time over the wall
+// time, from getrusage of the child), measurements sent and accepted, instants decided, and the
+// fused latency and the fuser's added latency from its JSON Lines (p50, p99).
+// Needs CYCLONEDDS_URI set to tests/dds/cyclonedds-loopback.xml (docs/BENCHMARKS.md).
+#include "../common/percentile.hpp"
+#include "dds/measurement_endpoints.hpp"
+
+#include <benchmark/benchmark.h>
+#include <nlohmann/json.hpp>
+
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
+
+namespace hrcsense {
+namespace {
+
+constexpr int kCameras = 16;
+constexpr double kFps = 90.0;
+constexpr int kInstants = 900;  // 10 s at 90 frames/s
+
+std::string cell_yaml(uint32_t domain) {
+  std::string yaml = "source: {type: sim}\nsim: {fps: 90, frames: 100000, color: false}\n"
+                     "robot: {model: ur5, padding_m: 0.05, joints_rad: [-2.74, -1.0, 1.6, -2.17, -1.57, 0.0]}\nsafety: {mode: ssm}\n"
+                     "ros2: {domain_id: " + std::to_string(domain) + ", namespace: /fuser_bench}\ncameras:\n";
+  for (int c = 0; c < kCameras; ++c) {
+    yaml += "  - name: cam" + std::to_string(c) + "\n    T_base_camera: {translation_m: [2.0, " + std::to_string(0.1 * c) +
+            ", 1.6], rotation_rpy_deg: [-125, 0, 90]}\n    fps: 90\n";
+  }
+  return yaml;
+}
+
+void BM_Fuser16Cameras90Hz(benchmark::State& state) {
+  const char* uri = std::getenv("CYCLONEDDS_URI");
+  if (uri == nullptr || std::string(uri).find("cyclonedds-loopback.xml") == std::string::npos) {
+    state.SkipWithError("set CYCLONEDDS_URI=file://<checkout>/tests/dds/cyclonedds-loopback.xml (loopback only)");
+    return;
+  }
+  const uint32_t domain = 204;
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("hrcsense_fuser_bench_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string config = (dir / "cell.yaml").string();
+  const std::string out = (dir / "fused.jsonl").string();
+  std::ofstream(config) << cell_yaml(domain);
+
+  for (auto _ : state) {
+    std::vector<std::string> args = {"hrcsense", "fuse", "--config", config, "--frames", std::to_string(kInstants), "--out", out};
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    pid_t fuser = -1;
+    if (posix_spawn(&fuser, HRCSENSE_BENCH_CLI, nullptr, nullptr, argv.data(), environ) != 0) {
+      state.SkipWithError("cannot start hrcsense fuse");
+      return;
+    }
+    // The cameras: one writer each in this process, a valid measurement every 1/90 s.
+    std::vector<std::unique_ptr<ros2::MeasurementSink>> sinks;
+    for (int c = 0; c < kCameras; ++c) {
+      ros2::MeasurementWriterParams params;
+      params.domain_id = domain;
+      params.node_namespace = "/fuser_bench";
+      params.camera_name = "cam" + std::to_string(c);
+      params.nominal_fps = kFps;
+      sinks.push_back(std::make_unique<ros2::MeasurementSink>(params));
+      RunHeader header;
+      header.session = 1000U + static_cast<uint32_t>(c);
+      sinks.back()->header(header);
+    }
+    FrameResult result;
+    result.valid = true;
+    result.clocked = true;
+    result.foreground_points = 2000;
+    result.robot_state.valid = true;
+    result.robot_state.q_rad = {-2.74, -1.0, 1.6, -2.17, -1.57, 0.0};
+    for (int link = 1; link <= 3; ++link) {
+      LinkContact l;
+      l.link = link;
+      l.contact.valid = true;
+      l.contact.distance_m = 1.2F + 0.1F * static_cast<float>(link);
+      l.speed_towards_mps = 0.2F;
+      l.distance_uncertainty_m = 0.03F;
+      result.links.push_back(l);
+    }
+    result.contact = result.links.front().contact;
+    result.seen_free.reset(144000);
+    std::mt19937 random(5);
+    for (size_t i = 0; i < result.seen_free.cells; ++i) {
+      if (random() % 4 != 0) result.seen_free.set(i);
+    }
+    // Give discovery a second, then publish until the fuser has its instants (bounded).
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+    const auto period = std::chrono::nanoseconds(static_cast<int64_t>(1e9 / kFps));
+    auto next = std::chrono::steady_clock::now();
+    int64_t sent = 0;
+    int status = 0;
+    const auto deadline = next + std::chrono::seconds(30);
+    while (waitpid(fuser, &status, WNOHANG) == 0 && std::chrono::steady_clock::now() < deadline) {
+      result.seen_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+      result.host_time_ns = result.seen_ns;
+      ++result.frame;
+      for (auto& sink : sinks) sink->frame(result);
+      sent += kCameras;
+      next += period;
+      std::this_thread::sleep_until(next);
+    }
+    if (waitpid(fuser, &status, WNOHANG) == 0) {
+      kill(fuser, SIGKILL);
+      waitpid(fuser, &status, 0);
+      state.SkipWithError("the fuser did not end within 30 s");
+      return;
+    }
+    rusage usage{};
+    getrusage(RUSAGE_CHILDREN, &usage);
+    const double cpu_s = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                         static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) * 1e-6;
+    std::vector<double> latency_us, added_us;
+    double wall_s = 0.0;
+    int64_t accepted = 0;
+    std::ifstream in(out);
+    for (std::string line; std::getline(in, line);) {
+      const nlohmann::json j = nlohmann::json::parse(line);
+      if (j["type"] == "frame" && j["valid"].get<bool>()) {
+        latency_us.push_back(j["latency_us"].get<double>());
+        added_us.push_back(j["timings_us"]["fusion_added"].get<double>());
+      } else if (j["type"] == "summary") {
+        wall_s = j["wall_s"].get<double>();
+        for (const auto& c : j["cameras"]) accepted += c["accepted"].get<int64_t>();
+      }
+    }
+    state.counters["fuser_cpu_share"] = wall_s > 0.0 ? cpu_s / wall_s : 0.0;
+    state.counters["sent"] = static_cast<double>(sent);
+    state.counters["accepted"] = static_cast<double>(accepted);
+    state.counters["valid_instants"] = static_cast<double>(latency_us.size());
+    state.counters["latency_p50_us"] = bench::percentile(latency_us, 0.5);
+    state.counters["latency_p99_us"] = bench::percentile(latency_us, 0.99);
+    state.counters["added_p50_us"] = bench::percentile(added_us, 0.5);
+    state.counters["added_p99_us"] = bench::percentile(added_us, 0.99);
+  }
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_Fuser16Cameras90Hz)->Name("Fuser/16cams_90fps/loopback")->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace hrcsense
