@@ -8,32 +8,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <ctime>
 
 namespace hrcsense::ros2 {
 namespace {
-
-int64_t clock_ns(clockid_t id) {
-  timespec ts{};
-  clock_gettime(id, &ts);
-  return static_cast<int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 // Samples taken per call of the reader; a full take is followed by another.
 constexpr uint32_t kMeasurementTake = 8;
 
 }  // namespace
-
-int64_t shared_clock_ns() { return clock_ns(CLOCK_REALTIME); }
-
-int64_t realtime_minus_steady_ns() {
-  // Read the steady clock on both sides of the realtime read: the offset is taken at their
-  // middle, within a microsecond or so.
-  const int64_t before = clock_ns(CLOCK_MONOTONIC);
-  const int64_t realtime = clock_ns(CLOCK_REALTIME);
-  const int64_t after = clock_ns(CLOCK_MONOTONIC);
-  return realtime - (before + (after - before) / 2);
-}
 
 struct MeasurementSink::Dds {
   ParticipantScope scope;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "dds/measurement_messages.hpp"
+#include "hrcsense/clock.hpp"
 #include "hrcsense/fusion.hpp"
 #include "hrcsense/sink.hpp"
 
@@ -16,11 +17,6 @@
 #include <vector>
 
 namespace hrcsense::ros2 {
-
-/// CLOCK_REALTIME − CLOCK_MONOTONIC now, ns: what moves a run-clock time onto the shared clock.
-int64_t realtime_minus_steady_ns();
-/// CLOCK_REALTIME now, ns: the shared clock.
-int64_t shared_clock_ns();
 
 struct MeasurementWriterParams {
   uint32_t domain_id = 0;                    ///< `ros2.domain_id`

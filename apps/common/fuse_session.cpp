@@ -196,7 +196,7 @@ class Fuser {
     for (const CameraEntry& entry : config.cameras) slowest = slowest > 0.0 ? std::min(slowest, entry.fps) : entry.fps;
     return slowest;
   }
-  static int64_t shared_clock() { return ros2::shared_clock_ns(); }
+  static int64_t shared_clock() { return shared_clock_ns(); }
 
   void receive(size_t topic, const CameraMeasurement& m, const std::string& problem, int64_t now) {
     RunSummary::CameraIntake& in = intake_[topic];

@@ -19,6 +19,13 @@ inline int64_t seconds_to_ns(double s) {
   return static_cast<int64_t>(std::llround((s < kMaxS ? s : kMaxS) * 1e9));
 }
 
+/// The shared clock of a cell with several cameras (docs/MULTICAMERA.md, "Clocks"):
+/// CLOCK_REALTIME, ns since the Unix epoch, kept in step across hosts by chrony or PTP.
+int64_t shared_clock_ns();
+/// CLOCK_REALTIME − the steady clock now, ns (the steady clock read on both sides of the realtime
+/// read, the offset taken at their middle): what moves a steady-clock time onto the shared clock.
+int64_t realtime_minus_steady_ns();
+
 /// The time source of run_pipeline. Times are integer nanoseconds from an arbitrary origin and
 /// never decrease. Implementations are called from several threads at once: the run's three,
 /// and the threads of the link sinks and live robot state sources that are given the clock.

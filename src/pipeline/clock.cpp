@@ -11,6 +11,19 @@
 
 namespace hrcsense {
 
+int64_t shared_clock_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+int64_t realtime_minus_steady_ns() {
+  const SteadyClock steady;
+  const int64_t before = steady.now_ns();
+  const int64_t realtime = shared_clock_ns();
+  const int64_t after = steady.now_ns();
+  return realtime - (before + (after - before) / 2);
+}
+
 int64_t SteadyClock::now_ns() const {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
       .count();

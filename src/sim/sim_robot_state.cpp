@@ -2,6 +2,7 @@
 // hrcsense — `robot.state.source: sim`: the simulator's scripted arm as a robot state source,
 // exact or delivered late with a seeded jitter through a RobotStateHistory.
 #include "hrcsense/sim/sim.hpp"
+#include "hrcsense/clock.hpp"
 
 #include <algorithm>
 #include <cmath>

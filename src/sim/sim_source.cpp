@@ -4,6 +4,8 @@
 
 #include "hrcsense/sim/sim.hpp"
 
+#include "hrcsense/clock.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -12,11 +14,6 @@
 
 namespace hrcsense {
 namespace {
-
-int64_t realtime_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 // When scene frame `index` is due, realtime ns: epoch + index / fps, rounded to the nanosecond.
 int64_t scene_frame_due_ns(int64_t epoch_ns, int64_t index, double fps) {
@@ -34,12 +31,6 @@ int64_t first_scene_frame_from(int64_t epoch_ns, int64_t now_ns, double fps) {
 }
 
 }  // namespace
-
-int64_t realtime_minus_steady_ns() {
-  const int64_t steady_ns =
-      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
-  return realtime_now_ns() - steady_ns;
-}
 
 SourceInfo SimSource::info() const {
   SourceInfo info;
@@ -80,7 +71,7 @@ Source::Status SimSource::next_scene_frame(Frame& out) {
   const int64_t epoch_ns = *sim_.params.epoch_ns;
   const double fps = sim_.params.fps;
   const int64_t period_ns = std::llround(1e9 / fps);
-  const int64_t now_ns = realtime_now_ns();
+  const int64_t now_ns = shared_clock_ns();
   if (!scene_joined_) {
     next_index_ = first_scene_frame_from(epoch_ns, now_ns, fps);
     scene_joined_ = true;

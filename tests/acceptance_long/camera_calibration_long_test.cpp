@@ -10,13 +10,20 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 namespace hrcsense {
 namespace {
 
 // Trials first..last, each within 5 mm and 0.2 degrees, each trial's error printed. Four tests of
-// five trials, so that ctest spreads them over the cores.
+// five trials, so that ctest spreads them over the cores. CI runs trials 1-10 (its 40 minutes);
+// HRCSENSE_ALL_CALIBRATION_TRIALS=1 runs 11-20 too, as docs/CALIBRATION.md's figures were made.
+bool all_trials() {
+  const char* all = std::getenv("HRCSENSE_ALL_CALIBRATION_TRIALS");
+  return all != nullptr && std::string(all) == "1";
+}
+
 void calibration_trials(unsigned first, unsigned last) {
   const Pose truth = test::calib_scene_pose("cell-ur5-moving.yaml");
   const std::string out = std::string(::testing::TempDir()) + "calibration_trial_" + std::to_string(first) + ".yaml";
@@ -41,9 +48,11 @@ void calibration_trials(unsigned first, unsigned last) {
 TEST(CameraCalibrationLong, TrialsOneToFiveLandWithinFiveMillimetresAndTwoTenthsOfADegree) { calibration_trials(1, 5); }
 TEST(CameraCalibrationLong, TrialsSixToTenLandWithinFiveMillimetresAndTwoTenthsOfADegree) { calibration_trials(6, 10); }
 TEST(CameraCalibrationLong, TrialsElevenToFifteenLandWithinFiveMillimetresAndTwoTenthsOfADegree) {
+  if (!all_trials()) GTEST_SKIP() << "trials 11-20 run with HRCSENSE_ALL_CALIBRATION_TRIALS=1";
   calibration_trials(11, 15);
 }
 TEST(CameraCalibrationLong, TrialsSixteenToTwentyLandWithinFiveMillimetresAndTwoTenthsOfADegree) {
+  if (!all_trials()) GTEST_SKIP() << "trials 11-20 run with HRCSENSE_ALL_CALIBRATION_TRIALS=1";
   calibration_trials(16, 20);
 }
 

@@ -14,6 +14,8 @@
 #include "hrcsense/recordings/recordings.hpp"
 #include "src/recordings/bag_reader.hpp"
 
+#include "../support/sanitized.hpp"
+
 #include <gtest/gtest.h>
 
 
@@ -33,7 +35,9 @@ using test::scene_path;
 namespace fs = std::filesystem;
 using test::ScratchDir;
 
-constexpr int kRoundTripFrames = 300;
+// 300 frames (10 s of the cell); under the sanitizers, whose simulator renders each frame several
+// times slower, 60 (the chunks, the index and the colour stream are the same code either way).
+constexpr int kRoundTripFrames = test::kSanitized ? 60 : 300;
 constexpr int kPushWaitMs = 10000;
 
 /// The colour simulator of config/cell-ur5.yaml (848x480 depth + colour), `frames` long.

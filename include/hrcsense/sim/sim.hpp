@@ -417,10 +417,6 @@ std::optional<Intrinsics> d435_color_intrinsics(int width, int height);
 /// frames first .. first+count-1 of the simulator. count ≥ 1.
 double sim_fill_rate(const Simulator& sim, int64_t first, int64_t count);
 
-/// CLOCK_REALTIME minus CLOCK_MONOTONIC (std::chrono's system and steady clocks) now, ns: a
-/// realtime instant t is the steady instant t − offset. Read afresh at each use, so that a
-/// stepped or slewed wall clock is followed.
-int64_t realtime_minus_steady_ns();
 
 /// The simulator as a source, ending after params.frames frames (frame index >= frames).
 /// Without params.epoch_ns: frames 0, 1, ... each when asked for, stamped index / fps. With it
