@@ -7,7 +7,6 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
-#include <cctype>
 #include <limits>
 
 namespace hrcsense::ros2 {
@@ -49,12 +48,6 @@ Contact contact_of(const hrcsense_msgs_msg_dds__LinkContact_& msg) {
   return c;
 }
 
-bool is_name_token(const std::string& name) {
-  if (name.empty() || std::isalpha(static_cast<unsigned char>(name.front())) == 0) return false;
-  return std::all_of(name.begin(), name.end(),
-                     [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) != 0 || ch == '_'; });
-}
-
 template <typename Seq, typename T>
 void point_at(Seq& seq, std::vector<T>& storage) {
   seq._maximum = static_cast<uint32_t>(storage.size());
@@ -66,7 +59,7 @@ void point_at(Seq& seq, std::vector<T>& storage) {
 }  // namespace
 
 std::string measurement_topic(const std::string& node_namespace, const std::string& camera_name) {
-  if (!is_name_token(camera_name)) {
+  if (!is_camera_name(camera_name)) {
     throw Ros2Error("camera name '" + camera_name + "': expected a ROS name token (a letter, then letters, digits, '_')");
   }
   const std::string topic =

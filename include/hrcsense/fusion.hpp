@@ -56,6 +56,10 @@ struct CameraMeasurement {
   std::vector<LinkTruth> truth_links;
 };
 
+/// A camera's name is a ROS 2 name token: a letter, then letters, digits and '_' (it becomes the
+/// last token of its topic, `<ns>/measurement/<NAME>`).
+bool is_camera_name(const std::string& name);
+
 /// The newest measurement of a camera's frame, for a fuser: `m` (a FrameResult or a Pipeline's
 /// measurement, clocked by run_pipeline) with its times moved from the run's steady clock onto
 /// the shared clock by `realtime_minus_steady_ns` (CLOCK_REALTIME − CLOCK_MONOTONIC, read once

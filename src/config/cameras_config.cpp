@@ -6,6 +6,8 @@
 
 #include "yaml_tree.hpp"
 
+#include "hrcsense/fusion.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -24,14 +26,6 @@ constexpr float kMaxVoxelM = 0.5F;
 /// `sim.epoch`: up to 4e9 s (the year 2096), so that epoch + sim.frames / sim.fps (at most 1e18
 /// ns) stays inside int64 nanoseconds.
 constexpr double kMaxEpochS = 4e9;
-
-// A ROS 2 name token: letters, digits and '_', starting with a letter (the camera's name goes
-// into topic names, `<ns>/measurement/<NAME>`).
-bool camera_name_token(const std::string& name) {
-  if (name.empty() || std::isalpha(static_cast<unsigned char>(name.front())) == 0) return false;
-  return std::all_of(name.begin(), name.end(),
-                     [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) != 0 || ch == '_'; });
-}
 
 std::string entry_key(size_t index) { return "cameras[" + std::to_string(index) + "]"; }
 
@@ -124,7 +118,7 @@ void check_camera_entries(const YAML::Node& root, const std::string& where, cons
     tree.only_keys(entry, key, {"name", "T_base_camera", "fps", "source", "sim"});
     const YAML::Node name_node = tree.required(entry, key, "name");
     const std::string name = name_node.IsScalar() ? name_node.Scalar() : std::string();
-    if (!camera_name_token(name)) {
+    if (!is_camera_name(name)) {
       tree.fail(key + ".name", "expected a ROS 2 name token (a letter, then letters, digits and '_'), got '" + name +
                                    "'");
     }

@@ -5,6 +5,7 @@
 #include "hrcsense/fusion.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -68,6 +69,12 @@ Rank rank_of(const SafetyParams& params, const CameraMeasurement& m, const LinkC
 }
 
 }  // namespace
+
+bool is_camera_name(const std::string& name) {
+  if (name.empty() || std::isalpha(static_cast<unsigned char>(name.front())) == 0) return false;
+  return std::all_of(name.begin(), name.end(),
+                     [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) != 0 || ch == '_'; });
+}
 
 void to_camera_measurement(const Measurement& m, int64_t realtime_minus_steady_ns, CameraMeasurement& out) {
   const auto shared = [&](int64_t steady_ns) { return steady_ns == 0 ? 0 : steady_ns + realtime_minus_steady_ns; };

@@ -203,6 +203,35 @@ TEST(CellFusion, AGridOfAnotherSizeIsRejected) {
   EXPECT_EQ(fusion.add(m, kT0), FusionIntake::accepted);
 }
 
+TEST(CellFusion, TheUnknownDistanceIsToTheNearestCubeNoCameraSawFree) {
+  FusionParams params = zones_params();
+  params.grid.enabled = true;
+  params.grid.box_base = Eigen::AlignedBox3f(Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(1, 1, 1));
+  params.grid.voxel_m = 0.5F;  // 8 cubes; cube 0's centre (0.25, 0.25, 0.25), cube 1's (0.75, 0.25, 0.25)
+  Capsule point;  // the robot: a point at x = -1 beside the box (robot.model points)
+  point.a = point.b = Eigen::Vector3f(-1.0F, 0.25F, 0.25F);
+  params.robot.points.capsules = {point};
+  CellFusion fusion({{"front", 30.0}, {"left", 30.0}}, params);
+  CameraMeasurement front = measured("front", kT0, {});
+  CameraMeasurement left = measured("left", kT0, {});
+  front.seen_free.reset(8);
+  left.seen_free.reset(8);
+  for (size_t i = 2; i < 8; ++i) front.seen_free.set(i);  // front saw neither cube 0 nor cube 1
+  left.seen_free.set(0);                                    // left saw cube 0 (and nothing else)
+  front.unknown_distance_m = 0.1F;  // their own per-ray distances are not used with grids
+  left.unknown_distance_m = 0.1F;
+  ASSERT_EQ(fusion.add(front, kT0), FusionIntake::accepted);
+  ASSERT_EQ(fusion.add(left, kT0), FusionIntake::accepted);
+  Measurement out;
+  fusion.fuse(kT0, 1, kT0, out);
+  ASSERT_TRUE(out.valid) << out.withheld_reason;
+  // Only cube 1 is seen free by neither: its centre is 1.75 m from the point.
+  EXPECT_NEAR(out.unknown_distance_m, 1.75F, 1e-5F);
+  ASSERT_EQ(out.seen_free.cells, 8U);
+  EXPECT_TRUE(out.seen_free.test(0));
+  EXPECT_FALSE(out.seen_free.test(1));
+}
+
 TEST(CellFusion, InSsmAFartherButLessCertainContactGovernsItsLink) {
   FusionParams params;
   params.safety.mode = SafetyParams::Mode::ssm;
