@@ -16,6 +16,7 @@
 
 #if HRCSENSE_HAVE_DDS
 #include "dds/measurement_endpoints.hpp"
+#include "dds/ros2_messages.hpp"  // Ros2Error
 #endif
 
 #include <spdlog/spdlog.h>
