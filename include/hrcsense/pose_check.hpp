@@ -87,6 +87,12 @@ struct ShapeInCamera {
 void shapes_in_camera(const Intrinsics& intrinsics, const Pose& T_base_camera, const RobotModel& visual_base,
                       std::vector<ShapeInCamera>& shapes);
 
+/// The pixels all of `shapes` may cover: [u0, u1] × [v0, v1]; empty (u1 < u0) without shapes.
+struct ShapesPixelBox {
+  int u0 = 0, v0 = 0, u1 = -1, v1 = -1;
+};
+ShapesPixelBox shapes_pixel_box(const std::vector<ShapeInCamera>& shapes, const Intrinsics& intrinsics);
+
 /// The nearest entry along `ray_camera` (z = 1) through pixel (u, v) into those of `shapes` that
 /// may cover it; depth 0 when none is hit.
 CapsuleHit nearest_shape_hit(const std::vector<ShapeInCamera>& shapes, int u, int v, const Eigen::Vector3f& ray_camera);

@@ -59,16 +59,8 @@ size_t predicted_arm(const ArmSamples& samples, const KeyframeFit& key, const Po
   shapes_in_camera(in, T_base_camera, RobotModel{key.shapes_base}, shapes);
   centroid_camera.setZero();
   if (shapes.empty()) return 0;
-  int u_min = in.width;
-  int u_max = -1;
-  int v_min = in.height;
-  int v_max = -1;
-  for (const ShapeInCamera& s : shapes) {
-    u_min = std::min(u_min, s.u0);
-    u_max = std::max(u_max, s.u1);
-    v_min = std::min(v_min, s.v0);
-    v_max = std::max(v_max, s.v1);
-  }
+  const ShapesPixelBox box = shapes_pixel_box(shapes, in);
+  const int u_min = box.u0, u_max = box.u1, v_min = box.v0, v_max = box.v1;
   const auto cell = [step](int pixel, int cells) { return std::clamp(pixel / step, 0, cells - 1); };
   const float scale = samples.depth_scale_m();
   size_t count = 0;

@@ -142,6 +142,17 @@ CapsuleHit nearest_shape_hit(const std::vector<ShapeInCamera>& shapes, int u, in
   return nearest;
 }
 
+ShapesPixelBox shapes_pixel_box(const std::vector<ShapeInCamera>& shapes, const Intrinsics& intrinsics) {
+  ShapesPixelBox box{intrinsics.width, intrinsics.height, -1, -1};
+  for (const ShapeInCamera& s : shapes) {
+    box.u0 = std::min(box.u0, s.u0);
+    box.u1 = std::max(box.u1, s.u1);
+    box.v0 = std::min(box.v0, s.v0);
+    box.v1 = std::max(box.v1, s.v1);
+  }
+  return box;
+}
+
 PoseDisagreement pose_disagreement(const PoseCheckParams& params, const DepthImage& depth,
                                    const Intrinsics& intrinsics, const Pose& T_base_camera,
                                    const RobotModel& visual_base, std::vector<ShapeInCamera>& shapes,
@@ -152,16 +163,8 @@ PoseDisagreement pose_disagreement(const PoseCheckParams& params, const DepthIma
     return out;
   }
   shapes_in_camera(intrinsics, T_base_camera, visual_base, shapes);
-  int u_min = intrinsics.width;
-  int u_max = -1;
-  int v_min = intrinsics.height;
-  int v_max = -1;
-  for (const ShapeInCamera& s : shapes) {
-    u_min = std::min(u_min, s.u0);
-    u_max = std::max(u_max, s.u1);
-    v_min = std::min(v_min, s.v0);
-    v_max = std::max(v_max, s.v1);
-  }
+  const ShapesPixelBox box = shapes_pixel_box(shapes, intrinsics);
+  const int u_min = box.u0, u_max = box.u1, v_min = box.v0, v_max = box.v1;
   const int step = std::max(1, params.grid_px);
   const float inv_fx = 1.0F / intrinsics.fx;
   const float inv_fy = 1.0F / intrinsics.fy;
