@@ -69,6 +69,8 @@ CLI::App* add_record_command(CLI::App& app, CommandArgs& args) {
   add_common_flags(*record, args);
   record->add_option("--out", args.out, "the .bag file (with record.split_mb: FILE-000.bag, ...)")->required();
   record->add_flag("--overwrite", args.overwrite, "replace an existing recording (never the source itself)");
+  record->add_option("--camera", args.camera,
+                     "record one camera of the scene's cameras: (its pose, source and sim settings; docs/MULTICAMERA.md)");
   // A day at most: longer recordings are split files of a service, not one command.
   record->add_option("--duration-s", args.duration_s, "stop after S seconds of source time, 0.001 to 86400")
       ->check(CLI::Range(0.001, 86400.0))

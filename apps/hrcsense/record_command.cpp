@@ -27,7 +27,7 @@ constexpr int kRecordWaitMs = 5000;
 }  // namespace
 
 int record_command(const CommandArgs& args) {
-  const Config config = load_config(args.config_path, args.sets);
+  const Config config = load_config(args.config_path, args.sets, args.camera);
   // Before anything is opened: never replace a file unasked, never the source being played.
   check_record_output(config, args.out, args.overwrite);
   CellOptions options;
