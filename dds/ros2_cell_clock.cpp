@@ -3,11 +3,13 @@
 #include "dds/ros2_cell_clock.hpp"
 
 #include "dds/dds_entity.hpp"
+#include "dds/ros2_messages.hpp"  // dds_topic_name, stamp_ns, stamp_from_ns, Ros2Error
 #include "hrcsense/clock.hpp"
 
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <string>
 #include <thread>
 
 namespace hrcsense::ros2 {

@@ -3,8 +3,10 @@
 #include "dds/ros2_joint_state_writer.hpp"
 
 #include "dds/dds_entity.hpp"
+#include "dds/ros2_messages.hpp"  // dds_topic_name, stamp_from_ns
 #include "hrcsense/robot_state_history.hpp"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 

@@ -10,6 +10,7 @@
 
 #include "hrcsense/clock.hpp"
 #include "hrcsense/fusion.hpp"
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/safety.hpp"
 #include "hrcsense/session.hpp"
 #include "hrcsense/sinks/sinks.hpp"

@@ -15,6 +15,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <memory>
 #include <string>
 
 namespace hrcsense::cell_clock_test {

@@ -16,6 +16,7 @@
 #include <sys/wait.h>
 
 #include <array>
+#include <csignal>
 #include <chrono>
 #include <filesystem>
 #include <fstream>

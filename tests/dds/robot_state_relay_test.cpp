@@ -9,7 +9,9 @@
 #include "dds/ros2_joint_state_writer.hpp"
 #include "dds_test_util.hpp"
 #include "joint_state_peers.hpp"
+#include "hrcsense/clock.hpp"
 #include "hrcsense/net/udp_json.hpp"
+#include "hrcsense/robot_state.hpp"
 
 #include <gtest/gtest.h>
 
