@@ -348,8 +348,9 @@ class RobotStateRelay {
     const int64_t rejected = stats.samples.rejected() + stats.malformed;
     const bool failed = c.refused > 0 || c.published == 0;
     spdlog::log(failed ? spdlog::level::warn : spdlog::level::info,
-                "fuse: {} robot states republished on {}, {} not written{}; the source rejected {}{}", c.published,
-                relay_->topic(), c.refused, c.last_error.empty() ? "" : " (last: " + c.last_error + ")", rejected,
+                "fuse: {} of the {} robot states the source accepted republished on {}, {} not written{}; the source "
+                "rejected {}{}",
+                c.published, stats.samples.accepted, relay_->topic(), c.refused, c.last_error.empty() ? "" : " (last: " + c.last_error + ")", rejected,
                 rejected == 0 || stats.last_problem.empty() ? "" : " (last: " + stats.last_problem + ")");
   }
 
