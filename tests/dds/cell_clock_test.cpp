@@ -5,6 +5,7 @@
 // sim.epoch takes it (with_cell_clock) and plays the same scene frames at the same capture times
 // as a camera that started before it. Loopback DDS; every wait is bounded.
 #include "common/assembly.hpp"
+#include "common/fuse_session.hpp"
 #include "dds/ros2_cell_clock.hpp"
 #include "dds/ros2_messages.hpp"
 #include "dds_test_util.hpp"
@@ -131,6 +132,13 @@ TEST(CellClock, ACameraStartedLaterJoinsTheSameSceneFramesWithTheEpochFromDds) {
   for (int i = 0; i < 30 && c.index < b.index; ++i) ASSERT_EQ(first->next(c), Source::Status::frame);
   EXPECT_EQ(c.timestamp_ns, due_ns(epoch_ns, c.index));
   EXPECT_EQ(c.timestamp_ns - b.timestamp_ns, due_ns(epoch_ns, c.index) - due_ns(epoch_ns, b.index));
+}
+
+TEST(CellClock, TheFuserPublishesSimEpochElseASecondAfterItsStart) {
+  Config config;
+  EXPECT_EQ(app::cell_clock_epoch_ns(config, 1'800'000'000'000'000'000), 1'800'000'001'000'000'000);
+  config.sim_epoch_ns = 1'799'999'990'250'000'000;
+  EXPECT_EQ(app::cell_clock_epoch_ns(config, 1'800'000'000'000'000'000), 1'799'999'990'250'000'000);
 }
 
 TEST(CellClock, ACameraWithItsOwnEpochOrNotACameraOfACellWaitsForNothing) {
