@@ -13,6 +13,8 @@
 #if HRCSENSE_HAVE_DDS
 #include "dds/measurement_endpoints.hpp"
 #include "dds/ros2_camera_source.hpp"
+#include "dds/ros2_cell_clock.hpp"
+#include "dds/ros2_joint_state_writer.hpp"
 #include "dds/ros2_joint_state_source.hpp"
 #include "dds/ros2_outputs.hpp"
 #endif
@@ -275,6 +277,38 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
                   "recorded needs: record with hrcsense record or hrcsense run --record");
   }
   return states;
+}
+
+bool robot_state_is_live(const Config& config) {
+  const RobotStateOrigin source = config.robot_state.source;
+  return source == RobotStateOrigin::rtde || source == RobotStateOrigin::udp_json || source == RobotStateOrigin::ros2;
+}
+
+std::vector<std::string> camera_robot_state_sets(const Config& config) {
+  if (!robot_state_is_live(config)) return {};
+  // The key names of load_config; the topic is what the fuser's writer uses
+  // (cell_joint_states_topic), spelled here too for a build without DDS, where nothing runs.
+  return {"robot.state.source=ros2", "robot.state.ros2.topic=" + config.ros2.node_namespace + "/joint_states"};
+}
+
+Config with_cell_clock(const Config& config, [[maybe_unused]] double timeout_s,
+                       [[maybe_unused]] const std::atomic<bool>* stop_requested) {
+  if (config.camera.empty() || config.source.type != SourceType::sim || config.sim_epoch_ns) return config;
+#if HRCSENSE_HAVE_DDS
+  Config joined = config;
+  try {
+    joined.sim_epoch_ns = ros2::wait_for_cell_clock(static_cast<uint32_t>(config.ros2.domain_id),
+                                                    config.ros2.node_namespace, timeout_s, stop_requested);
+  } catch (const ros2::Ros2Error& e) {
+    throw ConfigError(config_where(config) + ": --camera " + config.camera + " without sim.epoch: " + e.what());
+  }
+  spdlog::info("camera '{}': the scene clock's epoch {:.3f} s from {}", config.camera,
+               static_cast<double>(*joined.sim_epoch_ns) * 1e-9, ros2::cell_clock_topic(config.ros2.node_namespace));
+  return joined;
+#else
+  throw ConfigError(config_where(config) + ": --camera " + config.camera + " of a simulated cell without sim.epoch: "
+                    "this hrcsense was built without Cyclone DDS to read the fuser's cell_clock; set sim.epoch");
+#endif
 }
 
 bool load_background_file(const Config& config, const SourceInfo& info, Pipeline& pipeline) {

@@ -89,6 +89,22 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
                                                           RunClock* clock = nullptr,
                                                           std::shared_ptr<TrajectoryClock> trajectory_clock = nullptr);
 
+/// robot.state.source is a live robot (rtde, udp_json, ros2): in a cell with several cameras the
+/// fuser owns it and republishes it on `<ros2.namespace>/joint_states` (docs/MULTICAMERA.md).
+bool robot_state_is_live(const Config& config);
+
+/// The `--set` overrides that make a camera process of a cell read the fuser's republished
+/// robot state (robot.state.source ros2 on `<ros2.namespace>/joint_states`; the joint names'
+/// robot.state.ros2.tf_prefix and the speed scaling topic stay as configured, as the fuser
+/// writes the names with that prefix); empty when the robot state is not live.
+std::vector<std::string> camera_robot_state_sets(const Config& config);
+
+/// `hrcsense run --camera NAME` of a simulated camera without `sim.epoch`: the configuration
+/// with the epoch the fuser publishes on `<ros2.namespace>/cell_clock`, waited for up to
+/// `timeout_s`; any other configuration as it is. Throws ConfigError naming the topic and the
+/// domain when no valid epoch came (or in a build without Cyclone DDS).
+Config with_cell_clock(const Config& config, double timeout_s, const std::atomic<bool>* stop_requested);
+
 /// Loads background.path into `pipeline` when the file exists (checked against the filtered
 /// resolution: after decimation); false when there is nothing to load. Throws IoError for a
 /// damaged or mismatched file, naming it.

@@ -10,12 +10,15 @@
 
 #include "hrcsense/clock.hpp"
 #include "hrcsense/fusion.hpp"
+#include "hrcsense/robot_state.hpp"
 #include "hrcsense/safety.hpp"
 #include "hrcsense/session.hpp"
 #include "hrcsense/sinks/sinks.hpp"
 
 #if HRCSENSE_HAVE_DDS
 #include "dds/measurement_endpoints.hpp"
+#include "dds/ros2_cell_clock.hpp"
+#include "dds/ros2_joint_state_writer.hpp"
 #include "dds/ros2_messages.hpp"  // Ros2Error
 #endif
 
@@ -34,6 +37,10 @@ double fuse_wait_s(const Config& config) {
   double fastest_fps = 0.0;
   for (const CameraEntry& entry : config.cameras) fastest_fps = std::max(fastest_fps, entry.fps);
   return fastest_fps > 0.0 ? 0.5 / fastest_fps : 0.0;
+}
+
+int64_t cell_clock_epoch_ns(const Config& config, int64_t fuser_start_ns) {
+  return config.sim_epoch_ns ? *config.sim_epoch_ns : fuser_start_ns + 1'000'000'000;
 }
 
 #if HRCSENSE_HAVE_DDS
@@ -306,6 +313,53 @@ class Fuser {
   std::vector<double> added_us_;  ///< per valid fused instant: what the fuser added (fusion_added)
 };
 
+// The live robot state the fuser owns and republishes on <ns>/joint_states for the cameras
+// (docs/MULTICAMERA.md, "Robot state"); nothing for a simulated, fixed or recorded arm, which
+// every camera process plays or reads itself.
+class RobotStateRelay {
+ public:
+  explicit RobotStateRelay(const Config& config) {
+    if (!robot_state_is_live(config)) {
+      spdlog::info("fuse: robot.state.source {}: each camera process has the arm itself (the simulator's on the "
+                   "scene clock); nothing is republished",
+                   robot_state_origin_name(config.robot_state.source));
+      return;
+    }
+    ros2::JointStateWriterParams params;
+    params.domain_id = static_cast<uint32_t>(config.ros2.domain_id);
+    params.topic = ros2::cell_joint_states_topic(config.ros2.node_namespace);
+    params.tf_prefix = config.robot_state.ros2.tf_prefix;
+    if (config.robot_state.source == RobotStateOrigin::ros2 && config.robot_state.ros2.topic == params.topic) {
+      // It would read its own samples back.
+      throw ConfigError(config_where(config) + ": robot.state.ros2.topic: " + params.topic +
+                        " is where hrcsense fuse republishes the robot state; read the driver's topic (e.g. "
+                        "/joint_states)");
+    }
+    states_ = make_robot_state_source(config, &clock_);
+    relay_ = std::make_unique<ros2::JointStateRelay>(*states_, clock_, params);
+    spdlog::info("fuse: robot state from {} republished on {} (domain {}) for the cameras",
+                 robot_state_origin_name(config.robot_state.source), params.topic, config.ros2.domain_id);
+  }
+  // What went out, and what the source refused, for the log.
+  void report() const {
+    if (!relay_) return;
+    const ros2::JointStateRelayCounters c = relay_->counters();
+    const RobotStateStats stats = states_->stats();
+    const int64_t rejected = stats.samples.rejected() + stats.malformed;
+    const bool failed = c.refused > 0 || c.published == 0;
+    spdlog::log(failed ? spdlog::level::warn : spdlog::level::info,
+                "fuse: {} of the {} robot states the source accepted republished on {}, {} not written{}; the source "
+                "rejected {}{}",
+                c.published, stats.samples.accepted, relay_->topic(), c.refused, c.last_error.empty() ? "" : " (last: " + c.last_error + ")", rejected,
+                rejected == 0 || stats.last_problem.empty() ? "" : " (last: " + stats.last_problem + ")");
+  }
+
+ private:
+  SteadyClock clock_;  // stateless: the time the live sources stamp with
+  std::unique_ptr<RobotStateSource> states_;
+  std::unique_ptr<ros2::JointStateRelay> relay_;  // after states_: stops before the source goes
+};
+
 }  // namespace
 
 int fuse_session(const Config& config, const FuseOptions& options) {
@@ -330,12 +384,19 @@ int fuse_session(const Config& config, const FuseOptions& options) {
   ConsoleSink console;
   TeeSink tee({udp.get(), rtde.get(), ros2.sink.get(), &jsonl, &console});
   try {
+    // The scene clock first: simulated cameras started with the fuser wait for it.
+    const ros2::CellClockPublisher cell_clock(static_cast<uint32_t>(config.ros2.domain_id), config.ros2.node_namespace,
+                                              cell_clock_epoch_ns(config, shared_clock_ns()));
+    spdlog::info("fuse: the scene clock's epoch on {} (domain {}){}", cell_clock.topic(), config.ros2.domain_id,
+                 config.sim_epoch_ns ? ": sim.epoch" : ": a second from now");
+    const RobotStateRelay robot_state(config);
     Fuser fuser(config, tee);
     spdlog::info("fuse: {} cameras on {}/measurement/* (domain {}); waits {:.1f} ms for an instant's stragglers",
                  config.cameras.size(), config.ros2.node_namespace, config.ros2.domain_id, fuse_wait_s(config) * 1e3);
     tee.header(fused_header(config));
     const RunSummary summary = fuser.run(options.frames);
     tee.summary(summary);
+    robot_state.report();
     if (StopSignals::stop_requested()) spdlog::info("signal received: the fuser ended with a stop");
     out.flush();
     if (!out) return report_error((options.out.empty() ? "stdout" : options.out) + ": write failed", kExitRuntime);

@@ -29,4 +29,9 @@ int fuse_session(const Config& config, const FuseOptions& options);
 /// measurement (T_r then counts from its capture).
 double fuse_wait_s(const Config& config);
 
+/// The scene clock's epoch the fuser publishes on `<ros2.namespace>/cell_clock` (realtime ns):
+/// `sim.epoch` when set, else a second after the fuser's start, so that the cameras started
+/// with it have joined before frame 0.
+int64_t cell_clock_epoch_ns(const Config& config, int64_t fuser_start_ns);
+
 }  // namespace hrcsense::app

@@ -44,6 +44,10 @@ extern "C" void on_stop_signal(int signal) {
 
 constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGTSTP};
 
+// How long `run --camera NAME` of a simulated cell waits for the fuser's cell_clock: discovery on
+// a network takes well under a second, and the fuser is started first.
+constexpr double kCellClockWaitS = 5.0;
+
 // SIGPIPE is ignored for the whole run: a reader that goes away makes the write fail (EPIPE),
 // and the failed sink ends the run, instead of the signal killing it mid-line.
 void install_signal_handlers() {
@@ -220,12 +224,14 @@ void report_links(const Cell& cell) {
 
 void request_session_stop() { g_stop_requested.store(true); }
 
-int run_session(const Config& config, const SessionOptions& args) {
+int run_session(const Config& given, const SessionOptions& args) {
   // Before anything is opened: a recording never silently replaces a file, nor the source.
-  if (!args.record.empty()) check_record_output(config, args.record, args.overwrite);
+  if (!args.record.empty()) check_record_output(given, args.record, args.overwrite);
   // From here a signal ends the run with a stop line and a summary, also while a live camera
   // is still awaited; the handlers go when the session does, however it ends.
   const SignalHandlers signal_handlers;
+  // A simulated camera of a cell without sim.epoch plays the fuser's scene clock (cell_clock).
+  const Config config = with_cell_clock(given, kCellClockWaitS, &g_stop_requested);
   const std::unique_ptr<Cell> cell = assemble_cell(config, cell_options(args));
   std::ofstream file;
   if (!args.out.empty()) {

@@ -109,9 +109,10 @@ int cell_command(const CommandArgs& args) {
                         kExitUsage);
   }
   const StopSignals signals;
+  // Every child, the fuser too: simulated cameras share a scene clock, frame 0 a second from
+  // now, so that every process has started by then and all learn their background from the same
+  // frames; the fuser publishes the same epoch on <ns>/cell_clock for a camera started by hand.
   std::vector<std::string> common_sets;
-  // Simulated cameras share a scene clock: frame 0 a second from now, so that every process
-  // has started by then and all learn their background from the same frames.
   bool simulated = false;
   for (const CameraEntry& entry : config.cameras) simulated = simulated || entry.source_type == SourceType::sim;
   if (simulated && !config.sim_epoch_ns) {
@@ -121,18 +122,29 @@ int cell_command(const CommandArgs& args) {
     std::snprintf(epoch, sizeof epoch, "sim.epoch=%.6f", static_cast<double>(now.tv_sec + 1) + now.tv_nsec * 1e-9);
     common_sets.emplace_back(epoch);
   }
+  // A live robot: the fuser owns its connection and republishes it; the cameras read that.
+  const std::vector<std::string> camera_sets = camera_robot_state_sets(config);
+  const auto add_sets = [](std::vector<std::string>& to, const std::vector<std::string>& sets) {
+    for (const std::string& set : sets) to.insert(to.end(), {"--set", set});
+  };
 
   std::vector<Child> children;
   // The fuser first: its readers are there when the cameras' first measurements come.
   std::vector<std::string> fuse = child_args(args, "fuse");
+  add_sets(fuse, common_sets);
   if (!args.out.empty()) fuse.insert(fuse.end(), {"--out", args.out});
   children.push_back({"fuse", spawn(fuse), true, 0});
   for (const CameraEntry& entry : config.cameras) {
     std::vector<std::string> run = child_args(args, "run");
-    for (const std::string& set : common_sets) run.insert(run.end(), {"--set", set});
+    add_sets(run, common_sets);
+    add_sets(run, camera_sets);
     run.insert(run.end(), {"--camera", entry.name, "--out", camera_out(args.out, entry.name)});
     if (args.frames > 0) run.insert(run.end(), {"--frames", std::to_string(args.frames)});
     children.push_back({"camera '" + entry.name + "'", spawn(run), true, 0});
+  }
+  if (!camera_sets.empty()) {
+    spdlog::info("cell: the fuser owns robot.state.source {}; the cameras read {}",
+                 robot_state_origin_name(config.robot_state.source), camera_sets[1].substr(camera_sets[1].find('=') + 1));
   }
   spdlog::info("cell: {} cameras and the fuser started{}", config.cameras.size(),
                args.out.empty() ? "" : "; each camera's own run beside " + args.out);
