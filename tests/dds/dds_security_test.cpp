@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// DDS Security on loopback (docs/MULTICAMERA.md, "Security"): the test makes a CA, identities,
+// DDS Security on loopback, and across two network namespaces where the test may make them
+// (docs/MULTICAMERA.md, "Security"): the test makes a CA, identities,
 // a governance and permissions signed by the CA (make_dds_security.sh, openssl), and gives each
 // participant nothing but a CYCLONEDDS_URI with a <Security> block, as a cell's processes are
 // given theirs. Then a camera with a certificate of the cell's CA reaches a secure reader; a
@@ -7,12 +8,15 @@
 // camera name, is refused: never matched, never heard; and a camera's certificate lets it publish
 // its own measurement topic only. Each participant is a process of its own (dds_security_peer):
 // Cyclone reads its configuration once per process. Without the plugins or openssl the tests
-// skip. Also here: the fuser's reader counts writers on unconfigured measurement topics.
+// skip. Also here: the fuser's reader counts writers on unconfigured measurement topics, and
+// its summary says so.
 #include "../support/child_process.hpp"
 #include "dds/measurement_endpoints.hpp"
 #include "dds_test_util.hpp"
+#include "hrcsense/sinks/sinks.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -25,6 +29,7 @@
 #include <fstream>
 #include <memory>
 #include <set>
+#include <utility>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -405,6 +410,29 @@ TEST(UnconfiguredMeasurementTopics, AWriterOnAnUnconfiguredCameraNameIsCountedOn
   EXPECT_EQ(reader.writers(0), 1);
   EXPECT_EQ(reader.unconfigured_publishers(), 1);
   EXPECT_EQ(reader.last_unconfigured_topic(), "/count_cell/measurement/intruder");
+}
+
+TEST(UnconfiguredMeasurementTopics, TheFusedSummaryCarriesTheCountAndTheLastTopic) {
+  // Beside the per-camera intake, in a fused run's summary only (docs/OUTPUT.md).
+  std::ostringstream out;
+  JsonLinesSink sink(out);
+  RunSummary fused;
+  fused.cameras.push_back(RunSummary::CameraIntake{});
+  fused.cameras.back().name = "front";
+  sink.summary(fused);
+  fused.unconfigured_measurement_publishers = 2;
+  fused.last_unconfigured_measurement_topic = "/hrcsense/measurement/intruder";
+  sink.summary(fused);
+  sink.summary(RunSummary{});  // a single camera's run
+  std::istringstream lines(out.str());
+  std::vector<nlohmann::json> summaries;
+  for (std::string line; std::getline(lines, line);) summaries.push_back(nlohmann::json::parse(line));
+  ASSERT_EQ(summaries.size(), 3U);
+  EXPECT_EQ(summaries[0]["unconfigured_measurement_publishers"], 0);
+  EXPECT_TRUE(summaries[0]["last_unconfigured_measurement_topic"].is_null());
+  EXPECT_EQ(summaries[1]["unconfigured_measurement_publishers"], 2);
+  EXPECT_EQ(summaries[1]["last_unconfigured_measurement_topic"], "/hrcsense/measurement/intruder");
+  EXPECT_FALSE(summaries[2].contains("unconfigured_measurement_publishers"));
 }
 
 }  // namespace hrcsense::security_test
