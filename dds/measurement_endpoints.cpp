@@ -85,6 +85,7 @@ void MeasurementSink::frame(const FrameResult& result) {
 struct MeasurementReader::Dds {
   ParticipantScope scope;
   std::vector<dds_entity_t> readers;
+  dds_entity_t publications = 0;  ///< the built-in DCPSPublication reader: every writer discovered
   dds_entity_t waitset = 0;
   explicit Dds(uint32_t domain_id) : scope(domain_id) {}
 };
@@ -92,7 +93,14 @@ struct MeasurementReader::Dds {
 MeasurementReader::MeasurementReader(uint32_t domain_id, const std::string& node_namespace,
                                      const std::vector<std::string>& camera_names) {
   for (const std::string& name : camera_names) topics_.push_back(measurement_topic(node_namespace, name));
+  const std::string probe = measurement_topic(node_namespace, "x");
+  measurement_prefix_ = dds_topic_name(probe.substr(0, probe.size() - 1));
   dds_ = std::make_unique<Dds>(domain_id);
+  // Not attached to the waitset: discovery is counted when measurements are taken, and a
+  // stream of foreign writers must not wake the fuser.
+  dds_->publications = dds_->scope.own(
+      dds_create_reader(dds_->scope.participant(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr),
+      "DDS reader of the built-in DCPSPublication topic");
   dds_->waitset = dds_->scope.own(dds_create_waitset(dds_->scope.participant()), "DDS waitset");
   // Best-effort keep-last 8: matches reliable and best-effort writers; a fuser that falls behind
   // reads the newest eight of each camera, never an unbounded backlog.
@@ -125,8 +133,38 @@ int32_t MeasurementReader::writers(size_t i) const {
   return static_cast<int32_t>(matched.current_count);
 }
 
+void MeasurementReader::take_publications() {
+  // Bounded: at most 64 batches a call; what is left waits for the next take().
+  for (int batch = 0; batch < 64; ++batch) {
+    std::array<void*, kMeasurementTake> samples{};
+    std::array<dds_sample_info_t, kMeasurementTake> infos{};
+    const dds_return_t n = dds_take(dds_->publications, samples.data(), infos.data(), kMeasurementTake, kMeasurementTake);
+    if (n <= 0) break;
+    for (size_t i = 0; i < static_cast<size_t>(n); ++i) {
+      // A writer is an instance of DCPSPublication: counted once, when first seen (NEW), not
+      // again when its QoS changes or it goes.
+      if (!infos[i].valid_data || infos[i].view_state != DDS_NEW_VIEW_STATE) continue;
+      bool again = false;
+      for (size_t j = 0; j < i; ++j) again = again || infos[j].instance_handle == infos[i].instance_handle;
+      const auto* writer = static_cast<const dds_builtintopic_endpoint_t*>(samples[i]);
+      if (again || writer->topic_name == nullptr) continue;
+      const std::string name(writer->topic_name);
+      if (name.size() <= measurement_prefix_.size() || name.compare(0, measurement_prefix_.size(), measurement_prefix_) != 0) {
+        continue;
+      }
+      const std::string ros_topic = name.substr(2);  // without "rt"
+      if (std::find(topics_.begin(), topics_.end(), ros_topic) != topics_.end()) continue;
+      ++unconfigured_publishers_;
+      last_unconfigured_topic_ = ros_topic;
+    }
+    dds_return_loan(dds_->publications, samples.data(), n);
+    if (n < static_cast<dds_return_t>(kMeasurementTake)) break;
+  }
+}
+
 size_t MeasurementReader::take(
     const std::function<void(size_t topic, const CameraMeasurement& m, const std::string& problem)>& received) {
+  take_publications();
   size_t count = 0;
   for (size_t t = 0; t < dds_->readers.size(); ++t) {
     for (;;) {

@@ -68,7 +68,9 @@ class MeasurementSink final : public Sink {
 
 /// Reads `<namespace>/measurement/<name>` for each configured camera name (best-effort, so
 /// that reliable and best-effort writers both match; keep-last 8). Not thread-safe: one
-/// thread waits and takes.
+/// thread waits and takes. It also watches DDS discovery (the built-in DCPSPublication topic)
+/// for writers on `<namespace>/measurement/<x>` with x no configured camera: they are never
+/// read, only counted, so that an operator sees a misnamed or foreign camera in the summary.
 class MeasurementReader {
  public:
   MeasurementReader(uint32_t domain_id, const std::string& node_namespace, const std::vector<std::string>& camera_names);
@@ -87,10 +89,19 @@ class MeasurementReader {
   const std::vector<std::string>& topics() const { return topics_; }
   /// Writers matched on topic `i` now.
   int32_t writers(size_t i) const;
+  /// Writers discovered so far on `<namespace>/measurement/<x>`, x no configured camera (each
+  /// writer once; updated by take()).
+  int64_t unconfigured_publishers() const { return unconfigured_publishers_; }
+  /// The ROS topic of the last of them ("/hrcsense/measurement/intruder"), empty before one.
+  const std::string& last_unconfigured_topic() const { return last_unconfigured_topic_; }
 
  private:
   struct Dds;
+  void take_publications();
   std::vector<std::string> topics_;
+  std::string measurement_prefix_;  ///< the DDS topic names' common start, "rt/hrcsense/measurement/"
+  int64_t unconfigured_publishers_ = 0;
+  std::string last_unconfigured_topic_;
   std::unique_ptr<Dds> dds_;
   CameraMeasurement scratch_;
 };

@@ -170,6 +170,8 @@ class Fuser {
       if (!c.last_problem.empty()) in.last_problem = c.last_problem;
     }
     summary.cameras = intake_;
+    summary.unconfigured_measurement_publishers = reader_.unconfigured_publishers();
+    summary.last_unconfigured_measurement_topic = reader_.last_unconfigured_topic();
     if (!added_us_.empty()) {
       std::sort(added_us_.begin(), added_us_.end());
       spdlog::info("fuse: the fuser added p50 {:.0f} µs, p99 {:.0f} µs beyond the last camera's publication "

@@ -100,6 +100,10 @@ struct RunSummary {
     std::string last_problem;
   };
   std::vector<CameraIntake> cameras;
+  /// A fused cell: writers discovered on `<ns>/measurement/<x>`, x no configured camera (never
+  /// read), and the last such topic.
+  int64_t unconfigured_measurement_publishers = 0;
+  std::string last_unconfigured_measurement_topic;
 };
 
 /// A consumer of results. One of the four virtual interfaces of hrcsense (listed at the top of source.hpp).

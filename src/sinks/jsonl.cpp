@@ -464,6 +464,8 @@ void JsonLinesSink::summary(const RunSummary& summary) {
       line_ += '}';
     }
     line_ += ']';
+    m.integer("unconfigured_measurement_publishers", summary.unconfigured_measurement_publishers);
+    m.text_or_null("last_unconfigured_measurement_topic", summary.last_unconfigured_measurement_topic);
   }
   put_robot_state_counters(m, summary.robot_state, summary.robot_status);
   put_record_counters(m, app.record);
