@@ -421,8 +421,8 @@ void log_frame_times(const LoopState& s, const ViewTap& tap) {
 // --fused: what the status strip reads of the fused verdict and pair, as a ViewFrame: the
 // verdict is the fuser's (never the viewer's own); none yet, or one older than
 // max_frame_age_s, is NO DATA (shown_state).
-void fused_status_frame(const ros2::FusedView& view, const FusedPair& pair, int64_t polls, ViewFrame& frame) {
-  frame.frame = view.verdict.received ? polls : -1;
+void fused_status_frame(const ros2::FusedView& view, const FusedPair& pair, int64_t verdicts, ViewFrame& frame) {
+  frame.frame = view.verdict.received ? verdicts : -1;
   frame.made_ns = view.verdict.received_steady_ns;
   frame.timestamp_ns = view.verdict.stamp_ns;
   frame.valid = view.verdict.received;
@@ -484,7 +484,8 @@ int run_fused_viewer(const ViewArgs& args, const Config& config) {
   ViewStats stats;
   OrbitCamera orbit = fused_default_orbit(reader.view());
   const int64_t start_ns = steady_ns();
-  int64_t polls = 0, drawn = 0;
+  int64_t verdicts = 0, drawn = 0, last_verdict_stamp_ns = -1;
+  Timeline timeline(kTimelineSeconds);
   int exit_code = 0;
   bool reset_orbit = false;
   PaneMode mode = PaneMode::view_3d;
@@ -492,10 +493,18 @@ int run_fused_viewer(const ViewArgs& args, const Config& config) {
     glfwPollEvents();
     if (g_quit.load() || glfwWindowShouldClose(window)) break;
     const ros2::FusedView& view = reader.poll(seconds_to_ns(1.0 / 60.0), steady_ns());
-    ++polls;
     const FusedPair pair = fused_closest_pair(view);
     const std::vector<FusedCameraRow> rows = fused_camera_rows(view, shared_clock_ns());
-    fused_status_frame(view, pair, polls, frame);
+    // Each new fused verdict on the strip's timeline: its distance and verdict, as the fuser sent.
+    if (view.verdict.received && view.verdict.stamp_ns != last_verdict_stamp_ns) {
+      last_verdict_stamp_ns = view.verdict.stamp_ns;
+      ++verdicts;
+      const bool contact = std::isfinite(view.verdict.distance_m);
+      timeline.add(TimelinePoint{view.verdict.stamp_ns, view.verdict.received_steady_ns,
+                                 contact ? view.verdict.distance_m : -1.0F, view.verdict.verdict, 0.0});
+      stats.timeline = timeline.points();
+    }
+    fused_status_frame(view, pair, verdicts, frame);
     if (std::exchange(reset_orbit, false)) orbit = fused_default_orbit(view);
     orbit_drag(orbit, std::exchange(g_drag_x, 0.0F), std::exchange(g_drag_y, 0.0F));
     orbit_zoom(orbit, std::exchange(g_wheel, 0.0F));
