@@ -18,8 +18,10 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
-#include <thread>
+#include <algorithm>
+#include <array>
+#include <string>
+#include <vector>
 
 namespace hrcsense::fused_view_dds_test {
 namespace {

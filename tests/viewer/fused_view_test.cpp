@@ -7,7 +7,9 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace hrcsense::fused_view_test {
 namespace {
