@@ -4,6 +4,7 @@
 
 #include "dds/ros2_messages.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -232,6 +233,22 @@ void fill_point_cloud(const std::vector<uint8_t>& bytes, int64_t stamp_ns, const
   out.data._length = out.data._maximum = static_cast<uint32_t>(count * kCloudPointStep);
   out.data._release = false;
   out.is_dense = true;  // pack_xyz's points are measured ones: no NaN
+}
+
+void fill_depth_image_16uc1(const uint16_t* pixels_mm, int width, int height, int64_t stamp_ns,
+                            const std::string& frame_id, sensor_msgs_msg_dds__Image_& out) {
+  out = sensor_msgs_msg_dds__Image_{};
+  out.header.stamp = stamp_from_ns(stamp_ns);
+  out.header.frame_id = output_text(frame_id);
+  out.width = static_cast<uint32_t>(std::max(width, 0));
+  out.height = static_cast<uint32_t>(std::max(height, 0));
+  out.encoding = const_cast<char*>("16UC1");
+  out.is_bigendian = 0;
+  out.step = 2U * out.width;
+  // dds_write only reads the pixels.
+  out.data._buffer = reinterpret_cast<uint8_t*>(const_cast<uint16_t*>(pixels_mm));
+  out.data._length = out.data._maximum = out.step * out.height;
+  out.data._release = false;
 }
 
 MarkerColor verdict_color(VerdictState state, float alpha) {

@@ -95,6 +95,13 @@ void pack_xyz(const PointCloud& points, std::vector<uint8_t>& bytes);
 void fill_point_cloud(const std::vector<uint8_t>& bytes, int64_t stamp_ns, const std::string& frame_id,
                       std::array<sensor_msgs_msg_dds__PointField_, 3>& fields, sensor_msgs_msg_dds__PointCloud2_& out);
 
+/// A sensor_msgs/Image over `width` × `height` 16-bit depth pixels in millimetres (encoding
+/// 16UC1, little-endian, step 2·width): points `out` at `pixels_mm` (width·height values) and
+/// `frame_id`, which must outlive it; nothing needs freeing. `hrcsense publish`'s depth image
+/// and a cell camera's depth preview are both made here.
+void fill_depth_image_16uc1(const uint16_t* pixels_mm, int width, int height, int64_t stamp_ns,
+                            const std::string& frame_id, sensor_msgs_msg_dds__Image_& out);
+
 /// visualization_msgs/Marker's numbers used here.
 enum MarkerType : int32_t { kMarkerSphere = 2, kMarkerCylinder = 3, kMarkerLineList = 5, kMarkerText = 9 };
 enum MarkerAction : int32_t { kMarkerAdd = 0, kMarkerDeleteAll = 3 };

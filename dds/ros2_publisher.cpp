@@ -3,6 +3,7 @@
 #include "dds/ros2_publisher.hpp"
 
 #include "dds/dds_entity.hpp"
+#include "dds/ros2_output_messages.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -82,13 +83,7 @@ void Ros2CameraPublisher::publish(const Frame& frame) {
     pixels = depth_mm_.data();
   }
   sensor_msgs_msg_dds__Image_ image{};
-  image.header.stamp = stamp_from_ns(frame.timestamp_ns);
-  image.header.frame_id = const_cast<char*>(depth_frame_id_.c_str());
-  image.width = static_cast<uint32_t>(depth.width);
-  image.height = static_cast<uint32_t>(depth.height);
-  image.encoding = const_cast<char*>("16UC1");
-  image.step = 2U * image.width;
-  point_image(image, pixels, image.step * image.height);
+  fill_depth_image_16uc1(pixels, depth.width, depth.height, frame.timestamp_ns, depth_frame_id_, image);
   check_dds(dds_write(dds_->depth, &image), "DDS write on " + topics_.depth_image);
 
   sensor_msgs_msg_dds__CameraInfo_ info{};

@@ -30,6 +30,8 @@ bool clip_to(float q, float dq, float& t0, float& t1) {
   return t0 <= t1;
 }
 
+}  // namespace
+
 // A segment between two orbit-camera points, cut at the near plane and then to the image
 // (plus a margin for the line's width), drawn as a DDA line of 2·half_width + 1 pixels.
 // The cuts keep the loop short whatever the ends' projections (a point just past the near
@@ -66,6 +68,27 @@ void draw_segment(ColorImage& image, const Intrinsics& in, const Eigen::Vector3f
     }
   }
 }
+
+// The robot as compose_2d() draws it: brightened halfway to white, the edge exact.
+void draw_robot_pixels(const std::vector<uint8_t>& robot, ColorImage& out) {
+  const int w = out.width;
+  const int h = out.height;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const size_t i = static_cast<size_t>(v) * w + u;
+      if (!robot[i]) continue;
+      const bool edge = u == 0 || v == 0 || u == w - 1 || v == h - 1 || !robot[i - 1] || !robot[i + 1] ||
+                        !robot[i - w] || !robot[i + w];
+      if (edge) {
+        put_pixel(out, u, v, kRobotOutline);
+      } else {
+        for (int c = 0; c < 3; ++c) out.rgb[3 * i + c] = static_cast<uint8_t>((out.rgb[3 * i + c] + 255) / 2);
+      }
+    }
+  }
+}
+
+namespace {
 
 Extrinsics to_extrinsics(const Eigen::Isometry3f& T) {
   Extrinsics e;
@@ -153,25 +176,9 @@ void draw_foreground(const ViewFrame& frame, const ViewCamera& camera, ColorImag
   }
 }
 
-// The robot as compose_2d() draws it: brightened halfway to white, the edge exact.
 void draw_robot(const ViewFrame& frame, const ViewCamera& camera, Cloud3dScratch& scratch, ColorImage& out) {
   robot_mask(frame.capsules_base, frame.T_camera_base, camera, scratch.robot);
-  const std::vector<uint8_t>& robot = scratch.robot;
-  const int w = out.width;
-  const int h = out.height;
-  for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      const size_t i = static_cast<size_t>(v) * w + u;
-      if (!robot[i]) continue;
-      const bool edge = u == 0 || v == 0 || u == w - 1 || v == h - 1 || !robot[i - 1] || !robot[i + 1] ||
-                        !robot[i - w] || !robot[i + w];
-      if (edge) {
-        put_pixel(out, u, v, kRobotOutline);
-      } else {
-        for (int c = 0; c < 3; ++c) out.rgb[3 * i + c] = static_cast<uint8_t>((out.rgb[3 * i + c] + 255) / 2);
-      }
-    }
-  }
+  draw_robot_pixels(scratch.robot, out);
 }
 
 void draw_contact(const ViewFrame& frame, const ViewCamera& camera, ColorImage& out) {

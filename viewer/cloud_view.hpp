@@ -80,6 +80,16 @@ Pose orbit_T_view_base(const OrbitCamera& camera);
 /// points go to the base frame and then into the orbit camera.
 ViewCamera orbit_view_camera(const ViewFrame& frame, const OrbitCamera& camera, int width, int height);
 
+/// A line between two points of the orbit camera's optical frame, cut at its near plane and at
+/// the image (`in`: orbit_view_camera's intrinsics), 2·half_width + 1 pixels wide.
+void draw_segment(ColorImage& image, const Intrinsics& in, const Eigen::Vector3f& a_view, const Eigen::Vector3f& b_view,
+                  int half_width, const Rgb& color);
+
+/// The robot's pixels (`robot`: robot_mask() of `out`'s size) brightened halfway to white, its
+/// edge pixels (a robot pixel with a 4-neighbour that is not, or on the image border) exactly
+/// kRobotOutline.
+void draw_robot_pixels(const std::vector<uint8_t>& robot, ColorImage& out);
+
 /// Reusable buffers of compose_3d(): sized on the first call of an image size, reused after.
 struct Cloud3dScratch {
   std::vector<float> zbuffer;  ///< orbit-camera z per output pixel, metres

@@ -7,6 +7,7 @@
 // back through a ControlInbox and a recording's pause, step and seek through a PlaybackControl. Headless: --snapshot DIR
 // --snapshot-at LIST writes PNGs from an offscreen framebuffer and exits after the last.
 #include "viewer/cloud_view.hpp"
+#include "viewer/fused_view.hpp"
 #include "viewer/gl_panels.hpp"
 #include "viewer/gl_renderer.hpp"
 #include "viewer/playback.hpp"
@@ -17,8 +18,13 @@
 #include "common/app_errors.hpp"
 #include "common/run_session.hpp"
 
+#include "hrcsense/clock.hpp"
 #include "hrcsense/config/config.hpp"
 #include "hrcsense/io/io.hpp"
+
+#if HRCSENSE_HAVE_DDS
+#include "dds/fused_view_reader.hpp"
+#endif
 
 #include <CLI/CLI.hpp>
 #include <GLFW/glfw3.h>
@@ -63,6 +69,8 @@ struct ViewArgs {
   std::string snapshot_at;
   std::string pane = "2d";
   int slow_render_ms = 0;  ///< hidden: a deliberately slow renderer (tests of the mailbox)
+  bool fused = false;      ///< --fused: a cell's cameras read off DDS, no pipeline of its own
+  double snapshot_wait_s = 10.0;  ///< --fused --snapshot: how long to wait for every camera
 };
 
 // Set by GLFW's callbacks (main thread), read by the loop. Keys typed into an ImGui field
@@ -408,8 +416,157 @@ void log_frame_times(const LoopState& s, const ViewTap& tap) {
                nearest_rank(s.compose_times_ms, 0.5));
 }
 
+
+#if HRCSENSE_HAVE_DDS
+// --fused: what the status strip reads of the fused verdict and pair, as a ViewFrame: the
+// verdict is the fuser's (never the viewer's own); none yet, or one older than
+// max_frame_age_s, is NO DATA (shown_state).
+void fused_status_frame(const ros2::FusedView& view, const FusedPair& pair, int64_t verdicts, ViewFrame& frame) {
+  frame.frame = view.verdict.received ? verdicts : -1;
+  frame.made_ns = view.verdict.received_steady_ns;
+  frame.timestamp_ns = view.verdict.stamp_ns;
+  frame.valid = view.verdict.received;
+  frame.verdict.state = view.verdict.verdict;
+  frame.verdict.code = static_cast<ReasonCode>(view.verdict.reason_code);
+  frame.contact = Contact{};
+  frame.contact.valid = pair.valid;
+  frame.contact.distance_m = pair.distance_m;
+  frame.contact.closest_base = pair.closest_base;
+  frame.contact.closest_robot_base = pair.closest_robot_base;
+  frame.contact.robot_link = pair.link;
+  frame.foreground_points = 0;
+  for (const ros2::FusedCameraView& camera : view.cameras) frame.foreground_points += camera.cloud_base.size();
+}
+
+ros2::FusedViewParams fused_view_params(const Config& config) {
+  ros2::FusedViewParams params;
+  params.domain_id = static_cast<uint32_t>(config.ros2.domain_id);
+  params.node_namespace = config.ros2.node_namespace;
+  for (const CameraEntry& entry : config.cameras) {
+    params.cameras.push_back({entry.name, entry.T_base_camera, entry.intrinsics.value_or(Intrinsics{})});
+  }
+  return params;
+}
+
+// Every camera has sent a measurement, a cloud and a preview.
+bool fused_view_complete(const ros2::FusedView& view, std::string& missing) {
+  missing.clear();
+  for (const ros2::FusedCameraView& camera : view.cameras) {
+    if (!camera.measurement || camera.cloud_stamp_ns == 0 || camera.preview.width == 0) {
+      missing += (missing.empty() ? "" : ", ") + camera.name;
+    }
+  }
+  return missing.empty();
+}
+
+// The fused view: no pipeline, one 3D pane of every camera's outputs, the camera list, the
+// fused verdict in the border. Headless (--snapshot DIR): one DIR/fused.png once every camera
+// and the fuser's verdict have been heard (or --snapshot-wait-s passed: exit code 1 when a camera
+// is missing, naming it; a missing verdict is a warning, the picture then says NO DATA).
+int run_fused_viewer(const ViewArgs& args, const Config& config) {
+  if (config.cameras.empty()) {
+    const std::string where = args.config_path.empty() ? std::string("configuration") : args.config_path;
+    throw ConfigError(where + ": --fused needs a cell configuration with `cameras:` (docs/MULTICAMERA.md)");
+  }
+  const bool snapshot = !args.snapshot_dir.empty();
+  if (snapshot) std::filesystem::create_directories(args.snapshot_dir);
+  ros2::FusedViewReader reader(fused_view_params(config));
+  spdlog::info("fused view: {} cameras under {} on domain {}", config.cameras.size(), config.ros2.node_namespace,
+               config.ros2.domain_id);
+  Renderer renderer;
+  GLFWwindow* window = open_renderer(snapshot, renderer);
+  if (window == nullptr) return kExitNoDisplay;
+  ViewFrame frame;
+  frame.slow_distance_m = config.pipeline.safety.slow_distance_m;
+  frame.stop_distance_m = config.pipeline.safety.stop_distance_m;
+  ColorImage pane, picture;
+  FusedScratch scratch;
+  ViewStats stats;
+  OrbitCamera orbit = fused_default_orbit(reader.view());
+  const int64_t start_ns = steady_ns();
+  int64_t verdicts = 0, drawn = 0, last_verdict_stamp_ns = -1;
+  Timeline timeline(kTimelineSeconds);
+  int exit_code = 0;
+  bool reset_orbit = false;
+  PaneMode mode = PaneMode::view_3d;
+  while (true) {
+    glfwPollEvents();
+    if (g_quit.load() || glfwWindowShouldClose(window)) break;
+    const ros2::FusedView& view = reader.poll(seconds_to_ns(1.0 / 60.0), steady_ns());
+    const FusedPair pair = fused_closest_pair(view);
+    const std::vector<FusedCameraRow> rows = fused_camera_rows(view, shared_clock_ns());
+    // Each new fused verdict on the strip's timeline: its distance and verdict, as the fuser sent.
+    if (view.verdict.received && view.verdict.stamp_ns != last_verdict_stamp_ns) {
+      last_verdict_stamp_ns = view.verdict.stamp_ns;
+      ++verdicts;
+      const bool contact = std::isfinite(view.verdict.distance_m);
+      timeline.add(TimelinePoint{view.verdict.stamp_ns, view.verdict.received_steady_ns,
+                                 contact ? view.verdict.distance_m : -1.0F, view.verdict.verdict, 0.0});
+      stats.timeline = timeline.points();
+    }
+    fused_status_frame(view, pair, verdicts, frame);
+    if (std::exchange(reset_orbit, false)) orbit = fused_default_orbit(view);
+    orbit_drag(orbit, std::exchange(g_drag_x, 0.0F), std::exchange(g_drag_y, 0.0F));
+    orbit_zoom(orbit, std::exchange(g_wheel, 0.0F));
+    int width = kSnapshotWidth, height = kSnapshotHeight;
+    if (!snapshot) glfwGetFramebufferSize(window, &width, &height);
+    const PaneRects rects = window_panes(mode, width, height);
+    compose_fused_3d(view, fused_robot_capsules(view, config.pipeline.robot), pair, orbit, rects.cloud_3d.width,
+                     rects.cloud_3d.height, scratch, pane);
+    const PaneImages panes{mode, nullptr, &pane};
+    const ShownState state = shown_state(frame, steady_ns(), config.pipeline.safety.max_frame_age_s);
+    ++drawn;
+    stats.display_fps = static_cast<double>(drawn) / std::max(1e-9, static_cast<double>(steady_ns() - start_ns) * 1e-9);
+    const auto list = [&] { draw_fused_camera_list(rows, pair); };
+    if (snapshot) {
+      std::string missing;
+      const bool complete = fused_view_complete(view, missing);
+      const bool timed_out = static_cast<double>(steady_ns() - start_ns) * 1e-9 > args.snapshot_wait_s;
+      // The fuser's verdict too, when it publishes one: a picture without it says NO DATA.
+      if (!(complete && view.verdict.received) && !timed_out) continue;
+      if (!complete) {
+        spdlog::error("fused view: nothing (measurement, cloud and preview) from {} within {:g} s", missing,
+                      args.snapshot_wait_s);
+        exit_code = 1;
+      }
+      if (!view.verdict.received) spdlog::warn("fused view: no fused verdict within {:g} s (NO DATA)", args.snapshot_wait_s);
+      // Twice: ImGui sizes an auto-resized window on its first frame and shows it on the next.
+      renderer.snapshot(frame, panes, state, stats, width, height, picture, list);
+      if (!renderer.snapshot(frame, panes, state, stats, width, height, picture, list)) {
+        spdlog::error("snapshot: the offscreen framebuffer could not be made");
+        exit_code = 1;
+        break;
+      }
+      const std::string path = (std::filesystem::path(args.snapshot_dir) / "fused.png").string();
+      write_color_png(path, picture);
+      spdlog::info("snapshot: {} ({}, closest {})", path, state_word(state),
+                   pair.valid ? std::to_string(pair.distance_m) + " m by " + pair.camera : std::string("none"));
+      break;
+    }
+    if (g_screenshot.exchange(false)) {
+      renderer.snapshot(frame, panes, state, stats, kSnapshotWidth, kSnapshotHeight, picture, list);
+      write_color_png("fused.png", picture);
+    }
+    renderer.draw(frame, panes, state, stats, width, height, list);
+    glfwSwapBuffers(window);
+  }
+  renderer.shutdown();
+  glfwDestroyWindow(window);
+  glfwTerminate();
+  return exit_code;
+}
+#endif
+
 int run_viewer(const ViewArgs& args) {
   const Config config = load_config(args.config_path, args.sets);
+  if (args.fused) {
+#if HRCSENSE_HAVE_DDS
+    return run_fused_viewer(args, config);
+#else
+    throw ConfigError("--fused: this hrcsense-view was built without Cyclone DDS; install cyclonedds-dev and "
+                      "cyclonedds-tools (scripts/setup does) and rebuild");
+#endif
+  }
   const bool snapshots = !args.snapshot_dir.empty();
   std::set<int64_t> snapshot_frames;
   if (snapshots) {
@@ -480,6 +637,12 @@ int main(int argc, char** argv) {
   app.add_option("--snapshot", args.snapshot_dir, "headless: write DIR/frame_%06d.png (1280x720) at --snapshot-at");
   app.add_option("--snapshot-at", args.snapshot_at, "comma-separated source frame indices for --snapshot");
   app.add_option("--pane", args.pane, "what the window shows: 2d (default), 3d or split (key v cycles)");
+  app.add_flag("--fused", args.fused,
+               "a cell with several cameras: show every camera's cloud, preview and age and the fused verdict, read "
+               "over DDS (no pipeline of its own; docs/VIEWER.md)");
+  app.add_option("--snapshot-wait-s", args.snapshot_wait_s,
+                 "with --fused --snapshot: wait at most this long for every camera (default 10)")
+      ->check(CLI::Range(0.1, 600.0));
   app.add_option("--slow-render-ms", args.slow_render_ms, "testing: sleep this long per frame drawn")
       ->group("")
       ->check(CLI::Range(0, 10'000));

@@ -199,4 +199,43 @@ void Panels::draw_background_and_save() {
   }
 }
 
+void draw_fused_camera_list(const std::vector<FusedCameraRow>& rows, const FusedPair& pair) {
+  ImGui::SetNextWindowPos(ImVec2(20.0F, 20.0F), ImGuiCond_Always);
+  ImGui::SetNextWindowBgAlpha(0.8F);
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove |
+                                 ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings;
+  if (!ImGui::Begin("cameras", nullptr, flags)) {
+    ImGui::End();
+    return;
+  }
+  for (const FusedCameraRow& row : rows) {
+    const ImVec4 color(row.color[0] / 255.0F, row.color[1] / 255.0F, row.color[2] / 255.0F, 1.0F);
+    ImGui::TextColored(color, "%-10s", row.name.c_str());
+    ImGui::SameLine();
+    if (row.age_ms) {
+      ImGui::Text("%7.0f ms", *row.age_ms);
+    } else {
+      ImGui::Text("%7s ms", "-");
+    }
+    ImGui::SameLine();
+    if (row.valid) {
+      ImGui::Text("valid    %6zu points", row.cloud_points);
+    } else {
+      ImGui::TextColored(ImVec4(1.0F, 0.35F, 0.35F, 1.0F), "invalid (%d) %s", row.reason_code, row.reason.c_str());
+    }
+    if (row.rejected > 0) {
+      ImGui::SameLine();
+      ImGui::Text("[%lld unreadable]", static_cast<long long>(row.rejected));
+    }
+  }
+  ImGui::Separator();
+  if (pair.valid) {
+    ImGui::Text("closest: %.3f m, link %d, seen by %s", static_cast<double>(pair.distance_m), pair.link,
+                pair.camera.c_str());
+  } else {
+    ImGui::Text("closest: none (no valid camera sees anything)");
+  }
+  ImGui::End();
+}
+
 }  // namespace hrcsense::view

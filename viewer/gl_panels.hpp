@@ -6,6 +6,7 @@
 // ControlInbox, between frames.
 #pragma once
 
+#include "viewer/fused_view.hpp"
 #include "viewer/playback.hpp"
 #include "viewer/view_control.hpp"
 #include "viewer/view_model.hpp"
@@ -55,5 +56,11 @@ class Panels {
   bool confirm_relearn_ = false;
   bool edited_ = false;  ///< a slider was released after a change this frame
 };
+
+/// `--fused`: the list of the cell's cameras (a window at the top left, always open): per camera
+/// its name in its colour, the age of its newest measurement in ms, valid or its reason code and
+/// reason, the points of its newest cloud, and how many samples could not be read; then the
+/// fused closest pair and whose it is. Inside an ImGui frame.
+void draw_fused_camera_list(const std::vector<FusedCameraRow>& rows, const FusedPair& pair);
 
 }  // namespace hrcsense::view

@@ -317,7 +317,7 @@ void Renderer::draw_timeline(ImDrawList* draw, const ViewFrame& frame, const Vie
 }
 
 bool Renderer::snapshot(const ViewFrame& frame, const PaneImages& panes, ShownState state, const ViewStats& stats,
-                        int width, int height, ColorImage& out) {
+                        int width, int height, ColorImage& out, const std::function<void()>& panels) {
   if (fbo_ == 0 || fbo_width_ != width || fbo_height_ != height) {
     if (fbo_ != 0) glDeleteFramebuffers(1, &fbo_);
     if (fbo_texture_ != 0) glDeleteTextures(1, &fbo_texture_);
@@ -335,7 +335,7 @@ bool Renderer::snapshot(const ViewFrame& frame, const PaneImages& panes, ShownSt
     fbo_height_ = height;
   }
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-  draw(frame, panes, state, stats, width, height);
+  draw(frame, panes, state, stats, width, height, panels);
   glFinish();
   std::vector<uint8_t> rows(static_cast<size_t>(width) * height * 3);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);

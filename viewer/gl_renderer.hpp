@@ -57,10 +57,10 @@ class Renderer {
   /// the status strip; then `panels` (ImGui calls, may be empty) inside the same ImGui frame.
   void draw(const ViewFrame& frame, const PaneImages& panes, ShownState state, const ViewStats& stats, int width,
             int height, const std::function<void()>& panels = {});
-  /// Draws the same, without panels, into an offscreen framebuffer of width × height and
+  /// Draws the same (with `panels`, usually none) into an offscreen framebuffer of width × height and
   /// reads it back into `out` (rgb8, top row first). False when the framebuffer cannot be made.
   bool snapshot(const ViewFrame& frame, const PaneImages& panes, ShownState state, const ViewStats& stats, int width,
-                int height, ColorImage& out);
+                int height, ColorImage& out, const std::function<void()>& panels = {});
 
  private:
   /// A GL texture of a pane's image, re-allocated when the image's size changes.

@@ -11,6 +11,7 @@
 #include "hrcsense/net/udp_json.hpp"
 
 #if HRCSENSE_HAVE_DDS
+#include "dds/camera_previews.hpp"
 #include "dds/measurement_endpoints.hpp"
 #include "dds/ros2_camera_source.hpp"
 #include "dds/ros2_cell_clock.hpp"
@@ -378,10 +379,52 @@ std::unique_ptr<RtdeLinkSink> make_rtde_link_sink(const Config& config, const Ru
   }
 }
 
+namespace {
+
+#if HRCSENSE_HAVE_DDS
+// `run --camera NAME` with ros2.publish: no verdict, markers or TF of its own (the fuser
+// publishes those), only what a viewer shows of the camera: its cloud and a depth preview.
+Ros2Outputs make_camera_preview_outputs(const Config& config) {
+  const Ros2Config& ros2 = config.ros2;
+  ros2::CameraPreviewParams params;
+  params.domain_id = static_cast<uint32_t>(ros2.domain_id);
+  params.node_namespace = ros2.node_namespace;
+  params.camera_name = config.camera;
+  params.base_frame = ros2::base_frame_id(config.pipeline.robot.base_frame);
+  params.cloud_hz = ros2.cloud_hz;
+  params.preview_hz = ros2.preview_hz;
+  params.decimation = ros2.preview_decimation;
+  std::unique_ptr<ros2::CameraPreviewSink> sink;
+  try {
+    sink = std::make_unique<ros2::CameraPreviewSink>(params);
+  } catch (const ros2::Ros2Error& e) {
+    throw ConfigError(config_where(config) + ": --camera " + config.camera + ": " + e.what());
+  }
+  const int width = config.source.width / std::max(ros2.preview_decimation, 1);
+  const int height = config.source.height / std::max(ros2.preview_decimation, 1);
+  spdlog::info("camera '{}': previews on {} (base frame, at most {:g} Hz) and {} ({}x{} 16UC1 at most {:g} Hz: {:.0f} kB/s)",
+               config.camera, sink->topics().foreground, ros2.cloud_hz, sink->topics().depth_preview, width, height,
+               ros2.preview_hz, static_cast<double>(ros2::depth_preview_bytes(width, height)) * ros2.preview_hz * 1e-3);
+  Ros2Outputs outputs;
+  outputs.on_processed = [tap = sink.get()](const Frame& frame, const Pipeline& pipeline, const FrameResult& result) {
+    tap->on_processed(frame, pipeline, result);
+  };
+  outputs.status = [view = sink.get()] {
+    const ros2::CameraPreviewCounters c = view->counters();
+    return Ros2OutputsStatus{0, 0, c.clouds, c.failed_writes, c.last_error};
+  };
+  outputs.sink = std::move(sink);
+  return outputs;
+}
+#endif
+
+}  // namespace
+
 Ros2Outputs make_ros2_output_sink(const Config& config) {
   const Ros2Config& ros2 = config.ros2;
   if (!ros2.publish) return {};
 #if HRCSENSE_HAVE_DDS
+  if (!config.camera.empty()) return make_camera_preview_outputs(config);
   ros2::Ros2OutputParams params;
   params.domain_id = static_cast<uint32_t>(ros2.domain_id);
   params.node_namespace = ros2.node_namespace;

@@ -153,6 +153,9 @@ struct Ros2Outputs {
 /// safety.max_frame_gap_periods / max_frame_age_s; with source.type ros2 the camera's own
 /// link → optical chain is read from its /tf_static first (up to 2 s). Logs what it publishes.
 /// Empty without ros2.publish; throws ConfigError in a build without Cyclone DDS, saying so.
+/// A camera of a cell (config.camera set) publishes none of these (the fuser does), only its
+/// previews for a viewer: its foreground cloud (at most ros2.cloud_hz) and a depth preview
+/// decimated by ros2.preview_decimation (at most ros2.preview_hz), dds/camera_previews.hpp.
 Ros2Outputs make_ros2_output_sink(const Config& config);
 
 /// `hrcsense run --camera NAME` (config.camera set): the camera's measurements on

@@ -138,6 +138,7 @@ std::unique_ptr<Cell> assemble_cell(const Config& config, const CellOptions& opt
   if (options.links && !config.camera.empty()) {
     // One camera of several: it measures for the fuser, which alone decides and sends.
     cell->measurements = make_measurement_sink(config);
+    ros2_tap = add_ros2_outputs(*cell, config);  // ros2.publish: the camera's previews only
   } else if (options.links) {
     add_links(*cell, config);
     ros2_tap = add_ros2_outputs(*cell, config);

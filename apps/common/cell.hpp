@@ -78,7 +78,8 @@ struct Cell {
   std::unique_ptr<Sink> ros2_outputs;
   std::function<Ros2OutputsStatus()> ros2_status;  ///< what ros2_outputs did (null without it)
   /// A camera of a cell with several (config.camera): its measurements for the fuser, in place
-  /// of every link and ROS 2 output (make_measurement_sink).
+  /// of every link and ROS 2 output (make_measurement_sink); with ros2.publish, ros2_outputs
+  /// holds only its previews for a viewer.
   std::unique_ptr<Sink> measurements;
   /// Simulated runs: the simulator that labels each result's truth (TruthLabeller).
   std::optional<Simulator> truth;
@@ -91,9 +92,10 @@ struct Cell {
 
   /// What run_pipeline reads: the recording when there is one, else the source.
   Source& frames() { return recording ? static_cast<Source&>(*recording) : *source; }
-  /// The links in the order they get each result: the controller first, then the ROS 2 outputs.
+  /// The links in the order they get each result: the controller first, then the ROS 2 outputs
+  /// (a cell camera: its measurement before its previews, so the fuser never waits for them).
   std::vector<Sink*> link_sinks() const {
-    return {udp_link.get(), rtde_link.get(), follow.get(), ros2_outputs.get(), measurements.get()};
+    return {udp_link.get(), rtde_link.get(), follow.get(), measurements.get(), ros2_outputs.get()};
   }
 };
 

@@ -401,6 +401,8 @@ void read_ros2(KeyReader& r, Config& c) {
   r.integer("ros2.domain_id", out.domain_id, 0, 232);
   ros2_name(r, "ros2.namespace", out.node_namespace, false);
   r.number_in("ros2.cloud_hz", out.cloud_hz, 0.0, 100.0, " Hz");
+  r.number_in("ros2.preview_hz", out.preview_hz, 0.0, 30.0, " Hz");
+  r.integer("ros2.preview_decimation", out.preview_decimation, 1, 16);
   ros2_name(r, "ros2.speed_scaling_topic", out.speed_scaling_topic, true);
   r.text("ros2.camera_name", out.camera_name);
   if (!ros2_token(out.camera_name)) {

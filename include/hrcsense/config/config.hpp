@@ -80,6 +80,12 @@ struct Ros2Config {
   int domain_id = 0;                       ///< `ros2.domain_id`: the DDS domain (ROS_DOMAIN_ID)
   std::string node_namespace = "/hrcsense";  ///< `ros2.namespace`: the topics' prefix
   double cloud_hz = 10.0;                  ///< `ros2.cloud_hz`: foreground clouds per second at most; 0: none
+  /// `ros2.preview_hz`: a camera of a cell (`run --camera NAME`) publishes its decimated depth
+  /// on <namespace>/<NAME>/depth_preview this often at most; 0: none.
+  double preview_hz = 5.0;
+  /// `ros2.preview_decimation`: the preview keeps one pixel per this many in each direction
+  /// (4: 848×480 → 212×120).
+  int preview_decimation = 4;
   /// `ros2.speed_scaling_topic`: an absolute name for the speed scaling output; empty:
   /// <namespace>/speed_scaling.
   std::string speed_scaling_topic;
