@@ -24,6 +24,7 @@ struct CommandArgs {
   double duration_s = -1.0;         ///< record --duration-s S; < 0: until --frames or the source's end
   bool overwrite = false;           ///< record / run --record: --overwrite replaces an existing recording
   std::string camera;               ///< run / calibrate --camera NAME: one entry of the scene's cameras:
+  bool write_back = false;          ///< calibrate --write-back: the poses into the --config file's entries
 };
 
 /// `hrcsense eval`'s flags (docs/EVALUATION.md).
