@@ -347,6 +347,11 @@ int calibrate_command(const CommandArgs& args) {
   } else {
     names.push_back(args.camera);
   }
+  if (args.write_back) {
+    // A form the edit cannot take is refused before the sweeps, not after them.
+    const std::string text = read_text(args.config_path);
+    for (const std::string& name : names) with_camera_pose_text(text, name, Pose::Identity(), args.config_path);
+  }
   std::vector<CameraRun> runs;
   for (const std::string& name : names) {
     if (StopSignals::stop_requested()) break;
