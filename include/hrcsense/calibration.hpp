@@ -20,6 +20,8 @@
 // 4. Its spread: a jackknife over groups of keyframes (what the poses disagree on, the
 //    kinematic model's errors included), not the far smaller formal covariance of correlated
 //    pixels.
+// 5. In a cell with several cameras, camera_agreement compares two calibrated cameras: at the arm
+//    poses both saw, each camera's points of a link fitted to the link's shapes by a translation.
 #pragma once
 
 #include "hrcsense/robot.hpp"
