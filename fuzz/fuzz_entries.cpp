@@ -242,6 +242,32 @@ bool stage_parameters_finite(const Config& c) {
 
 }  // namespace
 
+// `hrcsense calibrate --write-back`'s edit of the same text (with_camera_pose_text): a ConfigError
+// naming the file, or a text that load_config reads with the new pose for that entry.
+void check_pose_write_back(const std::string& text, const std::string& camera, const fs::path& path) {
+  static const fs::path edited_path =
+      fs::temp_directory_path() / ("hrcsense_fuzz_write_back_" + std::to_string(::getpid()) + ".yaml");
+  Pose T = Pose::Identity();
+  T.translation() = Eigen::Vector3d(0.25, -0.5, 1.75);
+  std::string edited;
+  try {
+    edited = with_camera_pose_text(text, camera, T, path.string());
+  } catch (const ConfigError& e) {
+    if (std::string(e.what()).find(path.string()) == std::string::npos) contract_broken("write-back error names no file", e.what());
+    return;
+  }
+  {
+    std::ofstream file(edited_path, std::ios::binary | std::ios::trunc);
+    file << edited;
+  }
+  const Config config = load_config(edited_path.string(), {});  // a ConfigError here escapes: a crash
+  for (const CameraEntry& entry : config.cameras) {
+    if (entry.name == camera && (entry.T_base_camera.translation() - T.translation()).norm() > 1e-5) {
+      contract_broken("write-back", "the edited entry does not read back the written pose");
+    }
+  }
+}
+
 Outcome run_config(const uint8_t* data, size_t size) {
   static const fs::path path = fs::temp_directory_path() / ("hrcsense_fuzz_config_" + std::to_string(::getpid()) + ".yaml");
   {
@@ -253,6 +279,8 @@ Outcome run_config(const uint8_t* data, size_t size) {
     const Config config = load_config(path.string(), {});
     if (!stage_parameters_finite(config)) contract_broken("config", "loaded with a non-finite stage parameter");
     out.frames = 1;
+    const std::string text(reinterpret_cast<const char*>(data), size);
+    for (const CameraEntry& entry : config.cameras) check_pose_write_back(text, entry.name, path);
   } catch (const ConfigError& e) {
     out.error = e.what();
     if (out.error.find(path.string()) == std::string::npos) contract_broken("config error names no file", out.error);

@@ -24,6 +24,7 @@ struct CommandArgs {
   double duration_s = -1.0;         ///< record --duration-s S; < 0: until --frames or the source's end
   bool overwrite = false;           ///< record / run --record: --overwrite replaces an existing recording
   std::string camera;               ///< run / calibrate --camera NAME: one entry of the scene's cameras:
+  bool write_back = false;          ///< calibrate --write-back: the poses into the --config file's entries
 };
 
 /// `hrcsense eval`'s flags (docs/EVALUATION.md).
@@ -70,6 +71,7 @@ int info_command(const CommandArgs& args);
 /// background.reference; exit 1 when the source ends (or --frames) before it is learnt.
 int teach_command(const CommandArgs& args);
 /// calibrate --out POSE.yaml: the camera's pose from the arm's own depth (docs/CALIBRATION.md);
+/// --camera NAME | all [--write-back]: entries of a cell, with the cameras' agreement on the arm;
 /// exit 1 when refused (the reason on stderr), nothing written then.
 int calibrate_command(const CommandArgs& args);
 /// devices: the RealSense cameras connected, with their depth profiles (docs/CAMERAS.md); in a

@@ -139,7 +139,15 @@ Subcommands add_subcommands(CLI::App& app, CommandArgs& args, hrcsense::app::Eva
   commands.calibrate = app.add_subcommand(
       "calibrate", "the camera's pose from the arm's own depth while it sweeps the workspace (docs/CALIBRATION.md)");
   add_common_flags(*commands.calibrate, args);
-  commands.calibrate->add_option("--out", args.out, "the pose file (camera.T_base_camera and the fit's figures)")->required();
+  commands.calibrate->add_option("--out", args.out,
+                                 "the pose file (camera.T_base_camera and the fit's figures; with --camera a cameras: "
+                                 "list)");
+  commands.calibrate->add_option("--camera", args.camera,
+                                 "calibrate one camera of the scene's cameras:, or `all` in turn with their agreement "
+                                 "on the arm (docs/CALIBRATION.md)");
+  commands.calibrate->add_flag("--write-back", args.write_back,
+                               "with --camera: write the poses into the --config file's entries (the old file kept "
+                               "as FILE.bak)");
   commands.devices = app.add_subcommand("devices", "list the RealSense cameras connected and their depth profiles");
   commands.bench = app.add_subcommand("bench", "time the processing path on pre-rendered frames");
   add_common_flags(*commands.bench, args);

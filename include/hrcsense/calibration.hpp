@@ -20,6 +20,8 @@
 // 4. Its spread: a jackknife over groups of keyframes (what the poses disagree on, the
 //    kinematic model's errors included), not the far smaller formal covariance of correlated
 //    pixels.
+// 5. In a cell with several cameras, camera_agreement compares two calibrated cameras: at the arm
+//    poses both saw, each camera's points of a link fitted to the link's shapes by a translation.
 #pragma once
 
 #include "hrcsense/robot.hpp"
@@ -151,6 +153,62 @@ struct CameraCalibration {
 /// pose), and checks it against the refusal limits of the params. Without `with_spread` the
 /// jackknife is skipped (sigma_* stay 0 and cannot refuse): the quicker fit of a progress check.
 CameraCalibration calibrate_camera(const ArmSamples& samples, const Pose& T_base_camera_told, bool with_spread = true);
+
+/// What one camera saw of the arm in one keyframe: its arm candidates in the base frame (through
+/// the camera's pose) and the arm's visual shapes at the keyframe's joints.
+struct ArmView {
+  JointAngles q_rad{};
+  std::vector<Eigen::Vector3f> points_base;
+  std::vector<Capsule> shapes_base;
+};
+
+/// The keyframes with arm candidates, seen through `T_base_camera` (a fitted or configured pose).
+std::vector<ArmView> arm_views(const ArmSamples& samples, const Pose& T_base_camera);
+
+/// How camera_agreement pairs views and points (docs/CALIBRATION.md, "Cells with several cameras").
+struct AgreementParams {
+  /// Two views show the same instant of the arm when every joint agrees within this (rad): the
+  /// simulator's cameras of a cell render the same scene frame with the same joints.
+  double same_pose_rad = 1e-4;
+  /// A point farther than this (m) from the arm's shapes is not the arm (wider than the fit's
+  /// 3 cm gate, so that a pose some centimetres off still finds its points).
+  float gate_m = 0.06F;
+  /// A link counts in a shared view when each camera has at least this many points on it...
+  int min_points = 20;
+  /// ...and is compared when each camera has this many over all shared views: fewer, and the
+  /// noise alone moves an offset by millimetres (a wrist seen in a handful of views).
+  int min_link_points = 500;
+  /// A direction whose eigenvalue of the points' Σ n nᵀ is below this share of the largest is not
+  /// constrained: the offset's component there is 0 (a link seen along a line of normals only).
+  double min_axis_share = 0.02;
+};
+
+/// Two cameras' offsets of one link's surface (or of every shared link's, `link` −1).
+struct LinkAgreement {
+  int link = 0;             ///< Capsule::link, −1 for all shared links together
+  int views = 0;            ///< shared views in which both cameras saw the link (link views for −1)
+  size_t points_a = 0;      ///< points of camera a in those views
+  size_t points_b = 0;
+  /// The translation (base frame, m) that moves the arm's shapes onto each camera's points best
+  /// (least squares of the points' signed distances to the link's shapes).
+  Eigen::Vector3d offset_a_base_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d offset_b_base_m = Eigen::Vector3d::Zero();
+  double disagreement_m = 0.0;  ///< |offset_a − offset_b|: where the two cameras put the same surface apart
+  int constrained_axes = 0;     ///< directions both offsets are constrained in (3: all)
+};
+
+/// How two cameras agree on the parts of the arm both saw at the same instants.
+struct CameraAgreement {
+  int shared_views = 0;             ///< views (keyframes) of the same arm pose in both
+  std::vector<LinkAgreement> links; ///< per link both saw enough of (min_points, min_link_points), by link
+  LinkAgreement all;                ///< every shared link's points together
+};
+
+/// Pairs each view of `a` with a view of `b` of the same arm pose and compares, per link both saw,
+/// the two cameras' surface offsets from the arm's shapes: with both poses right both are near 0;
+/// a camera whose pose is shifted by δ has an offset of about δ.
+CameraAgreement camera_agreement(const std::vector<ArmView>& a, const std::vector<ArmView>& b,
+                                 const AgreementParams& params = {});
 
 /// The rotation angle (deg) and translation (m) between two poses: how far a calibration is
 /// from another.

@@ -7,11 +7,14 @@
 #include "yaml_tree.hpp"
 
 #include "hrcsense/fusion.hpp"
+#include "hrcsense/number_text.hpp"
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <set>
+#include <string>
+#include <utility>
 
 namespace hrcsense::config_detail {
 namespace {
@@ -263,3 +266,90 @@ void read_cell(KeyReader& r, Config& c) {
 }
 
 }  // namespace hrcsense::config_detail
+
+// ---- The pose of one entry written back into the file's text (hrcsense calibrate --write-back).
+
+namespace hrcsense {
+namespace {
+
+// The byte range [begin, end) of the flow list `[ ... ]` at `node` in `text`, which must lie
+// after `after` and before `before` (inside its entry: not an anchor elsewhere); else an error.
+std::pair<size_t, size_t> flow_list_span(const std::string& text, const YAML::Node& node, size_t after, size_t before,
+                                         const std::string& where, const std::string& key) {
+  const auto fail_form = [&](const std::string& why) {
+    throw ConfigError(where + ": key '" + key + "': cannot write the calibrated pose back: " + why +
+                      "; write it as a flow list [x, y, z] in the entry, or use --out");
+  };
+  if (!node.IsSequence() || node.Style() != YAML::EmitterStyle::Flow) fail_form("it is not a flow list");
+  const auto begin = static_cast<size_t>(node.Mark().pos);
+  if (begin <= after || begin >= before || begin >= text.size() || text[begin] != '[') {
+    fail_form("the list is not written inside the entry (an alias?)");
+  }
+  for (size_t i = begin + 1; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == ']') return {begin, i + 1};
+    // Numbers, signs, spaces, commas and line breaks only: anything else (a comment, a nested
+    // list, a quoted string) is a form this edit does not take apart.
+    if (!(std::isdigit(static_cast<unsigned char>(c)) != 0 || c == '.' || c == '-' || c == '+' || c == 'e' ||
+          c == 'E' || c == ',' || c == ' ' || c == '\t' || c == '\n' || c == '\r')) {
+      fail_form(std::string("the list holds '") + c + "'");
+    }
+  }
+  fail_form("the list is not closed");
+  return {0, 0};
+}
+
+std::string pose_list_text(const Eigen::Vector3d& v, int digits) {
+  return "[" + fixed_digits_text(v.x(), digits) + ", " + fixed_digits_text(v.y(), digits) + ", " +
+         fixed_digits_text(v.z(), digits) + "]";
+}
+
+}  // namespace
+
+Eigen::Vector3d rotation_rpy_deg(const Pose& pose) {
+  const Eigen::Matrix3d R = pose.rotation();
+  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  const double roll = std::atan2(R(2, 1), R(2, 2));
+  const double yaw = std::atan2(R(1, 0), R(0, 0));
+  return Eigen::Vector3d(roll, pitch, yaw) * (180.0 / 3.14159265358979323846);
+}
+
+std::string with_camera_pose_text(const std::string& yaml_text, const std::string& camera, const Pose& T_base_camera,
+                                  const std::string& where) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(where + ": not YAML: " + e.what());
+  }
+  const YAML::Node& const_root = root;
+  const YAML::Node list = const_root["cameras"];
+  if (!list.IsDefined() || !list.IsSequence()) throw ConfigError(where + ": key 'cameras': the file has no cameras: list");
+  for (size_t i = 0; i < list.size(); ++i) {
+    const YAML::Node entry = list[i];
+    const YAML::Node name = entry.IsMap() ? entry["name"] : YAML::Node();
+    if (!name.IsDefined() || !name.IsScalar() || name.Scalar() != camera) continue;
+    const std::string key = "cameras[" + std::to_string(i) + "].T_base_camera";
+    const YAML::Node pose = entry["T_base_camera"];
+    if (!pose.IsDefined() || !pose.IsMap()) throw ConfigError(where + ": key '" + key + "': expected a map");
+    const auto after = static_cast<size_t>(entry.Mark().pos);
+    const size_t before = i + 1 < list.size() ? static_cast<size_t>(list[i + 1].Mark().pos) : yaml_text.size();
+    const auto t_span = flow_list_span(yaml_text, pose["translation_m"], after, before, where, key + ".translation_m");
+    const auto r_span = flow_list_span(yaml_text, pose["rotation_rpy_deg"], after, before, where, key + ".rotation_rpy_deg");
+    std::string out = yaml_text;
+    const std::string t_text = pose_list_text(T_base_camera.translation(), 6);
+    const std::string r_text = pose_list_text(rotation_rpy_deg(T_base_camera), 5);
+    // The later span first, so that the earlier one's offsets still hold.
+    if (t_span.first > r_span.first) {
+      out.replace(t_span.first, t_span.second - t_span.first, t_text);
+      out.replace(r_span.first, r_span.second - r_span.first, r_text);
+    } else {
+      out.replace(r_span.first, r_span.second - r_span.first, r_text);
+      out.replace(t_span.first, t_span.second - t_span.first, t_text);
+    }
+    return out;
+  }
+  throw ConfigError(where + ": key 'cameras': no camera named '" + camera + "'");
+}
+
+}  // namespace hrcsense

@@ -280,6 +280,20 @@ inline constexpr double kCameraLatencyS = 0.033;
 Config load_config(const std::string& path, const std::vector<std::string>& overrides,
                    const std::string& camera = {});
 
+/// `rotation_rpy_deg` of a pose in CONFIG.md's convention, R = Rz(yaw)·Ry(pitch)·Rx(roll): [roll,
+/// pitch, yaw] in degrees (pitch in [−90, 90]).
+Eigen::Vector3d rotation_rpy_deg(const Pose& pose);
+
+/// The text of a configuration file with one `cameras:` entry's pose replaced (`hrcsense calibrate
+/// --camera NAME --write-back`, docs/CALIBRATION.md): the entry `camera`'s T_base_camera
+/// translation_m and rotation_rpy_deg lists become `T_base_camera`'s (6 and 5 decimals), every
+/// other byte of `yaml_text` (comments, the other entries, the layout) stays. Both lists must be
+/// written in flow form ([x, y, z]) inside the entry itself (not through an alias). Throws
+/// ConfigError naming `where` and the entry's key when the text does not parse, has no such
+/// entry or holds the pose in another form.
+std::string with_camera_pose_text(const std::string& yaml_text, const std::string& camera, const Pose& T_base_camera,
+                                  const std::string& where);
+
 /// Reads a robot description file (docs/ROBOT.md); throws ConfigError naming the file and the
 /// field, e.g. "arm.yaml: key 'links.forearm[1].radius_m': expected a number >= 0".
 RobotDescription load_robot_description(const std::string& path);
