@@ -5,8 +5,8 @@
 //   Fusion/instant/<cameras>cams_<cubes>: one instant of N cameras, every camera new; each
 //   camera's grid has a random third of its cubes unknown (the union a few, next to the arm).
 //   Fusion/instant/.../layout:1: the same where every camera leaves a person-sized box 0.4 ×
-//   0.4 × 1.8 m unknown about 1 m from the arm (a shadow no camera sees into) and one more box of
-//   its own elsewhere: the union's nearest unknown cube is far, so the search goes farther.
+//   0.4 × 1.8 m unknown 0.7 m from the arm (a shadow no camera sees into) and one more box of its
+//   own elsewhere: the union's nearest unknown cube is far, so the search goes farther.
 //   Fusion/messages/<cameras>cams_<cubes>: the same through the hrcsense_msgs/Measurement
 //   conversion each received sample goes through (dds/measurement_messages.hpp).
 #include "dds/measurement_messages.hpp"
@@ -77,8 +77,9 @@ FusionSetup setup(int camera_count, int cubes, int layout) {
     m.robot_state.q_rad = {-2.74, -1.0, 1.6, -2.17, -1.57, 0.0};
     m.robot_state.speed_fraction = 1.0;
     m.seen_free.reset(s.params.grid.cell_count());
-    const Eigen::AlignedBox3f shadow(Eigen::Vector3f(0.6F, 0.4F, 0.0F), Eigen::Vector3f(1.0F, 0.8F, 1.8F));
-    const Eigen::Vector3f own_corner(-1.4F, -1.4F + 0.15F * static_cast<float>(c % 16), 0.2F);
+    // The arm reaches towards +x +y (its tool near (0.55, 0.35, 0.2)); the shadow is behind its base.
+    const Eigen::AlignedBox3f shadow(Eigen::Vector3f(-1.2F, -0.6F, 0.0F), Eigen::Vector3f(-0.8F, -0.2F, 1.8F));
+    const Eigen::Vector3f own_corner(1.1F, -1.4F + 0.15F * static_cast<float>(c % 16), 0.2F);
     const Eigen::AlignedBox3f own(own_corner, own_corner + Eigen::Vector3f(0.3F, 0.3F, 0.5F));
     for (size_t i = 0; i < m.seen_free.cells; ++i) {
       const Eigen::Vector3f centre = s.params.grid.centre(i);
