@@ -2,7 +2,11 @@
 // The fuser's own work per instant (docs/BENCHMARKS.md, "Cells with several cameras"): each
 // camera's measurement taken (a copy into its slot), the cameras fused into one measurement (the
 // seen-free grids united, the robot's distance to the cubes no camera saw free) and decided once.
-//   Fusion/instant/<cameras>cams_<cubes>: one instant of N cameras, every camera new.
+//   Fusion/instant/<cameras>cams_<cubes>: one instant of N cameras, every camera new; each
+//   camera's grid has a random third of its cubes unknown (the union a few, next to the arm).
+//   Fusion/instant/.../layout:1: the same where every camera leaves a person-sized box 0.4 ×
+//   0.4 × 1.8 m unknown 0.7 m from the arm (a shadow no camera sees into) and one more box of its
+//   own elsewhere: the union's nearest unknown cube is far, so the search goes farther.
 //   Fusion/messages/<cameras>cams_<cubes>: the same through the hrcsense_msgs/Measurement
 //   conversion each received sample goes through (dds/measurement_messages.hpp).
 #include "dds/measurement_messages.hpp"
@@ -10,6 +14,7 @@
 #include "hrcsense/robot.hpp"
 #include "hrcsense/safety.hpp"
 
+#include <Eigen/Geometry>
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -38,9 +43,10 @@ struct FusionSetup {
   std::vector<CameraMeasurement> measurements;
 };
 
-// N cameras, each with three link contacts and a grid where a third of the cubes are unknown to
-// it (random, so that the union still leaves some unknown near the arm).
-FusionSetup setup(int camera_count, int cubes) {
+// N cameras, each with three link contacts and a grid: layout 0, a third of the cubes unknown to
+// it (random, so that the union still leaves some unknown near the arm); layout 1, a shadow
+// unknown to all and a box of its own.
+FusionSetup setup(int camera_count, int cubes, int layout) {
   FusionSetup s;
   s.params.safety.mode = SafetyParams::Mode::ssm;
   s.params.robot.arm = builtin_robot(BuiltinArm::ur5);
@@ -71,8 +77,14 @@ FusionSetup setup(int camera_count, int cubes) {
     m.robot_state.q_rad = {-2.74, -1.0, 1.6, -2.17, -1.57, 0.0};
     m.robot_state.speed_fraction = 1.0;
     m.seen_free.reset(s.params.grid.cell_count());
+    // The arm reaches towards +x +y (its tool near (0.55, 0.35, 0.2)); the shadow is behind its base.
+    const Eigen::AlignedBox3f shadow(Eigen::Vector3f(-1.2F, -0.6F, 0.0F), Eigen::Vector3f(-0.8F, -0.2F, 1.8F));
+    const Eigen::Vector3f own_corner(1.1F, -1.4F + 0.15F * static_cast<float>(c % 16), 0.2F);
+    const Eigen::AlignedBox3f own(own_corner, own_corner + Eigen::Vector3f(0.3F, 0.3F, 0.5F));
     for (size_t i = 0; i < m.seen_free.cells; ++i) {
-      if (random() % 3 != 0) m.seen_free.set(i);
+      const Eigen::Vector3f centre = s.params.grid.centre(i);
+      const bool unknown = layout == 0 ? random() % 3 == 0 : shadow.contains(centre) || own.contains(centre);
+      if (!unknown) m.seen_free.set(i);
     }
     s.measurements.push_back(std::move(m));
   }
@@ -83,7 +95,7 @@ FusionSetup setup(int camera_count, int cubes) {
 // (straight into CellFusion::add, or through the message), then fused and decided.
 template <typename Take>
 void run_instants(benchmark::State& state, Take take) {
-  FusionSetup s = setup(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  FusionSetup s = setup(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), static_cast<int>(state.range(2)));
   CellFusion fusion(s.cameras, s.params);
   SafetyMonitor monitor(s.params.safety, 90.0, true);
   FrameResult result;
@@ -107,8 +119,8 @@ void run_instants(benchmark::State& state, Take take) {
 void BM_FusionInstant(benchmark::State& state) {
   run_instants(state, [](CellFusion& fusion, const CameraMeasurement& m, int64_t t) { fusion.add(m, t); });
 }
-BENCHMARK(BM_FusionInstant)->Name("Fusion/instant")->ArgNames({"cams", "cubes"})
-    ->Args({3, 264000})->Args({16, 144000})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FusionInstant)->Name("Fusion/instant")->ArgNames({"cams", "cubes", "layout"})
+    ->Args({3, 264000, 0})->Args({16, 144000, 0})->Args({3, 264000, 1})->Args({16, 144000, 1})->Unit(benchmark::kMicrosecond);
 
 void BM_FusionMessages(benchmark::State& state) {
   ros2::MeasurementBuffers buffers;
@@ -119,8 +131,8 @@ void BM_FusionMessages(benchmark::State& state) {
     fusion.add(received, t);
   });
 }
-BENCHMARK(BM_FusionMessages)->Name("Fusion/messages")->ArgNames({"cams", "cubes"})
-    ->Args({3, 264000})->Args({16, 144000})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FusionMessages)->Name("Fusion/messages")->ArgNames({"cams", "cubes", "layout"})
+    ->Args({3, 264000, 0})->Args({16, 144000, 0})->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace hrcsense

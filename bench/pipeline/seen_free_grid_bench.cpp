@@ -10,10 +10,15 @@
 //   SeenFreeGrid/unite/144000            one camera's bits ORed into the fused grid
 //   SeenFreeGrid/unknown_distance/144000 the fused side: that frame's grid against a UR-sized arm
 //                                        of 7 capsules standing in the middle of the box
+//   SeenFreeGrid/unknown_distance/layout:L the same arm against other unions: 0 every cube free
+//                                        (the scan alone), 1 a random 1/27 unknown (the nearest
+//                                        next to the arm), 2 only a person-sized box 0.4 × 0.4 ×
+//                                        1.8 m unknown, 1 m from the arm (the search goes far)
 // Budget (issue H2): the grid ≤ 1 ms per camera frame, and about as much for the fuser.
 #include "hrcsense/seen_free_grid.hpp"
 #include "hrcsense/unknown_space.hpp"
 
+#include <Eigen/Geometry>
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -165,10 +170,31 @@ void BM_SeenFreeUnknownDistance(benchmark::State& state) {
   state.counters["distance_m"] = distance_m;
 }
 
+void BM_SeenFreeUnknownDistanceLayouts(benchmark::State& state) {
+  const GridScene s;
+  SeenFreeGrid grid;
+  grid.reset(s.spec.cell_count());
+  std::mt19937 rng(5);
+  const Eigen::AlignedBox3f shadow(Eigen::Vector3f(-1.3F, 0.2F, 0.0F), Eigen::Vector3f(-0.9F, 0.6F, 1.8F));
+  for (size_t i = 0; i < grid.cells; ++i) {
+    const bool unknown = state.range(0) == 1 ? rng() % 27 == 0 : state.range(0) == 2 && shadow.contains(s.spec.centre(i));
+    if (!unknown) grid.set(i);
+  }
+  UnknownDistanceScratch scratch;
+  float distance_m = 0.0F;
+  for (auto _ : state) {
+    distance_m = unknown_cells_distance_m(s.spec, grid, s.robot, scratch);
+    benchmark::DoNotOptimize(distance_m);
+  }
+  state.counters["distance_m"] = distance_m;
+}
+
 BENCHMARK(BM_SeenFreePrepare)->Name("SeenFreeGrid/prepare/144000")->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SeenFreeMark)->Name("SeenFreeGrid/mark/848x480")->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SeenFreeUnite)->Name("SeenFreeGrid/unite/144000")->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SeenFreeUnknownDistance)->Name("SeenFreeGrid/unknown_distance/144000")->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SeenFreeUnknownDistanceLayouts)->Name("SeenFreeGrid/unknown_distance")->ArgName("layout")->DenseRange(0, 2)
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace hrcsense

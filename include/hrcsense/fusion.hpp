@@ -171,7 +171,7 @@ class CellFusion {
   std::vector<int> link_ids_;     ///< per out.links entry: its link
   int contact_camera_ = -1;
   RobotModel robot_model_;           ///< scratch: the capsules at the fused state
-  std::vector<float> block_bounds_m_;  ///< scratch of unknown_cells_distance_m
+  UnknownDistanceScratch distance_scratch_;  ///< scratch of unknown_cells_distance_m
   std::string empty_;
 };
 

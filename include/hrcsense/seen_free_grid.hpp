@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 namespace hrcsense {
@@ -94,18 +95,24 @@ void mark_seen_free(const SeenFreeProjection& projection, const DepthImage& dept
 /// specs cannot be combined; the fuser checks the count before it unites).
 void unite(SeenFreeGrid& into, const SeenFreeGrid& other);
 
+/// The buffers of unknown_cells_distance_m, reused between calls (no allocation once sized).
+struct UnknownDistanceScratch {
+  std::vector<uint8_t> block_has_unknown;                  ///< per block of 4×4×4 cubes
+  std::vector<std::pair<float, uint32_t>> super_blocks;    ///< (lower bound m, index) of 4×4×4 blocks
+};
+
 /// The robot's smallest distance to a cube that no camera saw free: from the padded capsules'
 /// surfaces (segment distance less the radius, as segment_capsule_distance) to the cube's
 /// centre, m. Cubes whose centre lies inside a capsule are the robot's own volume and left out;
 /// 0 only for a centre on a capsule's surface. NaN when no cube is left (every cube free, or
 /// inside the robot), when the robot has no capsules, or when `union_bits` has another cell
-/// count than the spec. Exact: each block of 4×4×4 cubes with an unknown cube gets a lower bound
-/// once (kept in `block_bounds_m`, reused between calls: no allocation once sized), the block
-/// with the lowest is measured first, and then only the blocks whose bound is below the best
-/// found so far.
+/// count than the spec. Exact: blocks of 4×4×4 cubes and super-blocks of 4×4×4 blocks holding
+/// an unknown cube get a lower bound each (a bounding sphere's distance to the capsules); they
+/// are searched nearest bound first, and one whose bound is above the best distance found so
+/// far is skipped, never measured cube by cube.
 float unknown_cells_distance_m(const SeenFreeGridSpec& spec, const SeenFreeGrid& union_bits, const RobotModel& robot,
-                               std::vector<float>& block_bounds_m);
-/// The same with a buffer of its own (allocates each call).
+                               UnknownDistanceScratch& scratch);
+/// The same with buffers of its own (allocates each call).
 float unknown_cells_distance_m(const SeenFreeGridSpec& spec, const SeenFreeGrid& union_bits, const RobotModel& robot);
 
 }  // namespace hrcsense

@@ -5,6 +5,7 @@
 #include "hrcsense/fusion.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -326,6 +327,9 @@ void CellFusion::fuse(int64_t instant_ns, int64_t frame, int64_t now_ns, Measure
   size_t oldest = 0;
   double max_gap_ms = 0.0;
   bool all_grids = params_.grid.enabled;
+  // The rank of each out.links entry's contact, computed once per camera's link (a link id is
+  // below kMaxFusedLinks, so there are at most that many entries).
+  std::array<Rank, kMaxFusedLinks> held_rank;
   for (size_t i = 0; i < cameras_.size(); ++i) {
     const CameraMeasurement& m = slots_[i].newest;
     if (m.capture_ns < slots_[oldest].newest.capture_ns) oldest = i;
@@ -342,16 +346,18 @@ void CellFusion::fuse(int64_t instant_ns, int64_t frame, int64_t now_ns, Measure
       contact_camera_ = static_cast<int>(i);
     }
     for (const LinkContact& link : m.links) {
+      const Rank rank = rank_of(params_.safety, m, link);
       auto it = std::find(link_ids_.begin(), link_ids_.end(), link.link);
       if (it == link_ids_.end()) {
+        held_rank[out.links.size()] = rank;
         out.links.push_back(link);
         link_ids_.push_back(link.link);
         link_camera_.push_back(static_cast<int>(i));
         continue;
       }
       const size_t k = static_cast<size_t>(it - link_ids_.begin());
-      const CameraMeasurement& held = slots_[static_cast<size_t>(link_camera_[k])].newest;
-      if (rank_of(params_.safety, m, link).stricter_than(rank_of(params_.safety, held, out.links[k]))) {
+      if (rank.stricter_than(held_rank[k])) {
+        held_rank[k] = rank;
         out.links[k] = link;
         link_camera_[k] = static_cast<int>(i);
       }
@@ -378,7 +384,7 @@ void CellFusion::fuse(int64_t instant_ns, int64_t frame, int64_t now_ns, Measure
     seen = slots_[0].newest.seen_free;
     for (size_t i = 1; i < cameras_.size(); ++i) unite(seen, slots_[i].newest.seen_free);
     robot_model_at(params_.robot, base.robot_state.q_rad, robot_model_);
-    out.unknown_distance_m = unknown_cells_distance_m(params_.grid, seen, robot_model_, block_bounds_m_);
+    out.unknown_distance_m = unknown_cells_distance_m(params_.grid, seen, robot_model_, distance_scratch_);
   } else {
     // Without every camera's grid: the largest per-ray distance. Space unknown to the cell is
     // unknown to every camera, so its distance is at least each camera's: this never says more

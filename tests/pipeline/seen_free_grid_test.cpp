@@ -5,6 +5,7 @@
 // cubes picked below have x/z and y/z multiples of 0.05, so that their pixels are whole
 // numbers, far from any rounding boundary. The margin is half a cube's diagonal.
 
+#include "hrcsense/robot.hpp"
 #include "hrcsense/seen_free_grid.hpp"
 #include "hrcsense/unknown_space.hpp"
 
@@ -293,6 +294,46 @@ TEST(SeenFreeGrid, DistanceMatchesBruteForceOnRandomGrids) {
     } else {
       EXPECT_NEAR(fast, expected, 1e-5) << trial;
     }
+  }
+}
+
+// A UR5 (padded 0.05 m) in random poses over grids where a few boxes of space (people,
+// shelves, shadows) and scattered cubes are unknown, one box always around the robot's base so
+// that some unknown cubes lie inside its capsules; the box spans partial blocks and partial
+// super-blocks on every axis. The search must agree with every cube measured.
+TEST(SeenFreeGrid, DistanceMatchesBruteForceForAnArmInRandomPoses) {
+  SeenFreeGridSpec spec;
+  spec.enabled = true;
+  spec.box_base = Eigen::AlignedBox3f(Eigen::Vector3f(-1.3F, -1.1F, -0.2F), Eigen::Vector3f(1.25F, 1.35F, 1.6F));
+  spec.voxel_m = 0.07F;  // 37 × 35 × 26 cubes
+  RobotParams params;
+  params.arm = builtin_robot(BuiltinArm::ur5);
+  params.padding_m = 0.05;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> angle(-3.14, 3.14);
+  std::uniform_real_distribution<float> coord(-1.3F, 1.4F), size(0.05F, 0.6F), share(0.0F, 1.0F);
+  for (int trial = 0; trial < 24; ++trial) {
+    JointAngles q_rad{};
+    for (double& q : q_rad) q = angle(rng);
+    const RobotModel robot = robot_model_at(params, q_rad);
+    std::vector<Eigen::AlignedBox3f> unknown_boxes = {
+        Eigen::AlignedBox3f(Eigen::Vector3f(-0.2F, -0.2F, -0.2F), Eigen::Vector3f(0.2F, 0.2F, 0.3F))};
+    for (int b = 0; b < trial % 4; ++b) {
+      const Eigen::Vector3f corner(coord(rng), coord(rng), coord(rng));
+      unknown_boxes.emplace_back(corner, corner + Eigen::Vector3f(size(rng), size(rng), size(rng)));
+    }
+    const float scattered = trial % 3 == 0 ? 0.0F : trial % 3 == 1 ? 1e-4F : 1e-2F;
+    SeenFreeGrid grid;
+    grid.reset(spec.cell_count());
+    for (size_t cell = 0; cell < grid.cells; ++cell) {
+      const Eigen::Vector3f centre = spec.centre(cell);
+      bool unknown = share(rng) < scattered;
+      for (const Eigen::AlignedBox3f& box : unknown_boxes) unknown = unknown || box.contains(centre);
+      if (!unknown) grid.set(cell);
+    }
+    const float expected = brute_distance_m(spec, grid, robot);
+    ASSERT_FALSE(std::isnan(expected)) << trial;  // the base box reaches out of the base capsule
+    EXPECT_NEAR(unknown_cells_distance_m(spec, grid, robot), expected, 1e-5) << trial;
   }
 }
 
