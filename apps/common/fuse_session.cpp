@@ -198,6 +198,7 @@ class Fuser {
     params.safety = config.pipeline.safety;
     params.robot = config.pipeline.robot;
     params.grid = config.cell.grid;
+    params.clock_offset_max_ns = seconds_to_ns(config.cell.clock_offset_max_s);
     return params;
   }
   // T_r counts one period of the slowest camera: an intrusion can begin just after its capture.

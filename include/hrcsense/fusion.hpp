@@ -95,6 +95,10 @@ struct FusionParams {
   /// A capture stamped further than this ahead of the fuser's clock is rejected (a camera whose
   /// clock jumped, or an unsynchronised host), ns.
   int64_t max_clock_ahead_ns = 50'000'000;
+  /// The bound on any camera host's clock offset from the fuser's (`cell.clock_offset_max_s`),
+  /// ns: every capture counts as this much older, for T_r and for the stale rule, so that an
+  /// offset within the bound never makes a verdict laxer. 0 on one host.
+  int64_t clock_offset_max_ns = 0;
 };
 
 /// What became of a received measurement.

@@ -22,6 +22,9 @@ namespace {
 /// Cubes of the seen-free grid: at most 8 million (one bit each per camera and frame, and the
 /// fuser's union), so that a mistyped voxel or box cannot allocate gigabytes.
 constexpr double kMaxGridCells = 8e6;
+/// `cell.clock_offset_max_s`: a second is far beyond any synchronised clock (chrony on a LAN keeps
+/// well under 1 ms); more is a unit mistake.
+constexpr double kMaxClockOffsetS = 1.0;
 /// `cell.voxel_m`: 1 cm (finer is below the cameras' noise at a cell's distances) to 0.5 m
 /// (coarser hides a person's arm in a cube seen free around it).
 constexpr float kMinVoxelM = 0.01F;
@@ -254,6 +257,9 @@ void read_cell(KeyReader& r, Config& c) {
     grid.box_base = Eigen::AlignedBox3f(min, max);
   }
   grid.enabled = has_cameras;
+  if (has_cameras || r.raw("cell.clock_offset_max_s").IsDefined()) {
+    r.number("cell.clock_offset_max_s", c.cell.clock_offset_max_s, Bound::non_negative, kMaxClockOffsetS);
+  }
 
   if (r.raw("sim.epoch").IsDefined()) {
     double epoch_s = 0.0;

@@ -243,21 +243,24 @@ void CellFusion::fuse(int64_t instant_ns, int64_t frame, int64_t now_ns, Measure
 
   // Each camera's state; the first camera at fault gives the code, the reason names them all.
   ReasonCode first_fault = ReasonCode::clear;
+  // Ages as the worst clock offset allowed would make them (cell.clock_offset_max_s).
+  const int64_t offset_ns = params_.clock_offset_max_ns;
   for (size_t i = 0; i < cameras_.size(); ++i) {
     const Slot& slot = slots_[i];
     CameraStatus& status = out.cameras[i];
     status.name = cameras_[i].name;
     status.session = slot.have ? slot.newest.session : 0;
-    status.age_ms = slot.have ? static_cast<double>(now_ns - slot.newest.capture_ns) / kNsPerMs
+    status.age_ms = slot.have ? static_cast<double>(now_ns - slot.newest.capture_ns + offset_ns) / kNsPerMs
                               : std::numeric_limits<double>::quiet_NaN();
     status.valid = slot.have && slot.newest.valid;
     const double fps = slot.have ? slot.newest.nominal_fps : cameras_[i].fps;
     const double allowed_ms = params_.safety.max_frame_gap_periods / fps * 1e3;
     char text[192] = {};
     ReasonCode code = ReasonCode::clear;
-    const double newest_age_ms = slot.have ? static_cast<double>(now_ns - slot.newest.capture_ns) / kNsPerMs : 0.0;
+    const double newest_age_ms =
+        slot.have ? static_cast<double>(now_ns - slot.newest.capture_ns + offset_ns) / kNsPerMs : 0.0;
     const double valid_age_ms =
-        slot.have_valid ? static_cast<double>(now_ns - slot.newest_valid_capture_ns) / kNsPerMs : 0.0;
+        slot.have_valid ? static_cast<double>(now_ns - slot.newest_valid_capture_ns + offset_ns) / kNsPerMs : 0.0;
     if (!slot.have) {
       code = ReasonCode::camera_stale;
       std::snprintf(text, sizeof text, "camera '%s': no measurement yet", status.name.c_str());
@@ -372,10 +375,11 @@ void CellFusion::fuse(int64_t instant_ns, int64_t frame, int64_t now_ns, Measure
     }
   }
 
-  // T_r counts from the oldest contributing capture; the robot state is that camera's, aged by
+  // T_r counts from the oldest contributing capture (less the clock offset bound); the robot
+  // state is that camera's, aged by
   // the largest gap any camera had (robot_state_gap_s reads age − extrapolation).
   const CameraMeasurement& base = slots_[oldest].newest;
-  out.seen_ns = base.capture_ns;
+  out.seen_ns = base.capture_ns - offset_ns;
   out.robot_state = base.robot_state;
   out.robot_state_age_ms = max_gap_ms + static_cast<double>(base.robot_state.extrapolated_ns) / kNsPerMs;
 

@@ -12,6 +12,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <string_view>
 
 #ifndef HRCSENSE_VERSION
@@ -182,8 +184,15 @@ void put_frame_cameras(Members& m, const FrameResult& result) {
 // them no camera saw free this frame (`seen_free`); nothing without a grid.
 void put_seen_free(Members& m, const SeenFreeGrid& grid) {
   if (grid.cells == 0) return;
+  // Eight bytes at a time: a fused line of a 264 000-cube grid counts 33 000 bytes.
   size_t free_cubes = 0;
-  for (const uint8_t byte : grid.bytes) free_cubes += static_cast<size_t>(__builtin_popcount(byte));
+  size_t i = 0;
+  for (; i + 8 <= grid.bytes.size(); i += 8) {
+    uint64_t word = 0;
+    std::memcpy(&word, grid.bytes.data() + i, sizeof word);
+    free_cubes += static_cast<size_t>(__builtin_popcountll(word));
+  }
+  for (; i < grid.bytes.size(); ++i) free_cubes += static_cast<size_t>(__builtin_popcount(grid.bytes[i]));
   m.open("seen_free");
   m.integer("cubes", static_cast<int64_t>(grid.cells));
   m.integer("unknown", static_cast<int64_t>(grid.cells - std::min(free_cubes, grid.cells)));

@@ -111,6 +111,33 @@ TEST(CellFusion, ACameraOlderThanTwoPeriodsIsStaleByName) {
   EXPECT_TRUE(out.cameras[0].valid);
 }
 
+TEST(CellFusion, TheClockOffsetBoundAgesEveryCaptureForTrAndTheStaleRule) {
+  // cell.clock_offset_max_s 5 ms: each capture counts as 5 ms older than its stamp.
+  FusionParams params = zones_params();
+  params.clock_offset_max_ns = 5 * kMs;
+  CellFusion fusion = two_cameras(params);
+  fusion.add(measured("front", kT0, {link_at(2, 1.0F)}), kT0);
+  fusion.add(measured("left", kT0 - 10 * kMs, {link_at(2, 0.8F)}), kT0);
+  Measurement out;
+  fusion.fuse(kT0, 1, kT0 + 50 * kMs, out);
+  ASSERT_TRUE(out.valid) << out.withheld_reason;
+  EXPECT_EQ(out.seen_ns, kT0 - 15 * kMs);  // left's capture, 5 ms earlier
+  EXPECT_NEAR(out.cameras[0].age_ms, 55.0, 1e-9);
+  EXPECT_NEAR(out.cameras[1].age_ms, 65.0, 1e-9);
+  // At 53 ms left is 63 ms old by its stamp, within two periods (66.7 ms), but 68 ms with the
+  // bound: stale. Without the bound it would still count.
+  fusion.fuse(kT0, 1, kT0 + 53 * kMs, out);
+  EXPECT_FALSE(out.valid);
+  EXPECT_EQ(out.withheld_code, ReasonCode::camera_stale);
+  EXPECT_NE(out.withheld_reason.find("'left'"), std::string::npos) << out.withheld_reason;
+  CellFusion unbounded = two_cameras();
+  unbounded.add(measured("front", kT0, {link_at(2, 1.0F)}), kT0);
+  unbounded.add(measured("left", kT0 - 10 * kMs, {link_at(2, 0.8F)}), kT0);
+  unbounded.fuse(kT0, 1, kT0 + 53 * kMs, out);
+  EXPECT_TRUE(out.valid) << out.withheld_reason;
+  EXPECT_EQ(out.seen_ns, kT0 - 10 * kMs);
+}
+
 TEST(CellFusion, ACameraNeverHeardIsStale) {
   CellFusion fusion = two_cameras();
   fusion.add(measured("front", kT0, {}), kT0);

@@ -221,6 +221,9 @@ struct CellConfig {
   /// `cell.workspace_base` (default `foreground.workspace_base`'s box) and `cell.voxel_m`
   /// (0.05 m); enabled when the configuration has `cameras:`.
   SeenFreeGridSpec grid;
+  /// `cell.clock_offset_max_s` (0): the bound checked for every camera host's clock offset from
+  /// the fuser's (docs/MULTICAMERA.md, "Clocks"); the fuser takes every capture as this much older.
+  double clock_offset_max_s = 0.0;
 };
 
 struct Config {
