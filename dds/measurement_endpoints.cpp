@@ -102,9 +102,12 @@ MeasurementReader::MeasurementReader(uint32_t domain_id, const std::string& node
       dds_create_reader(dds_->scope.participant(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr),
       "DDS reader of the built-in DCPSPublication topic");
   dds_->waitset = dds_->scope.own(dds_create_waitset(dds_->scope.participant()), "DDS waitset");
-  // Best-effort keep-last 8: matches reliable and best-effort writers; a fuser that falls behind
-  // reads the newest eight of each camera, never an unbounded backlog.
-  const QosHandle qos(EndpointQos{false, false, int32_t{kMeasurementTake}});
+  // Reliable keep-last 8. Reliable, because a camera's last word (the end of its run, its own
+  // stop) is sent once: read best-effort, a lost fragment of it left the fuser seeing a stale
+  // camera instead of an ended one. Keep-last: the cameras' keep-last 1 writers never wait for
+  // the fuser, and a fuser that falls behind reads the newest eight of each camera, never an
+  // unbounded backlog. (A reliable reader matches reliable writers only, as hrcsense's are.)
+  const QosHandle qos(EndpointQos{true, false, int32_t{kMeasurementTake}});
   for (const std::string& ros_topic : topics_) {
     const std::string name = dds_topic_name(ros_topic);
     const dds_entity_t topic = dds_->scope.own(

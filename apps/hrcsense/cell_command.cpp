@@ -18,6 +18,7 @@
 #include <cstring>
 #include <ctime>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -149,9 +150,23 @@ int cell_command(const CommandArgs& args) {
   spdlog::info("cell: {} cameras and the fuser started{}", config.cameras.size(),
                args.out.empty() ? "" : "; each camera's own run beside " + args.out);
 
+  // Every camera's last measurement says its run ended, and the fuser ends on them. That
+  // measurement crosses DDS best-effort like any other: if one is lost, the fuser (rightly) sees
+  // a stale camera and goes on stopping. Here the cell knows its cameras have ended, so the fuser
+  // gets this long to end by itself, then the signal that makes it write its final stop.
+  constexpr auto kFuserEndGrace = std::chrono::seconds(2);
+  std::optional<std::chrono::steady_clock::time_point> cameras_ended_at;
   while (true) {
     reap(children);
     if (!children[0].running) break;  // the fuser ended: the cell has
+    bool cameras_running = false;
+    for (size_t i = 1; i < children.size(); ++i) cameras_running = cameras_running || children[i].running;
+    if (!cameras_running && !cameras_ended_at) cameras_ended_at = std::chrono::steady_clock::now();
+    if (cameras_ended_at && std::chrono::steady_clock::now() - *cameras_ended_at > kFuserEndGrace) {
+      spdlog::info("cell: every camera has ended and the fuser has not within 2 s: it is told to end");
+      end_all(children, 10.0);
+      break;
+    }
     if (StopSignals::stop_requested()) {
       // The fuser writes its final stop when its signal comes; the cameras end theirs alike.
       end_all(children, 10.0);

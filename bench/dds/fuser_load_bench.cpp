@@ -7,13 +7,15 @@
 // after --frames instants. Reported: the fuser's CPU (its own user + system time over the wall
 // time, from getrusage of the child), measurements sent and accepted, instants decided, and the
 // fused latency and the fuser's added latency from its JSON Lines (p50, p99).
-// Needs CYCLONEDDS_URI set to tests/dds/cyclonedds-loopback.xml (docs/BENCHMARKS.md).
+// Needs CYCLONEDDS_URI set to tests/dds/cyclonedds-loopback.xml (docs/BENCHMARKS.md); with
+// HRCSENSE_BENCH_FUSER_FIFO=N the fuser runs under SCHED_FIFO priority N.
 #include "../common/percentile.hpp"
 #include "dds/measurement_endpoints.hpp"
 
 #include <benchmark/benchmark.h>
 #include <nlohmann/json.hpp>
 
+#include <sched.h>
 #include <spawn.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -79,7 +81,20 @@ void BM_Fuser90Hz(benchmark::State& state) {
     // Children's CPU accumulates over the process: this run's fuser is the difference.
     const double cpu_before_s = children_cpu_s();
     pid_t fuser = -1;
-    if (posix_spawn(&fuser, HRCSENSE_BENCH_CLI, nullptr, nullptr, argv.data(), environ) != 0) {
+    // HRCSENSE_BENCH_FUSER_FIFO=N: the fuser under SCHED_FIFO priority N (root), as a decision
+    // host would run it (`chrt -f N hrcsense fuse`); the publishers stay at normal priority.
+    posix_spawnattr_t attributes;
+    posix_spawnattr_init(&attributes);
+    if (const char* fifo = std::getenv("HRCSENSE_BENCH_FUSER_FIFO")) {
+      sched_param priority{};
+      priority.sched_priority = std::atoi(fifo);
+      posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSCHEDULER);
+      posix_spawnattr_setschedpolicy(&attributes, SCHED_FIFO);
+      posix_spawnattr_setschedparam(&attributes, &priority);
+    }
+    const int spawned = posix_spawn(&fuser, HRCSENSE_BENCH_CLI, nullptr, &attributes, argv.data(), environ);
+    posix_spawnattr_destroy(&attributes);
+    if (spawned != 0) {
       state.SkipWithError("cannot start hrcsense fuse");
       return;
     }
