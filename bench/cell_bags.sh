@@ -48,15 +48,15 @@ $bag_cameras" '
   /^source:/ { print "source: {type: bag, path: '"$out"'/front.bag, pace: true}"; next }
   /^sim:/ { next }
   { print }' "$out/sim.yaml" > "$out/cell.yaml"
-printf 'robot: {state: {source: recorded}}\n' >> "$out/cell.yaml"
 
 timed() { local name=$1; shift; /usr/bin/time -f "%U %S %e" -o "$out/$name.time" "$@"; }
-timed fuser "$hrcsense" fuse --config "$out/cell.yaml" --out "$out/fused.jsonl" 2> "$out/fuser.log" &
+recorded=(--set robot.state.source=recorded)
+timed fuser "$hrcsense" fuse --config "$out/cell.yaml" "${recorded[@]}" --out "$out/fused.jsonl" 2> "$out/fuser.log" &
 fuser_pid=$!
 sleep 1  # the fuser's reader first, so that it sees every camera's first measurement
 pids=()
 for name in "${names[@]}"; do
-  timed "$name" "$hrcsense" run --config "$out/cell.yaml" --camera "$name" --out "$out/$name.jsonl" 2> "$out/$name.log" &
+  timed "$name" "$hrcsense" run --config "$out/cell.yaml" "${recorded[@]}" --camera "$name" --out "$out/$name.jsonl" 2> "$out/$name.log" &
   pids+=($!)
 done
 wait "${pids[@]}"
