@@ -9,6 +9,7 @@
 // is learnt, and the cell then runs.
 #include "../support/scenes.hpp"
 #include "../support/decide.hpp"
+#include "../support/sanitized.hpp"
 #include "common/assembly.hpp"
 #include "common/background_start.hpp"
 #include "hrcsense/config/config.hpp"
@@ -117,6 +118,7 @@ BackgroundModel* BackgroundReference::reference_ = nullptr;
 // Today's behaviour, and the scenario's premise, from the simulator's truth alone: the person
 // stands 0.29 m from the arm while the first batch is learnt, and the cell then says `run`.
 TEST_F(BackgroundReference, WithoutAReferenceAStandingPersonBecomesBackground) {
+  if (test::kSanitized) GTEST_SKIP() << "a long scenario run; the ci build runs it, and its code runs under the sanitizers in the unit tests (CI time)";
   const Config config = standing_person_cell(true);
   const std::vector<FrameOutcome> outcomes = run_cell(config, nullptr);
   const float slow_m = config.pipeline.safety.slow_distance_m;
@@ -131,6 +133,7 @@ TEST_F(BackgroundReference, WithoutAReferenceAStandingPersonBecomesBackground) {
 }
 
 TEST_F(BackgroundReference, WithAReferenceTheCellStopsUntilThePersonHasGone) {
+  if (test::kSanitized) GTEST_SKIP() << "a long scenario run; the ci build runs it, and its code runs under the sanitizers in the unit tests (CI time)";
   const Config config = standing_person_cell(true);
   const std::vector<FrameOutcome> outcomes = run_cell(config, reference_);
   const float slow_m = config.pipeline.safety.slow_distance_m;

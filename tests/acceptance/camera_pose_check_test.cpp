@@ -89,6 +89,7 @@ TEST(CameraPoseCheck, AKnockDuringTheRunStopsWithinTheBound) {
 }
 
 TEST(CameraPoseCheck, TheRightPoseNeverFiresInTheShortRuns) {
+  if (test::kSanitized) GTEST_SKIP() << "the ci build runs it and CameraPoseCheckLong's 10 000 frames; the check runs under the sanitizers in the other CameraPoseCheck tests (CI time)";
   for (const char* cell : pose_cells()) {
     const auto frames = run_frame_reasons(cell, "--frames 300", std::string("pose_right_") + cell);
     ASSERT_EQ(frames.size(), 300U) << cell;
