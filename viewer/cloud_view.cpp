@@ -263,15 +263,19 @@ ViewCamera orbit_view_camera(const ViewFrame& frame, const OrbitCamera& camera, 
   return view;
 }
 
-void compose_3d(const ViewFrame& frame, const OrbitCamera& camera, int width, int height, Cloud3dScratch& scratch,
-                ColorImage& out) {
+size_t clear_3d_pane(int width, int height, std::vector<float>& zbuffer, ColorImage& out) {
   out.width = std::max(width, 0);
   out.height = std::max(height, 0);
   const size_t pixels = static_cast<size_t>(out.width) * out.height;
   out.rgb.resize(pixels * 3);
   for (size_t i = 0; i < pixels; ++i) std::copy(kCloudBackdrop.begin(), kCloudBackdrop.end(), &out.rgb[3 * i]);
-  if (pixels == 0) return;
-  scratch.zbuffer.assign(pixels, std::numeric_limits<float>::infinity());
+  zbuffer.assign(pixels, std::numeric_limits<float>::infinity());
+  return pixels;
+}
+
+void compose_3d(const ViewFrame& frame, const OrbitCamera& camera, int width, int height, Cloud3dScratch& scratch,
+                ColorImage& out) {
+  if (clear_3d_pane(width, height, scratch.zbuffer, out) == 0) return;
   const ViewCamera view = orbit_view_camera(frame, camera, out.width, out.height);
   draw_floor_grid(camera, view.intrinsics, out);
   draw_cloud(frame, view, depth_to_orbit(frame, camera), scratch, out);

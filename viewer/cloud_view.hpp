@@ -90,6 +90,10 @@ void draw_segment(ColorImage& image, const Intrinsics& in, const Eigen::Vector3f
 /// kRobotOutline.
 void draw_robot_pixels(const std::vector<uint8_t>& robot, ColorImage& out);
 
+/// Sizes `out` to width × height (0 for a size ≤ 0), fills it with kCloudBackdrop and sets
+/// `zbuffer` to +inf per pixel: the start of every 3D pane. Returns the pixel count.
+size_t clear_3d_pane(int width, int height, std::vector<float>& zbuffer, ColorImage& out);
+
 /// Reusable buffers of compose_3d(): sized on the first call of an image size, reused after.
 struct Cloud3dScratch {
   std::vector<float> zbuffer;  ///< orbit-camera z per output pixel, metres

@@ -189,13 +189,8 @@ OrbitCamera fused_default_orbit(const ros2::FusedView& view) {
 
 void compose_fused_3d(const ros2::FusedView& view, const std::vector<Capsule>& capsules_base, const FusedPair& pair,
                       const OrbitCamera& camera, int width, int height, FusedScratch& scratch, ColorImage& out) {
-  out.width = std::max(width, 0);
-  out.height = std::max(height, 0);
-  const size_t pixels = static_cast<size_t>(out.width) * out.height;
-  out.rgb.resize(pixels * 3);
-  for (size_t i = 0; i < pixels; ++i) std::copy(kCloudBackdrop.begin(), kCloudBackdrop.end(), &out.rgb[3 * i]);
+  const size_t pixels = clear_3d_pane(width, height, scratch.cloud.zbuffer, out);
   if (pixels == 0) return;
-  scratch.cloud.zbuffer.assign(pixels, std::numeric_limits<float>::infinity());
   // The base frame stands for the depth camera of orbit_view_camera(): depth_to_view is then
   // the orbit camera's own pose.
   const ViewFrame base_frame;
