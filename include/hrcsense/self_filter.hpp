@@ -43,6 +43,10 @@ struct RobotPixels {
   const uint16_t* to_raw = nullptr;
   int u0 = 0, v0 = 0;
   int u1 = std::numeric_limits<int>::max(), v1 = std::numeric_limits<int>::max();
+  /// How far (px, square) the depth filters smear the arm into its surroundings
+  /// (SelfFilterParams::dilate_px): a candidate beyond the padded far side with the arm nearer
+  /// and the background farther within this reach is a mix of the two, the arm's; 0: none is.
+  int smear_px = 0;
   bool contains(size_t i, uint16_t raw) const {
     return from_raw[i] != 0 && raw >= from_raw[i] && raw <= to_raw[i];
   }
@@ -72,7 +76,7 @@ class SelfFilter {
   void render(const Frame& frame, const Pose& T_base_camera, const ForegroundParams& foreground);
   /// The robot's raw depths per pixel of the last render (valid until the next render).
   RobotPixels robot_pixels() const {
-    return {from_raw_.data(), to_raw_.data(), dirty_.u0, dirty_.v0, dirty_.u1, dirty_.v1};
+    return {from_raw_.data(), to_raw_.data(), dirty_.u0, dirty_.v0, dirty_.u1, dirty_.v1, params.dilate_px};
   }
   /// The padded body's nearest depth per pixel in metres, dilated (+inf where no robot); for
   /// tests and the viewer.

@@ -299,19 +299,65 @@ void keep_unknown_in_workspace(const DepthImage& depth, const Rays& rays, const 
   }
 }
 
-/// Clears the candidates that are the robot's own pixels (SelfFilter::robot_pixels()); returns
-/// how many. Done before speckle removal, so that the fringe the self-filter leaves around the
-/// arm is judged by its own size, not as part of the arm's blob.
+constexpr uint8_t kArmMix = 16;  // a candidate found to be a mix of the arm and what lies behind it
+
+/// A candidate inside the robot's silhouette but beyond its padded far side (`raw` over
+/// robot.to_raw) is the filters' mix of the arm and the surface behind it when, within
+/// robot.smear_px, there is both a pixel of the arm nearer than it and a pixel that is not
+/// foreground: the background farther than it, or no depth. Decimation's median of four and the
+/// spatial filter's smoothing put such depths along the arm's rim, between its two sides, where
+/// no surface is. Something real behind the arm has candidates of its own depth around it, not
+/// only the arm and the background, and stays (docs/ROBOT.md, "Self-filter", step 4).
+bool arm_mix(const DepthImage& depth, const RobotPixels& robot, const uint8_t* mask, size_t i) {
+  const int width = depth.width;
+  const int u = static_cast<int>(i % static_cast<size_t>(width));
+  const int v = static_cast<int>(i / static_cast<size_t>(width));
+  const uint16_t raw = depth.pixels[i];
+  bool arm_nearer = false, background_farther = false;
+  for (int vv = std::max(0, v - robot.smear_px); vv <= std::min(depth.height - 1, v + robot.smear_px); ++vv) {
+    for (int uu = std::max(0, u - robot.smear_px); uu <= std::min(width - 1, u + robot.smear_px); ++uu) {
+      const size_t j = static_cast<size_t>(vv) * static_cast<size_t>(width) + static_cast<size_t>(uu);
+      const uint16_t other = depth.pixels[j];
+      if (other != 0 && robot.contains(j, other)) {
+        arm_nearer = arm_nearer || other < raw;
+      } else if ((mask[j] & (kCandidate | kArmMix)) == 0) {
+        // The background, or a hole: beside an edge the sensor and the filters lose depth
+        // where the two sides disagree, and the mix came from the far side all the same.
+        background_farther = background_farther || other == 0 || other > raw;
+      }
+    }
+  }
+  return arm_nearer && background_farther;
+}
+
+/// Clears the candidates that are the robot's own pixels (SelfFilter::robot_pixels()), and the
+/// mixes of the arm and its background at its rim (arm_mix); returns how many. Done before
+/// speckle removal, so that the fringe the self-filter leaves around the arm is judged by its
+/// own size, not as part of the arm's blob.
 size_t remove_robot_pixels(const DepthImage& depth, const RobotPixels& robot, const uint8_t* row_states,
                            uint8_t* mask) {
   size_t removed = 0;
   const size_t width = static_cast<size_t>(depth.width);
-  for_each_marked_in_rows(mask, row_states, width, 0, static_cast<size_t>(depth.height), kCandidate, [&](size_t i) {
+  const size_t height = static_cast<size_t>(depth.height);
+  for_each_marked_in_rows(mask, row_states, width, 0, height, kCandidate, [&](size_t i) {
     if (robot.contains(i, depth.pixels[i])) {
       mask[i] = kNone;
       ++removed;
     }
   });
+  if (robot.smear_px <= 0) return removed;
+  // Mixes are marked first and cleared after, so that one mix never makes its neighbour look
+  // like the background behind it.
+  for_each_marked_in_rows(mask, row_states, width, 0, height, kCandidate, [&](size_t i) {
+    if (robot.from_raw[i] != 0 && depth.pixels[i] > robot.to_raw[i] && arm_mix(depth, robot, mask, i)) {
+      mask[i] = kArmMix;
+      ++removed;
+    }
+  });
+  auto clear = [&](size_t i) { mask[i] = kNone; };
+  for (size_t v = 0; v < height; ++v) {
+    if ((row_states[v] & kCandidate) != 0) for_each_marked(mask, v * width, (v + 1) * width, kArmMix, clear);
+  }
   return removed;
 }
 

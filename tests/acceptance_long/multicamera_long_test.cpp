@@ -179,19 +179,27 @@ void three_camera_cell_against_the_truth() {
 void empty_cell_fuses_to_run() {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("hrcsense_3cam_empty_" + std::to_string(::getpid()));
   ASSERT_EQ(run_cell("cell-ur5-3cam-empty.yaml", 430, dir), 0);  // 100 learning, 10 s after
-  int after_learning = 0, runs = 0;
+  int after_learning = 0, runs = 0, seen = 0;
+  std::map<std::string, int> stops_by_reason;
   for (const json& line : read_lines(dir / "fused.jsonl")) {
     if (line["type"] != "frame" || line["frame"].get<int64_t>() < 130) continue;
     ++after_learning;
     runs += line["verdict"] == "run";
+    if (line["verdict"] != "run") ++stops_by_reason[line["reason_code"].get<std::string>()];
+    seen += line.contains("distance_m") && line["distance_m"].is_number();  // some camera saw foreground
   }
-  std::printf("empty 3-camera cell: %d of %d fused instants after learning are run\n", runs, after_learning);
-  // Not every instant: `left` sees a few pixels of the wrist beyond the self-filter's capsules at
-  // the pick pose (5-10 points, 3-6 cm off the padded link 6), a stop held for min_hold_s; the
-  // other cameras see no foreground at all (docs/MULTICAMERA.md, "Measured"). 61 % on a quiet
-  // machine; a third with the other long tests on the same two cores.
+  std::printf("empty 3-camera cell: %d of %d fused instants after learning are run; %d with foreground;", runs,
+              after_learning, seen);
+  for (const auto& [reason, count] : stops_by_reason) std::printf(" %s %d", reason.c_str(), count);
+  std::printf("\n");
+  // Nobody is in the cell, and the self-filter takes the arm's pixels, its rim's mixes with the
+  // background included (docs/ROBOT.md, "Self-filter"): no camera sees anything, and the cell
+  // runs at every instant on a quiet machine (771 of 771 over the whole scene). A camera starved
+  // of the cores by the other long tests may still be stale at a few instants (camera_stale and
+  // the hold after it), so the run count has room; the foreground has none.
   EXPECT_GE(after_learning, 280);
-  EXPECT_GE(runs, after_learning / 3);
+  EXPECT_EQ(seen, 0);
+  EXPECT_GE(runs, after_learning * 2 / 3);
   std::filesystem::remove_all(dir);
 }
 

@@ -239,5 +239,74 @@ TEST(SelfFilter, ForegroundKeepsAHandInFrontOfTheArmAndDropsTheArm) {
   EXPECT_EQ(fg.self_filtered_pixels, 0U);
 }
 
+
+// The depth filters smear the arm's rim into what lies behind it: decimation's median of four
+// and the spatial filter give rim pixels depths between the arm and the wall, beyond the padded
+// body's far side, where no surface is. Such a pixel, with the arm nearer and the wall (or no
+// depth) farther within dilate_px, is the arm's; a body behind the arm keeps every pixel whose
+// neighbourhood holds only the arm and itself.
+TEST(SelfFilter, TheArmsRimMixedWithTheWallIsTheArmsAndABodyBehindItStays) {
+  SelfFilter filter = filter_with(2);
+  filter.add_pose(bar_at(2.0F));
+  Frame frame = camera_frame();
+  filter.render(frame, Pose::Identity(), ForegroundParams{});
+  BackgroundModel background;
+  background.width = background.height = kSize;
+  background.mean_m.assign(kSize * kSize, 3.0F);
+  background.spread_m.assign(kSize * kSize, 0.005F);
+  background.valid_ratio.assign(kSize * kSize, 1.0F);
+  // The wall at 3 m; the bar's rows 45..55 at its front + 1 cm (its cylinder covers columns
+  // 40..60 at 1.9-2 m: x = ±0.2 m); rows 43..57 are its silhouette dilated by 2 px.
+  frame.depth.pixels.assign(kSize * kSize, 3000);
+  for (int v = 45; v <= 55; ++v) {
+    for (int u = 0; u < kSize; ++u) {
+      const double front = filter.surface_depth_m()[index(u, v)];
+      if (std::isfinite(front)) frame.depth.pixels[index(u, v)] = static_cast<uint16_t>(std::lround(front * 1000.0 + 10.0));
+    }
+  }
+  // Row 44 is outside the bar, inside the dilated silhouette, and its far side there is the
+  // bar's back near its rim, about 2.0 m (ray_meets_bar(46, ...).second). 2.5 m is beyond it.
+  ASSERT_LT(ray_meets_bar(46, 2.0, 0.1).second, 2.5);
+  // Four mixed rim pixels at columns 43..46 of row 44: the arm below, the wall above.
+  for (int u = 43; u <= 46; ++u) frame.depth.pixels[index(u, 44)] = 2500;
+  // A body 50 cm behind the bar's front at columns 51..59, rows 40..44 (45 pixels): rows 40..42
+  // lie outside the silhouette. In rows 43 and 44 the columns 51, 52, 58 and 59 have the wall
+  // within 2 px beside them (columns 49, 50 and 60, 61): mixes by the rule, 8 pixels. Columns
+  // 53..57 see only the body and the arm: 10 pixels, kept.
+  for (int v = 40; v <= 44; ++v) {
+    for (int u = 51; u <= 59; ++u) frame.depth.pixels[index(u, v)] = 2500;
+  }
+  ForegroundExtractor extractor;
+  extractor.params.min_object_mm = 0.0F;
+  extractor.set_background(background, kFocalPx, 0.0F, 0.001F);
+  Foreground fg;
+  RobotPixels robot = filter.robot_pixels();
+  EXPECT_EQ(robot.smear_px, 2);
+  ASSERT_TRUE(extractor.extract(frame, Pose::Identity(), fg, &robot));
+  EXPECT_EQ(fg.points_camera.size(), 27U + 10U);
+  for (int v = 43; v <= 44; ++v) {
+    for (int u = 53; u <= 57; ++u) EXPECT_EQ(fg.mask[index(u, v)], 1) << u << ", " << v;  // the body's nearest row stays
+    for (int u : {43, 44, 45, 46, 51, 52, 58, 59}) EXPECT_EQ(fg.mask[index(u, v)], 0) << u << ", " << v;
+  }
+  // Without the rule (smear 0) the mixes and the body's corners are foreground: 4 + 45.
+  robot.smear_px = 0;
+  ASSERT_TRUE(extractor.extract(frame, Pose::Identity(), fg, &robot));
+  EXPECT_EQ(fg.points_camera.size(), 4U + 45U);
+
+  // No depth above the rim (the sensor's edge dropouts) is as good as the wall behind it.
+  robot.smear_px = 2;
+  for (int v = 41; v <= 43; ++v) {
+    for (int u = 40; u <= 49; ++u) frame.depth.pixels[index(u, v)] = 0;
+  }
+  ASSERT_TRUE(extractor.extract(frame, Pose::Identity(), fg, &robot));
+  for (int u = 43; u <= 46; ++u) EXPECT_EQ(fg.mask[index(u, 44)], 0) << u;
+  // Without the arm nearer (its pixels lost) a pixel beyond the far side is never a mix.
+  for (int u = 40; u <= 49; ++u) {
+    for (int v = 45; v <= 46; ++v) frame.depth.pixels[index(u, v)] = 0;
+  }
+  ASSERT_TRUE(extractor.extract(frame, Pose::Identity(), fg, &robot));
+  for (int u = 43; u <= 46; ++u) EXPECT_EQ(fg.mask[index(u, 44)], 1) << u;
+}
+
 }  // namespace
 }  // namespace hrcsense
