@@ -123,7 +123,8 @@ TEST(FuseRobotState, TheFuserRepublishesTheLiveRobotAndPublishesTheSceneClock) {
   std::vector<std::string> camera_sets = sets;
   for (const std::string& set : camera_robot_state_sets(live)) camera_sets.push_back(set);
   SteadyClock clock;
-  const std::unique_ptr<RobotStateSource> camera = make_robot_state_source(load_config(files.config, camera_sets), &clock);
+  const std::unique_ptr<RobotStateSource> camera =
+      make_robot_state_source(load_config(files.config, camera_sets), &clock);
   ASSERT_EQ(camera->origin(), RobotStateOrigin::ros2);
 
   // The scene clock: sim.epoch, latched for a camera that joins now.
@@ -137,8 +138,9 @@ TEST(FuseRobotState, TheFuserRepublishesTheLiveRobotAndPublishesTheSceneClock) {
   // that the fuser's sender-to-host map keeps the stamps near their arrival whatever the pace.
   int64_t t_ns = 0;
   const auto next_t_ns = [&t_ns] {
+    using std::chrono::steady_clock;
     const int64_t now_ns =
-        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+        std::chrono::duration_cast<std::chrono::nanoseconds>(steady_clock::now().time_since_epoch()).count();
     t_ns = std::max(t_ns + 1000, now_ns);
     return t_ns;
   };
@@ -166,8 +168,8 @@ TEST(FuseRobotState, TheFuserRepublishesTheLiveRobotAndPublishesTheSceneClock) {
   seen.clear();
   speed_seen.clear();
 
-  // The burst, as fast as the fuser takes them, never more than 16 ahead of what came back (the socket's buffer then never overflows: UDP loses nothing
-  // on loopback but to a full buffer). Each accepted sample comes back once, in order; the
+  // The burst, as fast as the fuser takes them, never more than 16 ahead of what came back (the
+  // socket's buffer then never overflows: UDP loses nothing on loopback but to a full buffer). Each accepted sample comes back once, in order; the
   // rejected one never; a speed fraction for each one that had one.
   std::vector<std::vector<double>> expected_q;
   std::vector<double> expected_speed;
@@ -224,8 +226,8 @@ TEST(FuseRobotState, TheFuserRepublishesTheLiveRobotAndPublishesTheSceneClock) {
   }
   EXPECT_EQ(mismatches, 0U) << "JointStates out of order, changed or missing";
   ASSERT_GE(speed_seen.size(), expected_speed.size());
-  EXPECT_EQ(std::vector<double>(speed_seen.begin(), speed_seen.begin() + static_cast<std::ptrdiff_t>(expected_speed.size())),
-            expected_speed);
+  const auto burst_end = speed_seen.begin() + static_cast<std::ptrdiff_t>(expected_speed.size());
+  EXPECT_EQ(std::vector<double>(speed_seen.begin(), burst_end), expected_speed);
   // After the burst only the camera phase's samples: 0.625 each while it said so, none after.
   for (size_t i = expected_speed.size(); i < speed_seen.size(); ++i) EXPECT_EQ(speed_seen[i], 0.625) << i;
   for (size_t i = expected_q.size(); i < seen.size(); ++i) {

@@ -282,6 +282,74 @@ TEST(RobotStateRelay, EveryAcceptedRtdeSampleGoesOutOnceInOrderWithItsSpeedFract
   EXPECT_EQ(counters.dropped, 0);
 }
 
+// robot.state.source ros2 in the fuser: a driver's JointState and speed scaling (here written by a
+// JointStateWriter standing in for the driver, 0.75 as a fraction) → Ros2JointStateSource →
+// the relay. Each sample the source accepted goes out once, in order, with the driver's speed
+// reading. The source's own reader is best-effort as the cameras' (it may lose a sample of a
+// burst): the count compared is the source's accepted count, not what the driver sent.
+TEST(RobotStateRelay, ADriversJointStatesAndSpeedScalingAreRelayed) {
+  if (!test::loopback_configured()) GTEST_SKIP() << test::kNoLoopback;
+  const uint32_t domain = test::test_domain();
+  const std::string driver_ns = "/relay_driver_" + std::to_string(::getpid());
+  const std::string ns = "/relay_ros2_" + std::to_string(::getpid());
+  ros2::JointStateWriter driver({domain, driver_ns + "/joint_states", "", driver_ns + "/speed_scaling"});
+  SteadyClock clock;
+  ros2::Ros2JointStateParams params;
+  params.topic = driver_ns + "/joint_states";
+  params.speed_scaling_topic = driver_ns + "/speed_scaling";
+  params.speed_scaling_unit = SpeedScalingUnit::fraction;
+  params.domain_id = domain;
+  params.history.max_age_s = 0.5;
+  ros2::Ros2JointStateSource source(params, clock);
+  ros2::JointStateRelay relay(source, {domain, ns + "/joint_states", "", ns + "/robot_speed_scaling"});
+  TestJointStateReader joints(domain, ns + "/joint_states", ReaderQos::reliable_keep_all);
+  TestFloat64Reader speeds(domain, ns + "/robot_speed_scaling");
+  ASSERT_TRUE(wait_until([&] {
+    return driver.readers_matched() > 0 && driver.speed_readers_matched() > 0 && relay.readers_matched() > 0 &&
+           relay.speed_readers_matched() > 0 && joints.matched() && speeds.matched();
+  }, 20.0));
+
+  // The speed reading first; then samples until one comes back with it (the reading is the
+  // source's once it has arrived), then a burst of 200, 1 ms apart, the reading repeated.
+  ASSERT_EQ(driver.write_speed_fraction(0.75), ros2::WriteOutcome::written);
+  JointAngles q{0.1, -1.2, 1.3, -0.4, 0.5, 0.6};
+  const JointAngles qd{0.5, 0.0, 0.0, 0.0, 0.0, 0.0};
+  std::vector<double> speed_seen;
+  for (int attempt = 0; attempt < 200 && speed_seen.empty(); ++attempt) {
+    q[0] += 0.0005;
+    driver.write(wall_ns(), q, qd);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    speeds.take(speed_seen);
+  }
+  ASSERT_FALSE(speed_seen.empty()) << "no speed fraction came back; " << source.error();
+  for (int k = 0; k < 200; ++k) {
+    // The reading again now and then: it holds for max_age_s (0.5 s) after its arrival.
+    if (k % 10 == 0) driver.write_speed_fraction(0.75);
+    q[0] += 0.0005;
+    driver.write(wall_ns(), q, qd);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  // Everything the source accepted, written; then read back.
+  ASSERT_TRUE(wait_until([&] {
+    return source.stats().samples.accepted >= 200 && relay.counters().published == source.stats().samples.accepted;
+  }, 20.0)) << relay.counters().published << " of " << source.stats().samples.accepted;
+  const int64_t accepted = source.stats().samples.accepted;
+  std::vector<Seen> seen;
+  EXPECT_TRUE(take_until([&] { joints.take(seen); }, [&] { return seen.size(); }, static_cast<size_t>(accepted)));
+  EXPECT_EQ(seen.size(), static_cast<size_t>(accepted));
+  for (size_t i = 1; i < seen.size(); ++i) {
+    EXPECT_GT(seen[i].position[0], seen[i - 1].position[0]) << "out of order or twice at " << i;
+  }
+  ASSERT_FALSE(seen.empty());
+  EXPECT_EQ(seen.back().position[0], q[0]) << "the last sample is the driver's last";
+  // Each sample after the reading arrived carries it: the speed fractions are 0.75, one per sample.
+  const int64_t speed_published = relay.counters().speed_published;
+  EXPECT_GE(speed_published, 200);
+  EXPECT_TRUE(take_until([&] { speeds.take(speed_seen); }, [&] { return speed_seen.size(); },
+                         static_cast<size_t>(speed_published)));
+  EXPECT_EQ(speed_seen, std::vector<double>(static_cast<size_t>(speed_published), 0.75));
+}
+
 // A source that hands over no samples (a fixed arm) has nothing to relay: a clear error, not a
 // silent topic.
 TEST(RobotStateRelay, AFixedArmIsNotRelayed) {
