@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <utility>
 
 namespace hrcsense::ros2 {
 namespace {
@@ -150,6 +151,9 @@ void Ros2JointStateSource::add_sample(const JointStateSample& parsed, int64_t ho
   sample.qd_rad_s = parsed.qd_rad_s;
   sample.valid = true;
   sample.origin = RobotStateOrigin::ros2;
+  // The speed reading of the sample's time, as state_at would give it: a listener (the fuser's
+  // relay) passes it on with the sample.
+  sample.speed_fraction = speed_fraction_at(host_time_ns);
   // Built on a rejection only: an accepted sample allocates nothing here.
   const auto stamp_text = [&parsed] {
     return "JointState stamped " + std::to_string(parsed.stamp_ns) + " ns rejected: ";
@@ -269,6 +273,12 @@ RobotStateStats Ros2JointStateSource::stats() const {
   stats.malformed = malformed_;
   stats.last_problem = last_problem_;
   return stats;
+}
+
+bool Ros2JointStateSource::set_sample_listener(RobotStateListener listener) {
+  const std::lock_guard<std::mutex> lock(mutex_);  // add_sample runs under it: no call is under way now
+  history_.listener = std::move(listener);
+  return true;
 }
 
 int64_t Ros2JointStateSource::speed_readings_rejected() const {

@@ -72,6 +72,9 @@ class Ros2JointStateSource final : public RobotStateSource {
   /// Why the last state_at failed, naming the topic and domain ("" after a valid one).
   std::string error() const override;
   RobotStateStats stats() const override;
+  /// Each accepted JointState's state, as the reader thread accepts it, with the speed reading
+  /// of its time (speed_fraction, as state_at gives it).
+  bool set_sample_listener(RobotStateListener listener) override;
   /// Speed scaling messages rejected (non-finite, out of range); also in stats().malformed.
   int64_t speed_readings_rejected() const;
   /// "/joint_states (domain 0)": how messages name this source.

@@ -4,39 +4,62 @@
 
 #include "dds/dds_entity.hpp"
 #include "dds/ros2_messages.hpp"  // dds_topic_name, stamp_from_ns
+#include "hrcsense/clock.hpp"
 #include "hrcsense/robot_state_history.hpp"
 
-#include <algorithm>
+#include "std_msgs.h"
+
 #include <array>
-#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
 
 namespace hrcsense::ros2 {
 
 std::string cell_joint_states_topic(const std::string& node_namespace) { return node_namespace + "/joint_states"; }
 
+std::string cell_robot_speed_scaling_topic(const std::string& node_namespace) {
+  return node_namespace + "/robot_speed_scaling";
+}
+
 struct JointStateWriter::Dds {
   ParticipantScope scope;
   dds_entity_t writer = 0;
+  dds_entity_t speed_writer = 0;  ///< 0: no speed scaling topic
   explicit Dds(uint32_t domain_id) : scope(domain_id) {}
+
+  dds_entity_t make_writer(const dds_topic_descriptor_t& type, const std::string& ros_topic) {
+    const std::string name = dds_topic_name(ros_topic);
+    const dds_entity_t topic =
+        scope.own(dds_create_topic(scope.participant(), &type, name.c_str(), nullptr, nullptr), "DDS topic " + name);
+    const QosHandle qos(EndpointQos{true, false, 10});  // ROS's default: reliable, volatile, keep-last 10
+    return scope.own(dds_create_writer(scope.participant(), topic, qos.get(), nullptr), "DDS writer on " + name);
+  }
 };
 
 JointStateWriter::JointStateWriter(const JointStateWriterParams& params)
     : params_(params), names_(ur_joint_names(params.tf_prefix)), dds_(std::make_unique<Dds>(params.domain_id)) {
-  const std::string name = dds_topic_name(params_.topic);
-  const dds_entity_t topic = dds_->scope.own(
-      dds_create_topic(dds_->scope.participant(), &sensor_msgs_msg_dds__JointState__desc, name.c_str(), nullptr, nullptr),
-      "DDS topic " + name);
-  const QosHandle qos(EndpointQos{true, false, 10});  // ROS's default: reliable, volatile, keep-last 10
-  dds_->writer = dds_->scope.own(dds_create_writer(dds_->scope.participant(), topic, qos.get(), nullptr),
-                                 "DDS writer on " + name);
+  dds_->writer = dds_->make_writer(sensor_msgs_msg_dds__JointState__desc, params_.topic);
+  if (!params_.speed_scaling_topic.empty()) {
+    dds_->speed_writer = dds_->make_writer(std_msgs_msg_dds__Float64__desc, params_.speed_scaling_topic);
+  }
 }
 
 JointStateWriter::~JointStateWriter() = default;
 
-bool JointStateWriter::write(int64_t stamp_ns, const JointAngles& q_rad, const JointAngles& qd_rad_s) {
+WriteOutcome JointStateWriter::outcome(int32_t ret, const std::string& topic) {
+  if (ret == DDS_RETCODE_TIMEOUT) return WriteOutcome::timed_out;
+  if (ret < 0) {
+    last_error_ = topic + ": write refused: " + dds_strretcode(ret);
+    return WriteOutcome::refused;
+  }
+  return WriteOutcome::written;
+}
+
+WriteOutcome JointStateWriter::write(int64_t stamp_ns, const JointAngles& q_rad, const JointAngles& qd_rad_s) {
   if (!all_finite(q_rad) || !all_finite(qd_rad_s)) {
     last_error_ = params_.topic + ": a non-finite joint value was not written";
-    return false;
+    return WriteOutcome::refused;
   }
   // The message points at these: nothing is allocated with DDS's allocator, nothing to free.
   std::array<char*, kJointCount> name_pointers{};
@@ -56,28 +79,57 @@ bool JointStateWriter::write(int64_t stamp_ns, const JointAngles& q_rad, const J
   msg.position._length = msg.position._maximum = static_cast<uint32_t>(kJointCount);
   msg.velocity._buffer = velocity.data();
   msg.velocity._length = msg.velocity._maximum = static_cast<uint32_t>(kJointCount);
-  const dds_return_t ret = dds_write(dds_->writer, &msg);
-  if (ret < 0) {
-    last_error_ = params_.topic + ": write refused: " + dds_strretcode(ret);
-    return false;
-  }
-  return true;
+  return outcome(dds_write(dds_->writer, &msg), params_.topic);
 }
 
-int32_t JointStateWriter::readers_matched() const {
+WriteOutcome JointStateWriter::write_speed_fraction(double fraction) {
+  if (dds_->speed_writer == 0) {
+    last_error_ = "no speed scaling topic to write a speed fraction on";
+    return WriteOutcome::refused;
+  }
+  if (!(fraction >= 0.0 && fraction <= 1.0)) {  // NaN fails too
+    last_error_ = params_.speed_scaling_topic + ": a speed fraction outside 0..1 was not written";
+    return WriteOutcome::refused;
+  }
+  const std_msgs_msg_dds__Float64_ msg{fraction};
+  return outcome(dds_write(dds_->speed_writer, &msg), params_.speed_scaling_topic);
+}
+
+namespace {
+
+int32_t matched_readers(dds_entity_t writer) {
   dds_publication_matched_status_t status{};
-  if (dds_get_publication_matched_status(dds_->writer, &status) != DDS_RETCODE_OK) return 0;
+  if (writer == 0 || dds_get_publication_matched_status(writer, &status) != DDS_RETCODE_OK) return 0;
   return static_cast<int32_t>(status.current_count);
 }
 
-JointStateRelay::JointStateRelay(RobotStateSource& source, const RunClock& clock, const JointStateWriterParams& params,
-                                 double poll_s)
-    : source_(source), clock_(clock), writer_(params), poll_ns_(std::max<int64_t>(100'000, seconds_to_ns(poll_s))) {
-  thread_ = std::thread([this] { loop(); });
+}  // namespace
+
+int32_t JointStateWriter::readers_matched() const { return matched_readers(dds_->writer); }
+
+int32_t JointStateWriter::speed_readers_matched() const { return matched_readers(dds_->speed_writer); }
+
+JointStateRelay::JointStateRelay(RobotStateSource& source, const JointStateWriterParams& params)
+    : source_(source), writer_(params), queue_(kQueueCapacity) {
+  if (!source_.set_sample_listener([this](const RobotState& sample) { enqueue(sample); })) {
+    throw std::invalid_argument(std::string("robot.state.source ") + robot_state_origin_name(source_.origin()) +
+                                " hands over no samples: nothing to republish on " + params.topic);
+  }
+  try {
+    thread_ = std::thread([this] { loop(); });
+  } catch (...) {
+    source_.set_sample_listener({});  // no call may reach this half-made relay
+    throw;
+  }
 }
 
 JointStateRelay::~JointStateRelay() {
-  stop_ = true;
+  source_.set_sample_listener({});  // once it returns, enqueue is not under way and never runs again
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_one();
   thread_.join();
 }
 
@@ -86,32 +138,62 @@ JointStateRelayCounters JointStateRelay::counters() const {
   return counters_;
 }
 
+void JointStateRelay::enqueue(const RobotState& sample) {
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (queued_ == queue_.size()) {  // the writer is far behind: the oldest goes, the newest matter
+      first_ = (first_ + 1) % queue_.size();
+      --queued_;
+      ++counters_.dropped;
+    }
+    queue_[(first_ + queued_) % queue_.size()] = sample;
+    ++queued_;
+  }
+  wake_.notify_one();
+}
+
 void JointStateRelay::loop() {
-  while (!stop_) {
-    relay_newest();
-    std::this_thread::sleep_for(std::chrono::nanoseconds(poll_ns_));
+  for (;;) {
+    RobotState sample;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [this] { return stop_ || queued_ > 0; });
+      if (stop_) return;
+      sample = queue_[first_];
+      first_ = (first_ + 1) % queue_.size();
+      --queued_;
+    }
+    publish(sample);
   }
 }
 
-void JointStateRelay::relay_newest() {
-  RobotState now_state;
-  source_.state_at(clock_.now_ns(), now_state);
-  // sample_time_ns is the newest accepted sample's host time, also when the state is stale: a
-  // silent source leaves it where it was, and nothing new is published.
-  const int64_t sample_ns = now_state.sample_time_ns;
-  if (sample_ns <= last_sample_ns_) return;
-  last_sample_ns_ = sample_ns;
-  // At its own time the history answers with the sample itself (no interpolation, no
-  // extrapolation), or nothing when it is already older than robot.state.max_age_s.
-  RobotState sample;
-  if (!source_.state_at(sample_ns, sample) || !sample.valid) return;
-  const bool written = writer_.write(sample_ns + realtime_minus_steady_ns(), sample.q_rad, sample.qd_rad_s);
-  const std::lock_guard<std::mutex> lock(mutex_);
-  if (written) {
+template <typename Write>
+bool JointStateRelay::write_until_done(const Write& write) {
+  for (;;) {
+    const WriteOutcome outcome = write();
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (outcome == WriteOutcome::written) return true;
+    if (outcome == WriteOutcome::refused) {
+      ++counters_.refused;
+      counters_.last_error = writer_.last_error();
+      return false;
+    }
+    ++counters_.write_waits;
+    if (stop_) return false;
+  }
+}
+
+void JointStateRelay::publish(const RobotState& sample) {
+  // The speed fraction first: a camera that takes both in one wake-up has the reading with the state.
+  if (!writer_.speed_scaling_topic().empty() && !std::isnan(sample.speed_fraction) &&
+      write_until_done([&] { return writer_.write_speed_fraction(sample.speed_fraction); })) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    ++counters_.speed_published;
+  }
+  const int64_t stamp_ns = sample.host_time_ns + realtime_minus_steady_ns();
+  if (write_until_done([&] { return writer_.write(stamp_ns, sample.q_rad, sample.qd_rad_s); })) {
+    const std::lock_guard<std::mutex> lock(mutex_);
     ++counters_.published;
-  } else {
-    ++counters_.refused;
-    counters_.last_error = writer_.last_error();
   }
 }
 

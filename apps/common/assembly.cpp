@@ -287,9 +287,13 @@ bool robot_state_is_live(const Config& config) {
 
 std::vector<std::string> camera_robot_state_sets(const Config& config) {
   if (!robot_state_is_live(config)) return {};
-  // The key names of load_config; the topic is what the fuser's writer uses
-  // (cell_joint_states_topic), spelled here too for a build without DDS, where nothing runs.
-  return {"robot.state.source=ros2", "robot.state.ros2.topic=" + config.ros2.node_namespace + "/joint_states"};
+  // The key names of load_config; the topics are what the fuser's writers use
+  // (cell_joint_states_topic, cell_robot_speed_scaling_topic), spelled here too for a build
+  // without DDS, where nothing runs. The fuser writes the speed as a fraction, 0..1.
+  const std::string& ns = config.ros2.node_namespace;
+  return {"robot.state.source=ros2", "robot.state.ros2.topic=" + ns + "/joint_states",
+          "robot.state.ros2.speed_scaling_topic=" + ns + "/robot_speed_scaling",
+          "robot.state.ros2.speed_scaling_unit=fraction"};
 }
 
 Config with_cell_clock(const Config& config, [[maybe_unused]] double timeout_s,

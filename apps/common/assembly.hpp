@@ -94,9 +94,10 @@ std::unique_ptr<RobotStateSource> make_robot_state_source(const Config& config, 
 bool robot_state_is_live(const Config& config);
 
 /// The `--set` overrides that make a camera process of a cell read the fuser's republished
-/// robot state (robot.state.source ros2 on `<ros2.namespace>/joint_states`; the joint names'
-/// robot.state.ros2.tf_prefix and the speed scaling topic stay as configured, as the fuser
-/// writes the names with that prefix); empty when the robot state is not live.
+/// robot state: robot.state.source ros2 on `<ros2.namespace>/joint_states`, and the robot's
+/// speed fraction from `<ros2.namespace>/robot_speed_scaling` (robot.state.ros2.speed_scaling_topic,
+/// speed_scaling_unit fraction). robot.state.ros2.tf_prefix stays as configured, as the fuser
+/// writes the joint names with that prefix. Empty when the robot state is not live.
 std::vector<std::string> camera_robot_state_sets(const Config& config);
 
 /// `hrcsense run --camera NAME` of a simulated camera without `sim.epoch`: the configuration

@@ -316,9 +316,9 @@ class Fuser {
   std::vector<double> added_us_;  ///< per valid fused instant: what the fuser added (fusion_added)
 };
 
-// The live robot state the fuser owns and republishes on <ns>/joint_states for the cameras
-// (docs/MULTICAMERA.md, "Robot state"); nothing for a simulated, fixed or recorded arm, which
-// every camera process plays or reads itself.
+// The live robot state the fuser owns and republishes on <ns>/joint_states, with its speed
+// fraction on <ns>/robot_speed_scaling, for the cameras (docs/MULTICAMERA.md, "Robot state");
+// nothing for a simulated, fixed or recorded arm, which every camera process plays or reads itself.
 class RobotStateRelay {
  public:
   explicit RobotStateRelay(const Config& config) {
@@ -331,17 +331,33 @@ class RobotStateRelay {
     ros2::JointStateWriterParams params;
     params.domain_id = static_cast<uint32_t>(config.ros2.domain_id);
     params.topic = ros2::cell_joint_states_topic(config.ros2.node_namespace);
+    params.speed_scaling_topic = ros2::cell_robot_speed_scaling_topic(config.ros2.node_namespace);
     params.tf_prefix = config.robot_state.ros2.tf_prefix;
-    if (config.robot_state.source == RobotStateOrigin::ros2 && config.robot_state.ros2.topic == params.topic) {
+    if (config.ros2.speed_scaling_topic == params.speed_scaling_topic) {
+      // Two writers of two types on one topic: hrcsense's commanded scale and the robot's reading.
+      throw ConfigError(config_where(config) + ": ros2.speed_scaling_topic: " + params.speed_scaling_topic +
+                        " is where hrcsense fuse republishes the robot's own speed fraction; choose another name");
+    }
+    if (config.robot_state.source == RobotStateOrigin::ros2) {
       // It would read its own samples back.
-      throw ConfigError(config_where(config) + ": robot.state.ros2.topic: " + params.topic +
-                        " is where hrcsense fuse republishes the robot state; read the driver's topic (e.g. "
-                        "/joint_states)");
+      const Ros2JointStateConfig& driver = config.robot_state.ros2;
+      if (driver.topic == params.topic) {
+        throw ConfigError(config_where(config) + ": robot.state.ros2.topic: " + params.topic +
+                          " is where hrcsense fuse republishes the robot state; read the driver's topic (e.g. "
+                          "/joint_states)");
+      }
+      if (driver.speed_scaling_topic == params.speed_scaling_topic) {
+        throw ConfigError(config_where(config) + ": robot.state.ros2.speed_scaling_topic: " +
+                          params.speed_scaling_topic + " is where hrcsense fuse republishes the robot's speed "
+                          "fraction; read the driver's topic (e.g. /speed_scaling_state_broadcaster/speed_scaling)");
+      }
     }
     states_ = make_robot_state_source(config, &clock_);
-    relay_ = std::make_unique<ros2::JointStateRelay>(*states_, clock_, params);
-    spdlog::info("fuse: robot state from {} republished on {} (domain {}) for the cameras",
-                 robot_state_origin_name(config.robot_state.source), params.topic, config.ros2.domain_id);
+    relay_ = std::make_unique<ros2::JointStateRelay>(*states_, params);
+    spdlog::info("fuse: robot state from {} republished on {} and its speed fraction on {} (domain {}) for the "
+                 "cameras",
+                 robot_state_origin_name(config.robot_state.source), params.topic, params.speed_scaling_topic,
+                 config.ros2.domain_id);
   }
   // What went out, and what the source refused, for the log.
   void report() const {
@@ -349,18 +365,20 @@ class RobotStateRelay {
     const ros2::JointStateRelayCounters c = relay_->counters();
     const RobotStateStats stats = states_->stats();
     const int64_t rejected = stats.samples.rejected() + stats.malformed;
-    const bool failed = c.refused > 0 || c.published == 0;
+    const bool failed = c.refused > 0 || c.dropped > 0 || c.published == 0;
     spdlog::log(failed ? spdlog::level::warn : spdlog::level::info,
-                "fuse: {} of the {} robot states the source accepted republished on {}, {} not written{}; the source "
-                "rejected {}{}",
-                c.published, stats.samples.accepted, relay_->topic(), c.refused, c.last_error.empty() ? "" : " (last: " + c.last_error + ")", rejected,
+                "fuse: {} of the {} robot states the source accepted republished on {} ({} with a speed fraction), "
+                "{} not written{}, {} dropped by a writer that fell behind, {} writes waited for a reliable "
+                "reader; the source rejected {}{}",
+                c.published, stats.samples.accepted, relay_->topic(), c.speed_published, c.refused,
+                c.last_error.empty() ? "" : " (last: " + c.last_error + ")", c.dropped, c.write_waits, rejected,
                 rejected == 0 || stats.last_problem.empty() ? "" : " (last: " + stats.last_problem + ")");
   }
 
  private:
   SteadyClock clock_;  // stateless: the time the live sources stamp with
   std::unique_ptr<RobotStateSource> states_;
-  std::unique_ptr<ros2::JointStateRelay> relay_;  // after states_: stops before the source goes
+  std::unique_ptr<ros2::JointStateRelay> relay_;  // after states_: stops listening before the source goes
 };
 
 }  // namespace

@@ -64,6 +64,12 @@ class RobotStateSource {
   virtual std::string error() const { return {}; }
   /// Counters so far; thread-safe (the summary reads them while the source may still run).
   virtual RobotStateStats stats() const { return {}; }
+  /// From now on `listener` is called with each sample the source accepts, as it accepts it:
+  /// on the source's receiving thread, in order, under its lock (RobotStateHistory::listener
+  /// says what the listener may do). An empty listener ends the calls: once this returns, no
+  /// call is under way and none follows. Thread-safe. False, and never called, for a source
+  /// that receives no samples (fixed, sim, recorded): the default.
+  virtual bool set_sample_listener(RobotStateListener /*listener*/) { return false; }
 };
 
 /// A valid state with the joint angles `q_rad`, zero velocity, origin `fixed`, at any time.

@@ -9,6 +9,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 
@@ -47,6 +48,9 @@ struct RobotStateCounts {
   int64_t rejected() const { return rejected_non_finite + rejected_backwards + rejected_jump + rejected_limits; }
 };
 
+/// Called with a sample as a RobotStateHistory accepts it (RobotStateHistory::listener).
+using RobotStateListener = std::function<void(const RobotState& accepted)>;
+
 /// The state for one frame, with how it was found.
 struct RobotStateLookup {
   RobotState state;           ///< valid false for no_robot_state / robot_state_stale; sample_time_ns the newest sample's
@@ -62,6 +66,12 @@ class RobotStateHistory {
   static constexpr size_t kCapacity = 256;  ///< 0.5 s at RTDE's 500 Hz, 2 s at 125 Hz
 
   RobotStateHistoryParams params;
+  /// Called by add() with each sample it accepts, once the sample is in the history (valid set),
+  /// in the order accepted; empty: nobody is told. It runs on the thread that calls add() and
+  /// under whatever guards this history (a live source's mutex), so it must be short and must
+  /// not call back into the source: handing the sample on to a queue is what it is for (the
+  /// fuser's JointStateRelay). Never called for a rejected sample, nor by clear().
+  RobotStateListener listener;
 
   /// Adds a sample (host_time_ns already on the host clock). Returns false and counts it when
   /// it is rejected: non-finite, a joint outside the limits, not later than the previous one,

@@ -168,6 +168,12 @@ RobotStateStats RtdeRobotState::stats() const {
   return out;
 }
 
+bool RtdeRobotState::set_sample_listener(RobotStateListener listener) {
+  std::lock_guard<std::mutex> lock(mutex_);  // on_data adds under it: no call is under way now
+  history_.listener = std::move(listener);
+  return true;
+}
+
 RtdeStatus RtdeRobotState::status() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return status_;

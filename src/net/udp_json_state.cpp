@@ -219,6 +219,12 @@ std::string UdpJsonRobotState::error() const {
   return error_.empty() ? lookup_error_ : error_;
 }
 
+bool UdpJsonRobotState::set_sample_listener(RobotStateListener listener) {
+  const std::lock_guard<std::mutex> lock(mutex_);  // handle() adds under it: no call is under way now
+  history_.listener = std::move(listener);
+  return true;
+}
+
 RobotStateStats UdpJsonRobotState::stats() const {
   const std::lock_guard<std::mutex> lock(mutex_);
   RobotStateStats stats;

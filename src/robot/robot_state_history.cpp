@@ -77,6 +77,7 @@ bool RobotStateHistory::add(const RobotState& sample) {
   slot.valid = true;
   ++size_;
   ++counts_.accepted;
+  if (listener) listener(slot);
   return true;
 }
 

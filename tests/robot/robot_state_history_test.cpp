@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
+#include <vector>
 
 namespace hrcsense {
 namespace {
@@ -164,6 +166,61 @@ TEST(RobotStateHistory, KeepsTheNewestCapacitySamples) {
   for (int i = 0; i < n; ++i) ASSERT_TRUE(history.add(sample(i, 0.0)));
   EXPECT_EQ(history.size(), RobotStateHistory::kCapacity);
   EXPECT_EQ(history.newest().host_time_ns, (n - 1) * kMs);
+}
+
+// The listener hears each accepted sample once, in order, as it is accepted (the history already
+// holds it), and never a rejected one: of 0 ms (q 0), NaN at 8, a jump to 0.07 at 8 (more than
+// 1 rad/s · 8 ms + 0.05), 0.05 at 8, a step back to 4, 0.1 after a gap at 500 ms, and a joint
+// outside ±2π, the listener hears 0, 0.05 and 0.1 ms with their values and speed fractions.
+TEST(RobotStateHistory, TheListenerHearsEachAcceptedSampleOnceInOrder) {
+  struct Heard {
+    int64_t t_ns;
+    double q1;
+    double speed_fraction;
+    size_t size_then;  // the history's size when the listener ran
+  };
+  RobotStateHistory history;
+  history.params.q_min_rad.fill(-6.3);
+  history.params.q_max_rad.fill(6.3);
+  std::vector<Heard> heard;
+  history.listener = [&](const RobotState& s) {
+    EXPECT_TRUE(s.valid);
+    heard.push_back({s.host_time_ns, s.q_rad[0], s.speed_fraction, history.size()});
+  };
+  RobotState first = sample(0, 0.0, 1.0);
+  first.speed_fraction = 0.25;
+  RobotState nan = sample(8, 0.0, 1.0);
+  nan.q_rad[2] = std::numeric_limits<double>::quiet_NaN();
+  RobotState outside = sample(520, 0.1, 1.0);
+  outside.q_rad[4] = 7.0;
+  EXPECT_TRUE(history.add(first));
+  EXPECT_FALSE(history.add(nan));
+  EXPECT_FALSE(history.add(sample(8, 0.07, 1.0)));
+  EXPECT_TRUE(history.add(sample(8, 0.05, 1.0)));   // speed fraction NaN: the source says none
+  EXPECT_FALSE(history.add(sample(4, 0.05, 1.0)));
+  EXPECT_TRUE(history.add(sample(500, 0.1, 1.0)));  // after a gap: the history starts afresh
+  EXPECT_FALSE(history.add(outside));
+  history.clear();
+
+  ASSERT_EQ(heard.size(), 3U);
+  EXPECT_EQ(heard[0].t_ns, 0);
+  EXPECT_EQ(heard[0].q1, 0.0);
+  EXPECT_EQ(heard[0].speed_fraction, 0.25);
+  EXPECT_EQ(heard[0].size_then, 1U);
+  EXPECT_EQ(heard[1].t_ns, 8 * kMs);
+  EXPECT_EQ(heard[1].q1, 0.05);
+  EXPECT_TRUE(std::isnan(heard[1].speed_fraction));
+  EXPECT_EQ(heard[1].size_then, 2U);
+  EXPECT_EQ(heard[2].t_ns, 500 * kMs);
+  EXPECT_EQ(heard[2].q1, 0.1);
+  EXPECT_EQ(heard[2].size_then, 1U);
+  EXPECT_EQ(history.counts().accepted, 3);
+  EXPECT_EQ(history.counts().rejected(), 4);
+
+  // An empty listener tells nobody.
+  history.listener = nullptr;
+  EXPECT_TRUE(history.add(sample(600, 0.1)));
+  EXPECT_EQ(heard.size(), 3U);
 }
 
 // The sender's clock runs 1000 s behind the host's; messages arrive after 3, 1 and 2 ms of

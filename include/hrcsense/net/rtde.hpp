@@ -96,6 +96,8 @@ class RtdeRobotState final : public RobotStateSource {
   /// streaming.
   std::string error() const override;
   RobotStateStats stats() const override;
+  /// Each accepted data package's state, as the reader thread accepts it.
+  bool set_sample_listener(RobotStateListener listener) override;
   RtdeStatus status() const;
 
  private:

@@ -88,6 +88,8 @@ class UdpJsonRobotState final : public RobotStateSource {
   /// samples: the history's counters; malformed: datagrams rejected by the parser (too long,
   /// not the format); last_problem: the last rejection with the sender's address.
   RobotStateStats stats() const override;
+  /// Each accepted datagram's state, as the reader thread accepts it.
+  bool set_sample_listener(RobotStateListener listener) override;
   /// The port actually bound (the listen port, or the one chosen for port 0).
   uint16_t bound_port() const { return bound_port_; }
 
