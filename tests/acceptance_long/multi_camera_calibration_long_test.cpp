@@ -228,19 +228,21 @@ TEST(MultiCameraCalibration, CamerasAtOtherInstantsArePairedByNearbyArmPosesAndA
                 link.points_a, link.points_b, link.disagreement_m * 1000.0, link.constrained_axes);
   }
   EXPECT_LE(same_joints, 4);
-  // (a) The table is filled: while the arm turns, front takes a keyframe every frame (the flange
-  // moves some 4 cm per frame at 30 frames/s, more than the 2 cm of keyframe_motion_m), so each
-  // keyframe of left has one of front's within half a frame's move, about 2 cm: nearly every one
-  // pairs.
+  // (a) The table is filled: while the arm turns, front takes a keyframe every frame (the flange,
+  // 0.66 m out, moves 3.5 cm per frame at 1.6 rad/s and 30 frames/s, more than the 2 cm of
+  // keyframe_motion_m), so each keyframe of left has one of front's within half a frame's move,
+  // about 2 cm: nearly every one pairs.
   ASSERT_GE(right.views_b, 40);
   EXPECT_GE(right.paired_views, right.views_b * 9 / 10);
   ASSERT_GE(right.links.size(), 2U);
   EXPECT_EQ(right.all.constrained_axes, 3);
-  // (b) At the true poses the two agree within the noise's bound plus the method's 0.1 mm.
+  // (b) At the true poses the two agree within the noise's bound plus the method's 0.1 mm (a
+  // noise-free sweep gives 0.03 mm here too: the pairs' few millimetres of travel add nothing).
   const double noise_bound_m = multi_noise_bound_m(front, front_truth, left, left_truth, front_config, right);
   EXPECT_LT(right.all.disagreement_m, noise_bound_m + 0.0001);
-  // (c) Shifted by 20 mm: that far apart, in the shift's direction (the 0.5 mm of the first test
-  // for the points the shift moves through the candidate margin).
+  // (c) Shifted by 20 mm: that far apart, in the shift's direction, within the noise's bound plus
+  // the 0.5 mm of the first test for the points the shift moves through the candidate margin (a
+  // noise-free sweep: 0.4 mm off the shift).
   EXPECT_LT((shifted_difference - shift).norm(), noise_bound_m + 0.0005);
   EXPECT_NEAR(shifted.all.disagreement_m, 0.020, noise_bound_m + 0.0005);
   for (const LinkAgreement& link : shifted.links) EXPECT_NEAR(link.disagreement_m, 0.020, 0.002) << link.link;
