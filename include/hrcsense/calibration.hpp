@@ -205,7 +205,7 @@ struct LinkAgreement {
 /// How two cameras agree on the parts of the arm both saw at nearby arm poses.
 struct CameraAgreement {
   int views_a = 0;                  ///< the views given of camera a (keyframes with arm points)
-  int views_b = 0;
+  int views_b = 0;                  ///< the same of camera b
   int paired_views = 0;             ///< pairs of a view of a and one of b, each view in one pair at most
   double pair_travel_median_m = 0.0;  ///< how far the arm's shapes lie apart between a pair's views: the median...
   double pair_travel_max_m = 0.0;     ///< ...and the largest over the pairs (at most pair_travel_m)

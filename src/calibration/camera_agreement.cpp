@@ -53,8 +53,11 @@ double shapes_travel_m(const std::vector<Capsule>& a, const std::vector<Capsule>
   double travel_m = 0.0;
   for (size_t k = 0; k < a.size(); ++k) {
     if (a[k].link != b[k].link) return std::numeric_limits<double>::infinity();
-    travel_m = std::max({travel_m, static_cast<double>((a[k].a - b[k].a).norm()),
-                         static_cast<double>((a[k].b - b[k].b).norm())});
+    const double first_end_m = (a[k].a - b[k].a).norm();
+    const double second_end_m = (a[k].b - b[k].b).norm();
+    // A shape with a NaN (invalid joints) pairs with nothing.
+    if (!std::isfinite(first_end_m) || !std::isfinite(second_end_m)) return std::numeric_limits<double>::infinity();
+    travel_m = std::max({travel_m, first_end_m, second_end_m});
     if (travel_m > limit_m) break;  // enough to know the pair is out of reach
   }
   return travel_m;
