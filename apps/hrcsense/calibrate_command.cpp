@@ -254,23 +254,31 @@ std::string write_back(const std::string& config_path, const std::vector<CameraR
 // The agreement table over every pair of cameras with samples, for the configured poses and the
 // calibrated ones (docs/CALIBRATION.md, "Cells with several cameras").
 void print_agreement(const std::vector<CameraRun>& runs) {
+  const AgreementParams params;
   std::printf("agreement on the arm (docs/CALIBRATION.md): per pair, how far apart the two cameras put the same link "
-              "surfaces at the arm poses both saw, mm\n");
-  std::printf("%-28s %6s %6s %9s %9s %12s %12s  %s\n", "pair", "views", "links", "points_a", "points_b", "configured",
+              "surfaces at nearby arm poses (keyframes paired within %.0f mm of the arm's travel), mm\n",
+              params.pair_travel_m * 1000.0);
+  std::printf("%-28s %6s %6s %9s %9s %12s %12s  %s\n", "pair", "pairs", "links", "points_a", "points_b", "configured",
               "calibrated", "worst link (calibrated)");
   for (size_t i = 0; i < runs.size(); ++i) {
     for (size_t j = i + 1; j < runs.size(); ++j) {
       const CameraRun& a = runs[i];
       const CameraRun& b = runs[j];
       const CameraAgreement told =
-          camera_agreement(arm_views(*a.samples, a.T_told), arm_views(*b.samples, b.T_told));
+          camera_agreement(arm_views(*a.samples, a.T_told), arm_views(*b.samples, b.T_told), params);
       const bool fitted = a.fit.ok && b.fit.ok;
       const CameraAgreement calibrated =
-          fitted ? camera_agreement(arm_views(*a.samples, a.fit.T_base_camera), arm_views(*b.samples, b.fit.T_base_camera))
+          fitted ? camera_agreement(arm_views(*a.samples, a.fit.T_base_camera),
+                                    arm_views(*b.samples, b.fit.T_base_camera), params)
                  : told;
       const std::string pair = a.name + "-" + b.name;
+      spdlog::info("agreement {}: {} view pairs of {} and {} keyframes with arm points; the arm's shapes {:.1f} mm apart "
+                   "between a pair's views at the median, {:.1f} mm at most; joints {:.3f} rad apart at most",
+                   pair, calibrated.paired_views, calibrated.views_a, calibrated.views_b,
+                   calibrated.pair_travel_median_m * 1000.0, calibrated.pair_travel_max_m * 1000.0,
+                   calibrated.pair_joint_max_rad);
       if (calibrated.links.empty()) {
-        std::printf("%-28s %6d %6s  no link seen by both at the same arm pose\n", pair.c_str(), calibrated.shared_views,
+        std::printf("%-28s %6d %6s  no link seen by both at nearby arm poses\n", pair.c_str(), calibrated.paired_views,
                     "0");
         continue;
       }
@@ -278,12 +286,12 @@ void print_agreement(const std::vector<CameraRun>& runs) {
           calibrated.links.begin(), calibrated.links.end(),
           [](const LinkAgreement& x, const LinkAgreement& y) { return x.disagreement_m < y.disagreement_m; });
       const std::string worst_text = link_name(worst->link) + " " + fixed_digits_text(worst->disagreement_m * 1000.0, 1);
-      std::printf("%-28s %6d %6zu %9zu %9zu %12.1f %12s  %s\n", pair.c_str(), calibrated.shared_views,
+      std::printf("%-28s %6d %6zu %9zu %9zu %12.1f %12s  %s\n", pair.c_str(), calibrated.paired_views,
                   calibrated.links.size(), calibrated.all.points_a, calibrated.all.points_b,
                   told.all.disagreement_m * 1000.0,
                   fitted ? fixed_digits_text(calibrated.all.disagreement_m * 1000.0, 1).c_str() : "-", worst_text.c_str());
       for (const LinkAgreement& link : calibrated.links) {
-        spdlog::info("agreement {}: {} in {} views, {} and {} points: offsets {} and {} mm, {:.1f} mm apart ({} axes)",
+        spdlog::info("agreement {}: {} in {} view pairs, {} and {} points: offsets {} and {} mm, {:.1f} mm apart ({} axes)",
                      pair, link_name(link.link), link.views, link.points_a, link.points_b,
                      vec3_text(link.offset_a_base_m * 1000.0, 1), vec3_text(link.offset_b_base_m * 1000.0, 1),
                      link.disagreement_m * 1000.0, link.constrained_axes);

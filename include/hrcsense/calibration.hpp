@@ -20,8 +20,9 @@
 // 4. Its spread: a jackknife over groups of keyframes (what the poses disagree on, the
 //    kinematic model's errors included), not the far smaller formal covariance of correlated
 //    pixels.
-// 5. In a cell with several cameras, camera_agreement compares two calibrated cameras: at the arm
-//    poses both saw, each camera's points of a link fitted to the link's shapes by a translation.
+// 5. In a cell with several cameras, camera_agreement compares two calibrated cameras: their
+//    keyframes paired by the nearest arm pose (the arm's shapes within 4 cm), each camera's
+//    points of a link fitted to the link's shapes at its own keyframe's joints by a translation.
 #pragma once
 
 #include "hrcsense/robot.hpp"
@@ -167,15 +168,19 @@ std::vector<ArmView> arm_views(const ArmSamples& samples, const Pose& T_base_cam
 
 /// How camera_agreement pairs views and points (docs/CALIBRATION.md, "Cells with several cameras").
 struct AgreementParams {
-  /// Two views show the same instant of the arm when every joint agrees within this (rad): the
-  /// simulator's cameras of a cell render the same scene frame with the same joints.
-  double same_pose_rad = 1e-4;
+  /// Two views may pair when no end of any of the arm's shapes lies farther than this (m) from
+  /// where it is in the other view. Each camera's offset is measured against the arm's model at
+  /// its own view's joints, so the move itself does not bias it; what differs between the two
+  /// poses is only what a camera's rotation error ε adds, at most ε times this (1° over 4 cm:
+  /// 0.7 mm). Twice the keyframes' spacing (keyframe_motion_m), so that a camera at another
+  /// rate or phase finds a neighbour for nearly every keyframe of a sweep.
+  double pair_travel_m = 0.04;
   /// A point farther than this (m) from the arm's shapes is not the arm (wider than the fit's
   /// 3 cm gate, so that a pose some centimetres off still finds its points).
   float gate_m = 0.06F;
-  /// A link counts in a shared view when each camera has at least this many points on it...
+  /// A link counts in a view pair when each camera has at least this many points on it...
   int min_points = 20;
-  /// ...and is compared when each camera has this many over all shared views: fewer, and the
+  /// ...and is compared when each camera has this many over all view pairs: fewer, and the
   /// noise alone moves an offset by millimetres (a wrist seen in a handful of views).
   int min_link_points = 500;
   /// A direction whose eigenvalue of the points' Σ n nᵀ is below this share of the largest is not
@@ -186,7 +191,7 @@ struct AgreementParams {
 /// Two cameras' offsets of one link's surface (or of every shared link's, `link` −1).
 struct LinkAgreement {
   int link = 0;             ///< Capsule::link, −1 for all shared links together
-  int views = 0;            ///< shared views in which both cameras saw the link (link views for −1)
+  int views = 0;            ///< view pairs in which both cameras saw the link (link views for −1)
   size_t points_a = 0;      ///< points of camera a in those views
   size_t points_b = 0;
   /// The translation (base frame, m) that moves the arm's shapes onto each camera's points best
@@ -197,16 +202,23 @@ struct LinkAgreement {
   int constrained_axes = 0;     ///< directions both offsets are constrained in (3: all)
 };
 
-/// How two cameras agree on the parts of the arm both saw at the same instants.
+/// How two cameras agree on the parts of the arm both saw at nearby arm poses.
 struct CameraAgreement {
-  int shared_views = 0;             ///< views (keyframes) of the same arm pose in both
+  int views_a = 0;                  ///< the views given of camera a (keyframes with arm points)
+  int views_b = 0;                  ///< the same of camera b
+  int paired_views = 0;             ///< pairs of a view of a and one of b, each view in one pair at most
+  double pair_travel_median_m = 0.0;  ///< how far the arm's shapes lie apart between a pair's views: the median...
+  double pair_travel_max_m = 0.0;     ///< ...and the largest over the pairs (at most pair_travel_m)
+  double pair_joint_max_rad = 0.0;    ///< the largest difference of a joint between a pair's views
   std::vector<LinkAgreement> links; ///< per link both saw enough of (min_points, min_link_points), by link
   LinkAgreement all;                ///< every shared link's points together
 };
 
-/// Pairs each view of `a` with a view of `b` of the same arm pose and compares, per link both saw,
-/// the two cameras' surface offsets from the arm's shapes: with both poses right both are near 0;
-/// a camera whose pose is shifted by δ has an offset of about δ.
+/// Pairs the views of `a` with views of `b` of nearby arm poses (nearest first, each view once,
+/// within params.pair_travel_m; views of two different shape lists never pair) and compares, per
+/// link both saw in a pair, the two cameras' surface offsets from the arm's shapes, each at its
+/// own view's joints: with both poses right both are near 0; a camera whose pose is shifted by δ
+/// has an offset of about δ. Deterministic: ties go to the earlier views.
 CameraAgreement camera_agreement(const std::vector<ArmView>& a, const std::vector<ArmView>& b,
                                  const AgreementParams& params = {});
 

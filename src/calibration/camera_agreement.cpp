@@ -1,14 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
 // hrcsense — how two calibrated cameras of a cell agree on the arm (calibration.hpp,
-// docs/CALIBRATION.md, "Cells with several cameras"): at the arm poses both saw, each camera's
-// points of a link are fitted to the link's shapes by a translation, and the two translations
-// are compared.
+// docs/CALIBRATION.md, "Cells with several cameras"): the two cameras' keyframes are paired by the
+// nearest arm pose, each camera's points of a link are fitted to the link's shapes at its own
+// keyframe's joints by a translation, and the two translations are compared.
 #include "hrcsense/calibration.hpp"
 
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <map>
 
@@ -43,12 +44,66 @@ std::map<int, LinkSlice> slices_by_link(const ArmView& view, float gate_m) {
   return out;
 }
 
-// Whether two views show the arm in the same pose: every joint within `tolerance_rad`.
-bool same_arm_pose(const JointAngles& a, const JointAngles& b, double tolerance_rad) {
-  for (size_t j = 0; j < a.size(); ++j) {
-    if (!(std::abs(a[j] - b[j]) <= tolerance_rad)) return false;
+// How far the arm's shapes lie apart between two views: the largest distance between the same
+// end of the same capsule. A rigid move displaces the points of a segment affinely, so no point
+// of a shape's axis lies farther apart than its farther end. Infinite for two different shape
+// lists (another arm or tool): such views are not compared.
+double shapes_travel_m(const std::vector<Capsule>& a, const std::vector<Capsule>& b, double limit_m) {
+  if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
+  double travel_m = 0.0;
+  for (size_t k = 0; k < a.size(); ++k) {
+    if (a[k].link != b[k].link) return std::numeric_limits<double>::infinity();
+    const double first_end_m = (a[k].a - b[k].a).norm();
+    const double second_end_m = (a[k].b - b[k].b).norm();
+    // A shape with a NaN (invalid joints) pairs with nothing.
+    if (!std::isfinite(first_end_m) || !std::isfinite(second_end_m)) return std::numeric_limits<double>::infinity();
+    travel_m = std::max({travel_m, first_end_m, second_end_m});
+    if (travel_m > limit_m) break;  // enough to know the pair is out of reach
   }
-  return true;
+  return travel_m;
+}
+
+struct ViewPair {
+  size_t a = 0;
+  size_t b = 0;
+  double travel_m = 0.0;
+};
+
+// Each view in one pair at most, nearest poses first: every pair within `max_travel_m`, sorted by
+// travel (ties by the views' order, so that the result is the same on every run), taken while both
+// its views are free. A view of a camera at twice the other's rate thus finds the other's nearest
+// view once, and the rest of its views stay out instead of counting a view of the other twice.
+std::vector<ViewPair> nearest_view_pairs(const std::vector<ArmView>& a, const std::vector<ArmView>& b,
+                                         double max_travel_m) {
+  std::vector<ViewPair> candidates;
+  for (size_t i = 0; i < a.size(); ++i) {
+    for (size_t j = 0; j < b.size(); ++j) {
+      const double travel_m = shapes_travel_m(a[i].shapes_base, b[j].shapes_base, max_travel_m);
+      if (travel_m <= max_travel_m) candidates.push_back({i, j, travel_m});
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const ViewPair& x, const ViewPair& y) {
+    if (x.travel_m != y.travel_m) return x.travel_m < y.travel_m;
+    return x.a != y.a ? x.a < y.a : x.b < y.b;
+  });
+  std::vector<bool> used_a(a.size(), false);
+  std::vector<bool> used_b(b.size(), false);
+  std::vector<ViewPair> pairs;
+  for (const ViewPair& c : candidates) {
+    if (used_a[c.a] || used_b[c.b]) continue;
+    used_a[c.a] = true;
+    used_b[c.b] = true;
+    pairs.push_back(c);
+  }
+  // In the order of a's views, as the keyframes were taken.
+  std::sort(pairs.begin(), pairs.end(), [](const ViewPair& x, const ViewPair& y) { return x.a < y.a; });
+  return pairs;
+}
+
+double largest_joint_difference_rad(const JointAngles& a, const JointAngles& b) {
+  double out = 0.0;
+  for (size_t j = 0; j < a.size(); ++j) out = std::max(out, std::abs(a[j] - b[j]));
+  return out;
 }
 
 // The translation o (base frame) that moves the shapes onto the slices' points best:
@@ -137,17 +192,26 @@ CameraAgreement camera_agreement(const std::vector<ArmView>& a, const std::vecto
                                  const AgreementParams& params) {
   CameraAgreement out;
   const auto min_points = static_cast<size_t>(std::max(1, params.min_points));
-  // Per view both cameras saw, per link: the slices of each; kept alive here for the fits.
+  out.views_a = static_cast<int>(a.size());
+  out.views_b = static_cast<int>(b.size());
+  // Per view pair, per link: the slices of each camera, each cut by its own view's shapes; kept
+  // alive here for the fits.
   std::vector<std::map<int, LinkSlice>> kept_a;
   std::vector<std::map<int, LinkSlice>> kept_b;
-  for (const ArmView& va : a) {
-    const auto match = std::find_if(b.begin(), b.end(), [&](const ArmView& vb) {
-      return same_arm_pose(va.q_rad, vb.q_rad, params.same_pose_rad);
-    });
-    if (match == b.end()) continue;
-    ++out.shared_views;
-    kept_a.push_back(slices_by_link(va, params.gate_m));
-    kept_b.push_back(slices_by_link(*match, params.gate_m));
+  std::vector<double> travels_m;
+  for (const ViewPair& pair : nearest_view_pairs(a, b, params.pair_travel_m)) {
+    ++out.paired_views;
+    travels_m.push_back(pair.travel_m);
+    out.pair_travel_max_m = std::max(out.pair_travel_max_m, pair.travel_m);
+    out.pair_joint_max_rad =
+        std::max(out.pair_joint_max_rad, largest_joint_difference_rad(a[pair.a].q_rad, b[pair.b].q_rad));
+    kept_a.push_back(slices_by_link(a[pair.a], params.gate_m));
+    kept_b.push_back(slices_by_link(b[pair.b], params.gate_m));
+  }
+  if (!travels_m.empty()) {
+    const auto middle = travels_m.begin() + static_cast<std::ptrdiff_t>(travels_m.size() / 2);
+    std::nth_element(travels_m.begin(), middle, travels_m.end());
+    out.pair_travel_median_m = *middle;
   }
   std::map<int, std::vector<const LinkSlice*>> link_a;
   std::map<int, std::vector<const LinkSlice*>> link_b;

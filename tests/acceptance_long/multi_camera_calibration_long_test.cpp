@@ -4,9 +4,10 @@
 // comes into view). `left`, told a pose 15 mm and 1 degree off, calibrates to within 5 mm and
 // 0.2 degrees of the simulator's true pose; the two cameras at their true poses agree on the
 // arm's surfaces within a bound derived from the sensor noise, and with `front` shifted by 20 mm
-// they disagree by that shift, in its direction. From the command line, `calibrate --camera all
-// --write-back` writes both poses into a copy of the cell's file, keeps the rest of it and its
-// backup, and prints the agreement table. (Some 10 s each at 848x480: the `long` label.)
+// they disagree by that shift, in its direction. The same with `left` at another frame rate, so
+// that the two cameras' keyframes show other instants and pair by the nearest arm pose. From the
+// command line, `calibrate --camera all --write-back` writes both poses into a copy of the cell's
+// file, keeps the rest of it and its backup, and prints the agreement table. (Some 10 s each at 848x480: the `long` label.)
 
 #include "../support/run_cli.hpp"
 #include "../support/scenes.hpp"
@@ -54,9 +55,9 @@ std::vector<std::string> multi_cell_sets(const Pose& left_truth, const Pose& lef
               multi_pose_text(left_truth) + "}}]"};
 }
 
-// The samples of one camera over the cell's frames 0..frames−1 (the person enters the views after
-// frame 120), with the joints the simulator moved the arm to: the same scene frames for every
-// camera, so the views of the two cameras share their instants.
+// The samples of one camera over its frames 0..frames−1 (frame i at i / fps s; the person enters
+// the views at 4 s), with the joints the simulator moved the arm to: cameras at one rate render
+// the same instants, cameras at other rates other instants.
 ArmSamples multi_collect(const Config& config, const Simulator& sim, int frames) {
   ArmSamples samples(config.calibration, sim.intrinsics(), *config.pipeline.robot.arm, config.pipeline.robot.base_frame);
   Frame frame;
@@ -65,6 +66,35 @@ ArmSamples multi_collect(const Config& config, const Simulator& sim, int frames)
     samples.add(i, frame.depth, sim.arm_joints(i).q_rad, frame.stereo_baseline_mm);
   }
   return samples;
+}
+
+// The bound on two right poses' disagreement from the sensor noise (docs/SIMULATOR.md): a pixel's
+// depth σ = Z² s / (fx B) at the farthest arm point either camera saw (s the disparity noise in
+// pixels, B the baseline); a 5×5 median about 1.25 σ / 5; an offset fitted to N points whose
+// normals span three directions about evenly has a σ of about √3 σ_point / √N per axis; the
+// difference of two, 6 σ.
+double multi_noise_bound_m(const ArmSamples& a, const Pose& a_truth, const ArmSamples& b, const Pose& b_truth,
+                           const Config& config, const CameraAgreement& agreement) {
+  double far_m = 0.0;
+  for (const auto* views : {&a, &b}) {
+    const Pose& T = views == &a ? a_truth : b_truth;
+    for (const ArmView& view : arm_views(*views, T)) {
+      for (const Eigen::Vector3f& p : view.points_base) {
+        Eigen::Vector3f normal;
+        if (std::abs(distance_to_shapes(view.shapes_base, p, normal)) > 0.06F) continue;  // not the arm
+        far_m = std::max(far_m, (p.cast<double>() - T.translation()).norm());
+      }
+    }
+  }
+  const double fx = a.intrinsics().fx;
+  const double sigma_pixel_m = far_m * far_m * config.sim.disparity_noise_px / (fx * kD435BaselineMm / 1000.0);
+  const double sigma_patch_m = 1.25 * sigma_pixel_m / 5.0;
+  const double bound_m = 6.0 * sigma_patch_m *
+                         std::sqrt(3.0 * (1.0 / static_cast<double>(agreement.all.points_a) +
+                                          1.0 / static_cast<double>(agreement.all.points_b)));
+  std::printf("farthest arm point %.2f m: a pixel's sigma %.1f mm, the bound %.2f mm + 0.1 mm (+ 0.5 mm shifted)\n",
+              far_m, sigma_pixel_m * 1000.0, bound_m * 1000.0);
+  return bound_m;
 }
 
 TEST(MultiCameraCalibration, AWrongPoseLandsNearTheTruthAndTheCamerasAgreeOnTheArm) {
@@ -96,7 +126,7 @@ TEST(MultiCameraCalibration, AWrongPoseLandsNearTheTruthAndTheCamerasAgreeOnTheA
   EXPECT_LT(rotation_between_deg(fit.T_base_camera, left_truth), 0.2);
 
   // 2. Two right poses (the simulator's truths) agree on the arm; the bound is from the sensor
-  // noise (below).
+  // noise (multi_noise_bound_m).
   const Pose& front_truth = front_sim.T_base_camera;
   const CameraAgreement right = camera_agreement(arm_views(front, front_truth), arm_views(left, left_truth));
   // 3. `front` told a pose shifted by 20 mm: the two cameras put the arm's surfaces that far apart,
@@ -107,9 +137,9 @@ TEST(MultiCameraCalibration, AWrongPoseLandsNearTheTruthAndTheCamerasAgreeOnTheA
   const CameraAgreement shifted = camera_agreement(arm_views(front, front_shifted), arm_views(left, left_truth));
   // 4. The fitted pose of `left` against front's truth.
   const CameraAgreement fitted = camera_agreement(arm_views(front, front_truth), arm_views(left, fit.T_base_camera));
-  std::printf("shared views %d, links %zu, points %zu and %zu: right poses %.2f mm apart, front shifted 20 mm: %.2f mm "
+  std::printf("view pairs %d, links %zu, points %zu and %zu: right poses %.2f mm apart, front shifted 20 mm: %.2f mm "
               "(offset difference [%.1f, %.1f, %.1f] mm), left as fitted %.2f mm\n",
-              right.shared_views, right.links.size(), right.all.points_a, right.all.points_b,
+              right.paired_views, right.links.size(), right.all.points_a, right.all.points_b,
               right.all.disagreement_m * 1000.0, shifted.all.disagreement_m * 1000.0,
               (shifted.all.offset_a_base_m - shifted.all.offset_b_base_m).x() * 1000.0,
               (shifted.all.offset_a_base_m - shifted.all.offset_b_base_m).y() * 1000.0,
@@ -122,41 +152,100 @@ TEST(MultiCameraCalibration, AWrongPoseLandsNearTheTruthAndTheCamerasAgreeOnTheA
                                                            : -1.0,
                 link.constrained_axes);
   }
-  ASSERT_GE(right.shared_views, 20);
+  ASSERT_GE(right.paired_views, 20);
   ASSERT_GE(right.links.size(), 2U);
   EXPECT_EQ(right.all.constrained_axes, 3);
-  // The bound from the sensor noise (docs/SIMULATOR.md): a pixel's depth σ = Z² s / (fx B) at the
-  // farthest arm point either camera saw (s the disparity noise in pixels, B the baseline); a 5×5
-  // median about 1.25 σ / 5; an offset fitted to N points whose normals span three directions
-  // about evenly has a σ of about √3 σ_point / √N per axis; the difference of two, 6 σ. Beside it
-  // the method's own error: 0.1 mm (a noise-free sweep gives 0.03 mm for the right poses and
-  // 0.17 mm for the shifted one, whose 2 cm move some points of the arm nearest the table through
-  // the candidate margin).
-  double far_m = 0.0;
-  for (const auto* views : {&front, &left}) {
-    const Pose& T = views == &front ? front_truth : left_truth;
-    for (const ArmView& view : arm_views(*views, T)) {
-      for (const Eigen::Vector3f& p : view.points_base) {
-        Eigen::Vector3f normal;
-        if (std::abs(distance_to_shapes(view.shapes_base, p, normal)) > 0.06F) continue;  // not the arm
-        far_m = std::max(far_m, (p.cast<double>() - T.translation()).norm());
-      }
-    }
-  }
-  const double fx = front_sim.intrinsics().fx;
-  const double sigma_pixel_m = far_m * far_m * front_config.sim.disparity_noise_px / (fx * kD435BaselineMm / 1000.0);
-  const double sigma_patch_m = 1.25 * sigma_pixel_m / 5.0;
-  const double noise_bound_m =
-      6.0 * sigma_patch_m *
-      std::sqrt(3.0 * (1.0 / static_cast<double>(right.all.points_a) + 1.0 / static_cast<double>(right.all.points_b)));
-  std::printf("farthest arm point %.2f m: a pixel's sigma %.1f mm, the bound %.2f mm + 0.1 mm (+ 0.5 mm shifted)\n",
-              far_m, sigma_pixel_m * 1000.0, noise_bound_m * 1000.0);
+  // Beside the noise bound the method's own error: 0.1 mm (a noise-free sweep gives 0.03 mm for
+  // the right poses and 0.17 mm for the shifted one, whose 2 cm move some points of the arm
+  // nearest the table through the candidate margin).
+  const double noise_bound_m = multi_noise_bound_m(front, front_truth, left, left_truth, front_config, right);
   EXPECT_LT(right.all.disagreement_m, noise_bound_m + 0.0001);
   EXPECT_LT((shifted.all.offset_a_base_m - shifted.all.offset_b_base_m - shift).norm(), noise_bound_m + 0.0005);
   EXPECT_NEAR(shifted.all.disagreement_m, 0.020, noise_bound_m + 0.0005);
   for (const LinkAgreement& link : shifted.links) EXPECT_NEAR(link.disagreement_m, 0.020, 0.002) << link.link;
   // `left` as fitted: within the calibration's own error of the truth (1-2 mm, 0.03 degrees at 2-3 m).
   EXPECT_LT(fitted.all.disagreement_m, 0.005);
+}
+
+// The cell's `front` at 30 frames/s and `left` at `left_fps`, both told and rendered at their
+// true poses (config/cell-ur5-3cam.yaml).
+std::vector<std::string> multi_cell_rate_sets(const std::string& left_fps) {
+  return {"sim.color=false",
+          "cameras=[{name: front, T_base_camera: {translation_m: [2.0, 0, 1.6], rotation_rpy_deg: [-133.3, 0, 90]}, "
+          "fps: 30, source: {seed: 1}}, {name: left, T_base_camera: {translation_m: [0.3, 2.2, 1.5], "
+          "rotation_rpy_deg: [-124.3, 0, 180]}, fps: " +
+              left_fps + ", source: {seed: 2}}]"};
+}
+
+TEST(MultiCameraCalibration, CamerasAtOtherInstantsArePairedByNearbyArmPosesAndAgree) {
+  // `left` at 23.3 frames/s: its frames (i / 23.3 s) meet front's (j / 30 s) only at 0 s and every
+  // 10 s (233 and 300 have no common factor), as two live cameras' frames hardly ever meet. Both
+  // over the same 3.65 s before the person comes into view: 110 frames of `front`, 85 of `left`.
+  const std::string cell = scene_path("cell-ur5-3cam.yaml");
+  const std::vector<std::string> sets = multi_cell_rate_sets("23.3");
+  const Config front_config = load_config(cell, sets, "front");
+  const Config left_config = load_config(cell, sets, "left");
+  ASSERT_DOUBLE_EQ(front_config.sim.fps, 30.0);
+  ASSERT_DOUBLE_EQ(left_config.sim.fps, 23.3);
+  const Simulator front_sim = make_simulator(front_config);
+  const Simulator left_sim = make_simulator(left_config);
+  const Pose& front_truth = front_sim.T_base_camera;
+  const Pose& left_truth = left_sim.T_base_camera;
+  const ArmSamples front = multi_collect(front_config, front_sim, 110);
+  const ArmSamples left = multi_collect(left_config, left_sim, 85);
+
+  // The premise: keyframes of the two with every joint within 1e-4 rad (the rule of exact instants)
+  // are few: frame 0, and where both took a keyframe as the arm arrived at a pose it holds.
+  int same_joints = 0;
+  for (const ArmKeyframe& l : left.keyframes()) {
+    for (const ArmKeyframe& f : front.keyframes()) {
+      bool same = true;
+      for (size_t j = 0; j < l.q_rad.size(); ++j) same = same && std::abs(l.q_rad[j] - f.q_rad[j]) <= 1e-4;
+      if (!same) continue;
+      ++same_joints;
+      break;
+    }
+  }
+
+  const CameraAgreement right = camera_agreement(arm_views(front, front_truth), arm_views(left, left_truth));
+  // `left` told a pose shifted by 20 mm: the two cameras put the arm's surfaces that far apart, in
+  // the shift's direction (left's offset minus front's).
+  Pose left_shifted = left_truth;
+  const Eigen::Vector3d shift(-0.016, 0.0, 0.012);
+  left_shifted.translation() += shift;
+  const CameraAgreement shifted = camera_agreement(arm_views(front, front_truth), arm_views(left, left_shifted));
+  const Eigen::Vector3d shifted_difference = shifted.all.offset_b_base_m - shifted.all.offset_a_base_m;
+  std::printf("keyframes with arm points %d and %d, %d of left's with a keyframe of front's of the same joints; "
+              "view pairs %d (the arm's shapes %.1f mm apart at the median, %.1f mm at most, joints %.3f rad), "
+              "links %zu, points %zu and %zu: right poses %.2f mm apart, left shifted 20 mm: %.2f mm "
+              "(offset difference [%.1f, %.1f, %.1f] mm)\n",
+              right.views_a, right.views_b, same_joints, right.paired_views, right.pair_travel_median_m * 1000.0,
+              right.pair_travel_max_m * 1000.0, right.pair_joint_max_rad, right.links.size(), right.all.points_a,
+              right.all.points_b, right.all.disagreement_m * 1000.0, shifted.all.disagreement_m * 1000.0,
+              shifted_difference.x() * 1000.0, shifted_difference.y() * 1000.0, shifted_difference.z() * 1000.0);
+  for (const LinkAgreement& link : right.links) {
+    std::printf("  link %d: %d view pairs, %zu and %zu points, %.2f mm apart, %d axes\n", link.link, link.views,
+                link.points_a, link.points_b, link.disagreement_m * 1000.0, link.constrained_axes);
+  }
+  EXPECT_LE(same_joints, 4);
+  // (a) The table is filled: while the arm turns, front takes a keyframe every frame (the flange,
+  // 0.66 m out, moves 3.5 cm per frame at 1.6 rad/s and 30 frames/s, more than the 2 cm of
+  // keyframe_motion_m), so each keyframe of left has one of front's within half a frame's move,
+  // about 2 cm: nearly every one pairs.
+  ASSERT_GE(right.views_b, 40);
+  EXPECT_GE(right.paired_views, right.views_b * 9 / 10);
+  ASSERT_GE(right.links.size(), 2U);
+  EXPECT_EQ(right.all.constrained_axes, 3);
+  // (b) At the true poses the two agree within the noise's bound plus the method's 0.1 mm (a
+  // noise-free sweep gives 0.03 mm here too: the pairs' few millimetres of travel add nothing).
+  const double noise_bound_m = multi_noise_bound_m(front, front_truth, left, left_truth, front_config, right);
+  EXPECT_LT(right.all.disagreement_m, noise_bound_m + 0.0001);
+  // (c) Shifted by 20 mm: that far apart, in the shift's direction, within the noise's bound plus
+  // the 0.5 mm of the first test for the points the shift moves through the candidate margin (a
+  // noise-free sweep: 0.4 mm off the shift).
+  EXPECT_LT((shifted_difference - shift).norm(), noise_bound_m + 0.0005);
+  EXPECT_NEAR(shifted.all.disagreement_m, 0.020, noise_bound_m + 0.0005);
+  for (const LinkAgreement& link : shifted.links) EXPECT_NEAR(link.disagreement_m, 0.020, 0.002) << link.link;
 }
 
 // The cell's text with its cameras: list replaced by `front` (its true pose) and `left` (told

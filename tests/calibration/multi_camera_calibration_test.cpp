@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Calibration in a cell with several cameras (issue H2): the agreement of two cameras on the arm
-// by hand on made-up surfaces, and the written-back entry read by load_config with every other
-// byte kept. The simulated cell's cameras: tests/acceptance_long/multi_camera_calibration_long_test.cpp.
+// by hand on made-up surfaces, their views paired by the nearest arm pose, and the written-back
+// entry read by load_config with every other byte kept. The simulated cell's cameras: tests/acceptance_long/multi_camera_calibration_long_test.cpp.
 
 #include "hrcsense/calibration.hpp"
 #include "hrcsense/config/config.hpp"
@@ -60,15 +60,22 @@ TEST(CameraAgreement, TwoCamerasSeeingOneSurfaceShiftedByDeltaDisagreeByDelta) {
   multi_capsule_points(sphere, Eigen::Vector3f(0.0F, 0.3F, 1.0F), Eigen::Vector3f::Zero(), a.points_base);
   multi_capsule_points(arm_capsule, Eigen::Vector3f(0.2F, 1.0F, 0.0F), delta, b.points_base);
   multi_capsule_points(sphere, Eigen::Vector3f(0.2F, 1.0F, 0.0F), delta, b.points_base);
-  // A view of another arm pose in a only, its points far off: no instant b shares.
+  // A view of another arm pose in a only (the arm's shapes 10 cm up, beyond the 4 cm a pair may
+  // lie apart), its points 3 cm off those shapes: no view of b is near it, so it must not count.
   ArmView a_alone = a;
-  a_alone.q_rad[0] += 0.01;
-  for (Eigen::Vector3f& p : a_alone.points_base) p += Eigen::Vector3f(0.0F, 0.0F, 0.03F);
+  a_alone.q_rad[1] += 0.2;
+  for (Capsule& c : a_alone.shapes_base) {
+    c.a.z() += 0.1F;
+    c.b.z() += 0.1F;
+  }
+  for (Eigen::Vector3f& p : a_alone.points_base) p += Eigen::Vector3f(0.0F, 0.0F, 0.13F);
 
   AgreementParams params;
   params.min_link_points = 50;  // a hand-made link has some hundred points
   const CameraAgreement agreement = camera_agreement({a, a_alone}, {b}, params);
-  EXPECT_EQ(agreement.shared_views, 1);
+  EXPECT_EQ(agreement.views_a, 2);
+  EXPECT_EQ(agreement.paired_views, 1);
+  EXPECT_EQ(agreement.pair_travel_max_m, 0.0);
   ASSERT_EQ(agreement.links.size(), 2U);
   const double delta_m = std::sqrt(241.0) / 1000.0;
   for (const LinkAgreement& link : agreement.links) {
@@ -130,6 +137,95 @@ TEST(CameraAgreement, ALinkSeenAlongOneDirectionOnlyLeavesTheOthersUnconstrained
   ASSERT_EQ(agreement.links.size(), 1U);
   EXPECT_EQ(agreement.links[0].constrained_axes, 1);
   EXPECT_NEAR(agreement.links[0].disagreement_m, 0.005, 1e-6);
+}
+
+// The arm of the next test at base angle θ (rad): link 2 a capsule from the base out to 0.5 m,
+// link 5 a sphere 0.7 m out and 0.15 m up; both turn about z with θ.
+std::vector<Capsule> multi_turning_arm(double theta_rad) {
+  const Eigen::Vector3f radial(static_cast<float>(std::cos(theta_rad)), static_cast<float>(std::sin(theta_rad)), 0.0F);
+  const Eigen::Vector3f sphere_centre = 0.7F * radial + Eigen::Vector3f(0.0F, 0.0F, 0.15F);
+  return {Capsule{Eigen::Vector3f::Zero(), 0.5F * radial, 0.05F, 2}, Capsule{sphere_centre, sphere_centre, 0.04F, 5}};
+}
+
+// A view of that arm at θ seen from `towards`, the points moved by `shift` (the camera's pose error).
+ArmView multi_turning_view(double theta_rad, const Eigen::Vector3f& towards, const Eigen::Vector3f& shift) {
+  ArmView view;
+  view.q_rad = {theta_rad, -1.0, 1.6, -2.17, -1.57, 0.0};
+  view.shapes_base = multi_turning_arm(theta_rad);
+  for (const Capsule& c : view.shapes_base) multi_capsule_points(c, towards, shift, view.points_base);
+  return view;
+}
+
+TEST(CameraAgreement, CamerasAtOtherInstantsArePairedByTheNearestArmPoseEachViewOnce) {
+  // Camera a sees the arm turning about its base every 0.06 rad (θ = 0, 0.06, ..., 0.54); camera
+  // b at other instants, 0.02 rad later (θ = 0.02, 0.08, ..., 0.32), and once at θ = 2, far from
+  // every view of a. No joint of a view of b equals one of a. b's pose is off by δ.
+  const Eigen::Vector3f from_a(0.0F, 0.3F, 1.0F);
+  const Eigen::Vector3f from_b(0.2F, 1.0F, 0.3F);
+  const Eigen::Vector3f delta(-0.008F, 0.011F, 0.006F);  // |δ| = √221 mm = 14.87 mm
+  std::vector<ArmView> a;
+  for (int i = 0; i < 10; ++i) a.push_back(multi_turning_view(0.06 * i, from_a, Eigen::Vector3f::Zero()));
+  std::vector<ArmView> b;
+  for (int i = 0; i < 6; ++i) b.push_back(multi_turning_view(0.06 * i + 0.02, from_b, delta));
+  b.push_back(multi_turning_view(2.0, from_b, delta));
+
+  AgreementParams params;
+  params.min_link_points = 50;
+  const CameraAgreement agreement = camera_agreement(a, b, params);
+  // Each view of b lies 0.02 rad from a view of a and 0.04 rad from the next: the nearer pairs,
+  // the sphere's centre (0.7 m out, the farthest end of any shape) 2 · 0.7 m · sin(0.01) apart.
+  const double pair_travel_m = 2.0 * 0.7 * std::sin(0.01);  // 14.0 mm
+  EXPECT_EQ(agreement.views_a, 10);
+  EXPECT_EQ(agreement.views_b, 7);
+  EXPECT_EQ(agreement.paired_views, 6);
+  EXPECT_NEAR(agreement.pair_travel_max_m, pair_travel_m, 2e-6);
+  EXPECT_NEAR(agreement.pair_travel_median_m, pair_travel_m, 2e-6);
+  EXPECT_NEAR(agreement.pair_joint_max_rad, 0.02, 1e-12);
+  // Each camera's offset is to the arm's shapes at its own view's joints: a's are 0 and b's are δ
+  // although no pair shows the same pose.
+  ASSERT_EQ(agreement.links.size(), 2U);
+  for (const LinkAgreement& link : agreement.links) {
+    SCOPED_TRACE(link.link);
+    EXPECT_EQ(link.views, 6);
+    EXPECT_LT(link.offset_a_base_m.norm(), 1e-5);
+    EXPECT_LT((link.offset_b_base_m - delta.cast<double>()).norm(), 1e-5);
+  }
+  EXPECT_EQ(agreement.all.constrained_axes, 3);
+  EXPECT_NEAR(agreement.all.disagreement_m, std::sqrt(221.0) / 1000.0, 1e-5);
+
+  // Below the pairs' 14 mm apart nothing pairs, and nothing is compared.
+  AgreementParams tight = params;
+  tight.pair_travel_m = 0.013;
+  const CameraAgreement none = camera_agreement(a, b, tight);
+  EXPECT_EQ(none.paired_views, 0);
+  EXPECT_TRUE(none.links.empty());
+
+  // b at twice a's rate (θ = 0, 0.03, ..., 0.57): its even views show a's poses exactly and pair
+  // with them; its odd views, 0.03 rad from two views of a each, find both taken and stay out. A
+  // view of a is never counted twice.
+  std::vector<ArmView> twice;
+  for (int k = 0; k < 20; ++k) twice.push_back(multi_turning_view(0.03 * k, from_b, delta));
+  const CameraAgreement doubled = camera_agreement(a, twice, params);
+  EXPECT_EQ(doubled.paired_views, 10);
+  EXPECT_EQ(doubled.pair_travel_max_m, 0.0);
+  ASSERT_EQ(doubled.links.size(), 2U);
+  EXPECT_EQ(doubled.links[0].views, 10);
+  // The same pairs whichever camera comes first.
+  EXPECT_EQ(camera_agreement(twice, a, params).paired_views, 10);
+
+  // A tie goes to the earlier view: b saw the arm twice in the same pose (a sweep's next cycle),
+  // the second time with its points another 3 cm up. a's one view, 0.02 rad away, pairs with the
+  // first given, and that one's points are compared.
+  const ArmView one = multi_turning_view(0.1, from_a, Eigen::Vector3f::Zero());
+  const ArmView first = multi_turning_view(0.12, from_b, delta);
+  const ArmView again = multi_turning_view(0.12, from_b, delta + Eigen::Vector3f(0.0F, 0.0F, 0.03F));
+  params.min_link_points = 20;
+  const CameraAgreement tie = camera_agreement({one}, {first, again}, params);
+  EXPECT_EQ(tie.paired_views, 1);
+  EXPECT_NEAR(tie.all.disagreement_m, std::sqrt(221.0) / 1000.0, 1e-5);
+  const CameraAgreement tie_swapped = camera_agreement({one}, {again, first}, params);
+  EXPECT_EQ(tie_swapped.paired_views, 1);
+  EXPECT_NEAR(tie_swapped.all.disagreement_m, std::sqrt(64.0 + 121.0 + 36.0 * 36.0) / 1000.0, 1e-5);  // δ + 30 mm up
 }
 
 // ---- Writing a calibrated pose back into the cell's file.
