@@ -63,4 +63,11 @@ inline std::optional<double> camera_age_ms(const FusedCameraView& camera, int64_
   return static_cast<double>(now_shared_ns - camera.measurement->capture_ns) * 1e-6;
 }
 
+/// The camera's newest measurement withholds (learning, blocked, no robot state, ...): its last
+/// cloud no longer says what it sees, so the view does not draw it. A camera without a
+/// measurement yet has nothing to withhold.
+inline bool camera_withholds(const FusedCameraView& camera) {
+  return camera.measurement && !camera.measurement->valid;
+}
+
 }  // namespace hrcsense::ros2

@@ -205,6 +205,7 @@ void compose_fused_3d(const ros2::FusedView& view, const std::vector<Capsule>& c
                  kCloudFloorGrid);
   }
   for (size_t i = 0; i < view.cameras.size(); ++i) {
+    if (ros2::camera_withholds(view.cameras[i])) continue;
     draw_fused_cloud(view.cameras[i].cloud_base, T_view_base, in, fused_camera_color(i), scratch.cloud.zbuffer, out);
   }
   for (size_t i = 0; i < view.cameras.size(); ++i) draw_frustum(view.cameras[i], T_view_base, in, fused_camera_color(i), out);

@@ -165,17 +165,19 @@ void print(const char* name, const LoopCounts& count) {
 // may go faster, returns above the allowed speed.
 TEST(ClosedLoop, TheArmFollowingTheLinkStaysWithinTheAllowedSpeed) {
   // Under the sanitizers (each run several times slower) the loop without a hold stands for both:
-  // it is the one where every frame's scale reaches the arm.
+  // it is the one where every frame's scale reaches the arm; and it closes for 200 frames, not
+  // 300 (the person is beside the arm in every one of them either way).
   const std::vector<bool> holds = test::kSanitized ? std::vector<bool>{false} : std::vector<bool>{false, true};
+  const int closed_frames = test::kSanitized ? 200 : 300;
   for (const bool hold : holds) {
     const Config config = closed_loop_cell(hold);
     ASSERT_EQ(config.pipeline.safety.mode, SafetyParams::Mode::ssm);
     ASSERT_EQ(config.pipeline.safety.ssm.robot_decel_mps2, 0.0F);  // allowed_speed_mps's linear S_p
     ASSERT_EQ(config.pipeline.background.frames, 100);
-    const LoopCounts count = run_closed_loop(config, 100, 400);
+    const LoopCounts count = run_closed_loop(config, 100, 100 + closed_frames);
     print(hold ? "closed loop, default hold" : "closed loop, no hold", count);
-    EXPECT_GE(count.frames_with_truth, 250);
-    EXPECT_GE(count.moving, 200);  // the person does not freeze the cell
+    EXPECT_GE(count.frames_with_truth, closed_frames * 5 / 6);
+    EXPECT_GE(count.moving, closed_frames * 2 / 3);  // the person does not freeze the cell
     EXPECT_GE(count.slowed, 20);   // the loop was closed: the arm did run slower
     EXPECT_EQ(count.too_lax, 0);
     EXPECT_EQ(count.late, 0);

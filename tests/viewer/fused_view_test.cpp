@@ -145,6 +145,26 @@ TEST(FusedView, PaneDrawsEachCloudInItsColourAndThePairInTheMarkerColours) {
   EXPECT_GT(pixels_of(out, view::kContactLine), 0);
 }
 
+// A camera that withholds (here: learning its background) has its last cloud hidden: it no
+// longer says what the camera sees. Valid again, the cloud is back.
+TEST(FusedView, AWithholdingCamerasLastCloudIsNotDrawn) {
+  FusedView view;
+  view.cameras = {camera_with("a", false, {}, 1)};
+  view.cameras[0].T_base_camera.translation() = Eigen::Vector3d(3.0, 0.0, 2.0);
+  view.cameras[0].cloud_base.x = {0.0F};
+  view.cameras[0].cloud_base.y = {0.0F};
+  view.cameras[0].cloud_base.z = {1.0F};
+  view::OrbitCamera orbit;
+  orbit.target_base = Eigen::Vector3f(0.0F, 0.0F, 1.0F);  // the point projects to (50, 50)
+  view::FusedScratch scratch;
+  ColorImage out;
+  view::compose_fused_3d(view, {}, view::FusedPair{}, orbit, 101, 101, scratch, out);
+  EXPECT_NE(pixel_at(out, 50, 50), view::fused_camera_color(0));
+  view.cameras[0].measurement->valid = true;
+  view::compose_fused_3d(view, {}, view::FusedPair{}, orbit, 101, 101, scratch, out);
+  EXPECT_EQ(pixel_at(out, 50, 50), view::fused_camera_color(0));
+}
+
 TEST(FusedView, PreviewsAlongTheBottomFramedInTheirCamerasColour) {
   FusedView view;
   FusedCameraView a;
