@@ -197,18 +197,18 @@ TEST(SelfFilter, CameraPoseMovesTheArmIntoTheCameraFrame) {
 }
 
 // The foreground keeps a hand 10 cm in front of the arm and drops the arm itself.
-TEST(SelfFilter, ForegroundKeepsAHandInFrontOfTheArmAndDropsTheArm) {
-  SelfFilter filter = filter_with(1);
-  filter.add_pose(bar_at(2.0F));
-  Frame frame = camera_frame();
-  filter.render(frame, Pose::Identity(), ForegroundParams{});
-  // Background: a wall at 3 m. The bar's own rows 45..55 at the bar's depth, and a 10 x 10 px
-  // hand 10 cm in front of the bar's front at columns 40..49, rows 46..55.
+/// The learnt background of a flat wall 3 m in front of the camera.
+BackgroundModel wall_at_3m() {
   BackgroundModel background;
   background.width = background.height = kSize;
   background.mean_m.assign(kSize * kSize, 3.0F);
   background.spread_m.assign(kSize * kSize, 0.005F);
   background.valid_ratio.assign(kSize * kSize, 1.0F);
+  return background;
+}
+
+/// The wall at 3 m, and the bar's rows 45..55 at 1 cm behind its rendered front surface.
+void draw_wall_and_bar(const SelfFilter& filter, Frame& frame) {
   frame.depth.pixels.assign(kSize * kSize, 3000);
   for (int v = 45; v <= 55; ++v) {
     for (int u = 0; u < kSize; ++u) {
@@ -216,6 +216,17 @@ TEST(SelfFilter, ForegroundKeepsAHandInFrontOfTheArmAndDropsTheArm) {
       if (std::isfinite(front)) frame.depth.pixels[index(u, v)] = static_cast<uint16_t>(std::lround(front * 1000.0 + 10.0));
     }
   }
+}
+
+TEST(SelfFilter, ForegroundKeepsAHandInFrontOfTheArmAndDropsTheArm) {
+  SelfFilter filter = filter_with(1);
+  filter.add_pose(bar_at(2.0F));
+  Frame frame = camera_frame();
+  filter.render(frame, Pose::Identity(), ForegroundParams{});
+  // Background: a wall at 3 m. The bar's own rows 45..55 at the bar's depth, and a 10 x 10 px
+  // hand 10 cm in front of the bar's front at columns 40..49, rows 46..55.
+  const BackgroundModel background = wall_at_3m();
+  draw_wall_and_bar(filter, frame);
   for (int v = 46; v <= 55; ++v) {
     for (int u = 40; u <= 49; ++u) frame.depth.pixels[index(u, v)] = 1800;
   }
@@ -250,20 +261,10 @@ TEST(SelfFilter, TheArmsRimMixedWithTheWallIsTheArmsAndABodyBehindItStays) {
   filter.add_pose(bar_at(2.0F));
   Frame frame = camera_frame();
   filter.render(frame, Pose::Identity(), ForegroundParams{});
-  BackgroundModel background;
-  background.width = background.height = kSize;
-  background.mean_m.assign(kSize * kSize, 3.0F);
-  background.spread_m.assign(kSize * kSize, 0.005F);
-  background.valid_ratio.assign(kSize * kSize, 1.0F);
   // The wall at 3 m; the bar's rows 45..55 at its front + 1 cm (its cylinder covers columns
   // 40..60 at 1.9-2 m: x = ±0.2 m); rows 43..57 are its silhouette dilated by 2 px.
-  frame.depth.pixels.assign(kSize * kSize, 3000);
-  for (int v = 45; v <= 55; ++v) {
-    for (int u = 0; u < kSize; ++u) {
-      const double front = filter.surface_depth_m()[index(u, v)];
-      if (std::isfinite(front)) frame.depth.pixels[index(u, v)] = static_cast<uint16_t>(std::lround(front * 1000.0 + 10.0));
-    }
-  }
+  const BackgroundModel background = wall_at_3m();
+  draw_wall_and_bar(filter, frame);
   // Row 44 is outside the bar, inside the dilated silhouette, and its far side there is the
   // bar's back near its rim, about 2.0 m (ray_meets_bar(46, ...).second). 2.5 m is beyond it.
   ASSERT_LT(ray_meets_bar(46, 2.0, 0.1).second, 2.5);
