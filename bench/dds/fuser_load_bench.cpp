@@ -8,7 +8,8 @@
 // time, from getrusage of the child), measurements sent and accepted, instants decided, and the
 // fused latency and the fuser's added latency from its JSON Lines (p50, p99).
 // Needs CYCLONEDDS_URI set to tests/dds/cyclonedds-loopback.xml (docs/BENCHMARKS.md); with
-// HRCSENSE_BENCH_FUSER_FIFO=N the fuser runs under SCHED_FIFO priority N.
+// HRCSENSE_BENCH_FUSER_FIFO=N the fuser runs under SCHED_FIFO priority N; with
+// HRCSENSE_BENCH_FUSER_CPU=N it runs alone on CPU N and this process's threads on the others.
 #include "../common/percentile.hpp"
 #include "dds/measurement_endpoints.hpp"
 
@@ -59,6 +60,14 @@ double children_cpu_s() {
          static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) * 1e-6;
 }
 
+// Every thread of this process onto `cpus` (Cyclone's own threads included).
+void pin_this_process(const cpu_set_t& cpus) {
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    const auto tid = static_cast<pid_t>(std::stol(task.path().filename().string()));
+    sched_setaffinity(tid, sizeof(cpus), &cpus);
+  }
+}
+
 void BM_Fuser90Hz(benchmark::State& state) {
   const auto cameras = static_cast<int>(state.range(0));
   const char* uri = std::getenv("CYCLONEDDS_URI");
@@ -92,8 +101,24 @@ void BM_Fuser90Hz(benchmark::State& state) {
       posix_spawnattr_setschedpolicy(&attributes, SCHED_FIFO);
       posix_spawnattr_setschedparam(&attributes, &priority);
     }
+    // HRCSENSE_BENCH_FUSER_CPU=N: the child inherits the spawning thread's CPUs, so the thread
+    // moves to N for the spawn and the whole process to the other CPUs after it.
+    cpu_set_t all_cpus;
+    sched_getaffinity(0, sizeof(all_cpus), &all_cpus);
+    const char* fuser_cpu = std::getenv("HRCSENSE_BENCH_FUSER_CPU");
+    if (fuser_cpu != nullptr) {
+      cpu_set_t only;
+      CPU_ZERO(&only);
+      CPU_SET(std::atoi(fuser_cpu), &only);
+      sched_setaffinity(0, sizeof(only), &only);
+    }
     const int spawned = posix_spawn(&fuser, HRCSENSE_BENCH_CLI, nullptr, &attributes, argv.data(), environ);
     posix_spawnattr_destroy(&attributes);
+    if (fuser_cpu != nullptr) {
+      cpu_set_t rest = all_cpus;
+      CPU_CLR(std::atoi(fuser_cpu), &rest);
+      pin_this_process(CPU_COUNT(&rest) > 0 ? rest : all_cpus);
+    }
     if (spawned != 0) {
       state.SkipWithError("cannot start hrcsense fuse");
       return;
@@ -148,6 +173,7 @@ void BM_Fuser90Hz(benchmark::State& state) {
       next += period;
       std::this_thread::sleep_until(next);
     }
+    if (fuser_cpu != nullptr) pin_this_process(all_cpus);
     if (waitpid(fuser, &status, WNOHANG) == 0) {
       kill(fuser, SIGKILL);
       waitpid(fuser, &status, 0);
