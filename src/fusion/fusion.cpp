@@ -110,6 +110,8 @@ std::string measurement_problem(const CameraMeasurement& m) {
   }
   if (m.capture_ns <= 0) return "capture: not a time";
   if (!known_reason_code(m.reason_code)) return "reason_code: " + std::to_string(static_cast<int>(m.reason_code)) + " is unknown";
+  // The fuser reads code 0 as "this camera has no fault": a withheld measurement must say why.
+  if (!m.valid && m.reason_code == ReasonCode::clear) return "reason_code: 0 (clear) on a withheld measurement";
   if (m.links.size() > static_cast<size_t>(kMaxFusedLinks)) return "links: more than " + std::to_string(kMaxFusedLinks);
   uint64_t seen_links = 0;
   for (size_t i = 0; i < m.links.size(); ++i) {

@@ -217,6 +217,29 @@ TEST(CellFusion, BadMeasurementsAreRejectedAndCounted) {
   EXPECT_EQ(fusion.newest(1)->sequence, 5U);
 }
 
+// Found by fuzz_ros2_measurement: code 0 is how the fuser marks a camera without a fault, so a
+// withheld measurement that carried it (and a link's garbage, unchecked on a withheld one) made
+// the cell's measurement valid with a negative distance.
+TEST(CellFusion, AWithheldMeasurementWithoutAReasonIsRejectedAndTheCellStaysStopped) {
+  CellFusion fusion = two_cameras();
+  ASSERT_EQ(fusion.add(measured("front", kT0, {link_at(2, 1.5F)}), kT0), FusionIntake::accepted);
+  CameraMeasurement silent = measured("left", kT0, {link_at(2, -9.0F)});
+  silent.valid = false;
+  silent.reason_code = ReasonCode::clear;
+  EXPECT_EQ(fusion.add(silent, kT0), FusionIntake::malformed);
+  EXPECT_NE(fusion.counters(1).last_problem.find("reason_code: 0"), std::string::npos) << fusion.counters(1).last_problem;
+  Measurement out;
+  fusion.fuse(kT0, 1, kT0 + kMs, out);
+  EXPECT_FALSE(out.valid);
+  EXPECT_EQ(out.withheld_code, ReasonCode::camera_stale);
+  // With a reason it is accepted, and its own stop is the cell's.
+  silent.reason_code = ReasonCode::no_valid_depth;
+  EXPECT_EQ(fusion.add(silent, kT0), FusionIntake::accepted);
+  fusion.fuse(kT0, 2, kT0 + kMs, out);
+  EXPECT_FALSE(out.valid);
+  EXPECT_EQ(out.withheld_code, ReasonCode::no_valid_depth);
+}
+
 TEST(CellFusion, AGridOfAnotherSizeIsRejected) {
   FusionParams params = zones_params();
   params.grid.enabled = true;
