@@ -5,6 +5,7 @@
 #include "common/app_errors.hpp"
 #include "common/assembly.hpp"
 #include "common/console_sink.hpp"
+#include "common/fuser_priority.hpp"
 #include "common/stop_signals.hpp"
 #include "common/tee_sink.hpp"
 
@@ -387,6 +388,13 @@ int fuse_session(const Config& config, const FuseOptions& options) {
   if (config.cameras.empty()) {
     throw ConfigError(config_where(config) + ": hrcsense fuse needs the cameras: list of a cell with several cameras "
                                              "(docs/MULTICAMERA.md)");
+  }
+  // Before any thread starts (DDS, the links, the relay): they inherit it.
+  if (const std::string refused = run_under_fifo(config.cell.fuser_priority); !refused.empty()) {
+    throw ConfigError(config_where(config) + ": " + refused);
+  }
+  if (config.cell.fuser_priority > 0) {
+    spdlog::info("fuse: every thread under SCHED_FIFO at priority {} (cell.fuser_priority)", config.cell.fuser_priority);
   }
   const StopSignals signals;
   std::ofstream file;

@@ -260,6 +260,10 @@ void read_cell(KeyReader& r, Config& c) {
   if (has_cameras || r.raw("cell.clock_offset_max_s").IsDefined()) {
     r.number("cell.clock_offset_max_s", c.cell.clock_offset_max_s, Bound::non_negative, kMaxClockOffsetS);
   }
+  if (has_cameras || r.raw("cell.fuser_priority").IsDefined()) {
+    // SCHED_FIFO's range on Linux.
+    r.integer("cell.fuser_priority", c.cell.fuser_priority, 0, 99);
+  }
 
   if (r.raw("sim.epoch").IsDefined()) {
     double epoch_s = 0.0;

@@ -170,6 +170,18 @@ TEST(CamerasConfig, BadGridsAreRefused) {
                       {"cubes", "cell.voxel_m"});
 }
 
+TEST(CamerasConfig, TheFusersPriorityIsOffByDefaultAndWithinSchedFifosRange) {
+  TempDir dir;
+  const std::string path = dir.write("cell.yaml", kTwoCameras);
+  EXPECT_EQ(load_config(path, {}).cell.fuser_priority, 0);
+  EXPECT_EQ(load_config(path, {"cell.fuser_priority=42"}).cell.fuser_priority, 42);
+  EXPECT_EQ(load_config(path, {"cell.fuser_priority=99"}).cell.fuser_priority, 99);
+  expect_config_error(path, {"cell.fuser_priority=100"}, {"cell.fuser_priority"});
+  expect_config_error(path, {"cell.fuser_priority=-1"}, {"cell.fuser_priority"});
+  expect_config_error(path, {"cell.fuser_priority=1.5"}, {"cell.fuser_priority"});
+  expect_config_error(path, {"cell.fuser_priority=.nan"}, {"cell.fuser_priority"});
+}
+
 TEST(CamerasConfig, UnknownCameraNamesTheEntries) {
   TempDir dir;
   const std::string path = dir.write("cell.yaml", kTwoCameras);

@@ -224,6 +224,10 @@ struct CellConfig {
   /// `cell.clock_offset_max_s` (0): the bound checked for every camera host's clock offset from
   /// the fuser's (docs/MULTICAMERA.md, "Clocks"); the fuser takes every capture as this much older.
   double clock_offset_max_s = 0.0;
+  /// `cell.fuser_priority` (0): 1..99 runs every thread of the fuser under SCHED_FIFO at this
+  /// priority, so that the cameras' processing on the same host cannot delay its decision
+  /// (docs/MULTICAMERA.md, "The fuser's host"); 0 leaves it to the normal scheduler.
+  int fuser_priority = 0;
 };
 
 struct Config {
